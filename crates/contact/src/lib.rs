@@ -1,0 +1,1 @@
+//! fbd-contact (to be written).

@@ -1,0 +1,1 @@
+//! fbd-dynamics (to be written).

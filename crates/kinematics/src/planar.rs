@@ -1,0 +1,427 @@
+//! Planar 7-DOF kinematics of the two-leg model (SPEC §1.4, paper §3.2).
+//!
+//! Every auxiliary point of the planar model (hips, knees, tips, link centres
+//! of mass) is the body position plus a sum of rotated segments,
+//!
+//! ```text
+//! p(q) = (Rx, Ry) + Σ_m ℓ_m · (cos α_m(q), sin α_m(q)),
+//! ```
+//!
+//! where every angle `α_m` is *linear* in the generalised coordinates. This
+//! holds for any planar tree of revolute joints on a floating base, so the
+//! description ([`PlanarChains`]) is generic; [`PlanarChains::two_leg`] builds
+//! the paper's model. The analytic Jacobian and the velocity-product
+//! ("second-derivative") terms follow in closed form:
+//!
+//! ```text
+//! ∂p/∂q_i = δ_{i,Rx} ex + δ_{i,Ry} ey + Σ_m ℓ_m c_{m,i} (−sin α_m, cos α_m)
+//! p̈ = J q̈ + Σ_m −ℓ_m α̇_m² (cos α_m, sin α_m)
+//! ```
+//!
+//! The model is immutable ([`PlanarChains`]); evaluations go into a reusable
+//! workspace ([`PlanarData`]) so that stepping never allocates.
+
+/// Number of generalised coordinates of the two-leg planar model.
+pub const NQ: usize = 7;
+/// Index of `Rx` in `q`.
+pub const RX: usize = 0;
+/// Index of `Ry` in `q`.
+pub const RY: usize = 1;
+/// Index of `φz` in `q`.
+pub const PHI_Z: usize = 2;
+
+/// Index in `q` of θ2 (hip) of the planar leg `leg` (0 = leg 3, 1 = leg 4).
+pub const fn theta2_index(leg: usize) -> usize {
+    3 + 2 * leg
+}
+/// Index in `q` of θ3 (knee) of the planar leg `leg` (0 = leg 3, 1 = leg 4).
+pub const fn theta3_index(leg: usize) -> usize {
+    4 + 2 * leg
+}
+
+/// Side sign `s` of SPEC §1.4: −1 for leg 3 (left), +1 for leg 4 (right).
+pub const fn side_sign(leg: usize) -> f64 {
+    if leg == 0 { -1.0 } else { 1.0 }
+}
+
+/// The hexapod leg number (3 or 4) of planar leg `leg` (0 or 1).
+pub const fn hexapod_leg_number(leg: usize) -> usize {
+    3 + leg
+}
+
+/// An angle linear in the generalised coordinates:
+/// `α(q) = offset + Σ coef · q[index]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearAngle {
+    /// Constant part (rad).
+    pub offset: f64,
+    /// `(index into q, coefficient)` pairs.
+    pub terms: Vec<(usize, f64)>,
+}
+
+impl LinearAngle {
+    /// Evaluates the angle at `q`.
+    pub fn value(&self, q: &[f64]) -> f64 {
+        self.offset + self.terms.iter().map(|&(i, c)| c * q[i]).sum::<f64>()
+    }
+
+    /// `∂α/∂q_i`.
+    pub fn coefficient(&self, i: usize) -> f64 {
+        self.terms
+            .iter()
+            .filter(|&&(j, _)| j == i)
+            .map(|&(_, c)| c)
+            .sum()
+    }
+
+    /// `α̇ = Σ coef · q̇[index]`.
+    pub fn rate(&self, qdot: &[f64]) -> f64 {
+        self.terms.iter().map(|&(i, c)| c * qdot[i]).sum()
+    }
+}
+
+/// A point of the mechanism: the base position plus rotated segments
+/// `(angle index, length)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PointDef {
+    /// Human-readable name, e.g. `"tip3"`.
+    pub name: String,
+    /// `(index into PlanarChains::angles, length in m)`.
+    pub segments: Vec<(usize, f64)>,
+}
+
+/// Generic planar floating-base tree: the angles and points, immutable.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanarChains {
+    /// Number of generalised coordinates; `q[0], q[1]` are the base position.
+    pub nq: usize,
+    /// Every angle that orients a segment or a body.
+    pub angles: Vec<LinearAngle>,
+    /// Every auxiliary point.
+    pub points: Vec<PointDef>,
+}
+
+/// Geometry of the two-leg planar model (both legs alike, as in the paper).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanarGeometry {
+    /// `d = L·cos(π/6)`: distance from the body centre to each hip (m).
+    pub d: f64,
+    /// Upper link length `a` (m).
+    pub a: f64,
+    /// Lower link length `c` (m).
+    pub c: f64,
+    /// Upper link centre of mass, as a fraction of `a` from the hip.
+    pub upper_com: f64,
+    /// Lower link centre of mass, as a fraction of `c` from the knee.
+    pub lower_com: f64,
+}
+
+impl Default for PlanarGeometry {
+    /// The SPEC §1.4 test-vector geometry: `L = 0.25` (so `d = 0.25·cos 30°`),
+    /// `a = 0.2`, `c = 0.42`, centres of mass at mid-link.
+    fn default() -> Self {
+        Self {
+            d: 0.25 * (std::f64::consts::PI / 6.0).cos(),
+            a: 0.2,
+            c: 0.42,
+            upper_com: 0.5,
+            lower_com: 0.5,
+        }
+    }
+}
+
+/// Indices of the named angles and points of the two-leg model in its
+/// [`PlanarChains`]. Per-leg arrays are `[leg 3, leg 4]`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TwoLegIndex {
+    /// The central body's angle `φz`.
+    pub body_angle: usize,
+    /// Absolute angle of each upper link (direction hip → knee).
+    pub upper_angle: [usize; 2],
+    /// Absolute angle of each lower link (direction knee → tip).
+    pub lower_angle: [usize; 2],
+    /// Hip points.
+    pub hip: [usize; 2],
+    /// Knee points.
+    pub knee: [usize; 2],
+    /// Tip (foot) points.
+    pub tip: [usize; 2],
+    /// Upper link centres of mass.
+    pub upper_com: [usize; 2],
+    /// Lower link centres of mass.
+    pub lower_com: [usize; 2],
+    /// The central body's centre of mass (= R).
+    pub body_com: usize,
+}
+
+impl PlanarChains {
+    /// The paper's planar model: central body and legs 3 and 4 (SPEC §1.4).
+    pub fn two_leg(g: &PlanarGeometry) -> (Self, TwoLegIndex) {
+        use std::f64::consts::PI;
+        let mut angles = vec![LinearAngle {
+            offset: 0.0,
+            terms: vec![(PHI_Z, 1.0)],
+        }];
+        let mut points = vec![PointDef {
+            name: "body".into(),
+            segments: vec![],
+        }];
+        let mut idx = TwoLegIndex {
+            body_angle: 0,
+            upper_angle: [0; 2],
+            lower_angle: [0; 2],
+            hip: [0; 2],
+            knee: [0; 2],
+            tip: [0; 2],
+            upper_com: [0; 2],
+            lower_com: [0; 2],
+            body_com: 0,
+        };
+        for leg in 0..2 {
+            let s = side_sign(leg);
+            let n = hexapod_leg_number(leg);
+            let (t2, t3) = (theta2_index(leg), theta3_index(leg));
+            // hip = R + Rot(φz)(s·d, 0)
+            let hip_dir = angles.len();
+            angles.push(LinearAngle {
+                offset: if s < 0.0 { PI } else { 0.0 },
+                terms: vec![(PHI_Z, 1.0)],
+            });
+            // knee − hip = Rot(φz)(s·a·cos θ2, −a·sin θ2) = a·u(φz − s·θ2 [+π if s<0])
+            let up = angles.len();
+            angles.push(LinearAngle {
+                offset: if s < 0.0 { PI } else { 0.0 },
+                terms: vec![(PHI_Z, 1.0), (t2, -s)],
+            });
+            // tip − knee = Rot(φz)(−s·c·cos β, c·sin β) = c·u(φz − s·β [+π if s>0])
+            let low = angles.len();
+            angles.push(LinearAngle {
+                offset: if s > 0.0 { PI } else { 0.0 },
+                terms: vec![(PHI_Z, 1.0), (t2, -s), (t3, -s)],
+            });
+            let hip = vec![(hip_dir, g.d)];
+            let knee = [hip.clone(), vec![(up, g.a)]].concat();
+            let tip = [knee.clone(), vec![(low, g.c)]].concat();
+            let ucom = [hip.clone(), vec![(up, g.a * g.upper_com)]].concat();
+            let lcom = [knee.clone(), vec![(low, g.c * g.lower_com)]].concat();
+            let mut push = |name: String, segments: Vec<(usize, f64)>| {
+                points.push(PointDef { name, segments });
+                points.len() - 1
+            };
+            idx.hip[leg] = push(format!("hip{n}"), hip);
+            idx.knee[leg] = push(format!("knee{n}"), knee);
+            idx.tip[leg] = push(format!("tip{n}"), tip);
+            idx.upper_com[leg] = push(format!("upper_com{n}"), ucom);
+            idx.lower_com[leg] = push(format!("lower_com{n}"), lcom);
+            idx.upper_angle[leg] = up;
+            idx.lower_angle[leg] = low;
+        }
+        (
+            Self {
+                nq: NQ,
+                angles,
+                points,
+            },
+            idx,
+        )
+    }
+
+    /// A fresh workspace sized for this model.
+    pub fn new_data(&self) -> PlanarData {
+        PlanarData {
+            angle: vec![0.0; self.angles.len()],
+            cos: vec![0.0; self.angles.len()],
+            sin: vec![0.0; self.angles.len()],
+            pos: vec![[0.0; 2]; self.points.len()],
+            jac: vec![0.0; self.points.len() * 2 * self.nq],
+            nq: self.nq,
+        }
+    }
+
+    /// Evaluates every angle, its sine and cosine, and every point at `q`.
+    pub fn eval_positions(&self, q: &[f64], data: &mut PlanarData) {
+        assert_eq!(q.len(), self.nq, "q has the wrong length");
+        for (k, a) in self.angles.iter().enumerate() {
+            let v = a.value(q);
+            let (s, c) = v.sin_cos();
+            data.angle[k] = v;
+            data.sin[k] = s;
+            data.cos[k] = c;
+        }
+        for (p, def) in self.points.iter().enumerate() {
+            let mut x = q[RX];
+            let mut y = q[RY];
+            for &(a, l) in &def.segments {
+                x += l * data.cos[a];
+                y += l * data.sin[a];
+            }
+            data.pos[p] = [x, y];
+        }
+    }
+
+    /// Fills the analytic point Jacobians; call after [`Self::eval_positions`].
+    pub fn eval_jacobians(&self, data: &mut PlanarData) {
+        let nq = self.nq;
+        data.jac.fill(0.0);
+        for (p, def) in self.points.iter().enumerate() {
+            let base = p * 2 * nq;
+            data.jac[base + RX] = 1.0;
+            data.jac[base + nq + RY] = 1.0;
+            for &(a, l) in &def.segments {
+                let (s, c) = (data.sin[a], data.cos[a]);
+                for &(i, coef) in &self.angles[a].terms {
+                    data.jac[base + i] -= l * coef * s;
+                    data.jac[base + nq + i] += l * coef * c;
+                }
+            }
+        }
+    }
+
+    /// Velocity of point `p`: `J(q)·q̇` (after [`Self::eval_jacobians`]).
+    pub fn point_velocity(&self, data: &PlanarData, p: usize, qdot: &[f64]) -> [f64; 2] {
+        let mut v = [0.0; 2];
+        for (axis, vk) in v.iter_mut().enumerate() {
+            *vk = (0..self.nq).map(|i| data.jac_at(p, axis, i) * qdot[i]).sum();
+        }
+        v
+    }
+
+    /// The velocity-product term of the acceleration of point `p`,
+    /// `J̇(q, q̇)·q̇ = Σ_m −ℓ_m α̇_m² (cos α_m, sin α_m)`, so that
+    /// `p̈ = J·q̈ + J̇·q̇` (after [`Self::eval_positions`]).
+    pub fn point_bias_acceleration(&self, data: &PlanarData, p: usize, qdot: &[f64]) -> [f64; 2] {
+        let mut b = [0.0; 2];
+        for &(a, l) in &self.points[p].segments {
+            let w = self.angles[a].rate(qdot);
+            b[0] -= l * w * w * data.cos[a];
+            b[1] -= l * w * w * data.sin[a];
+        }
+        b
+    }
+}
+
+/// Workspace of [`PlanarChains`] evaluations (allocated once).
+#[derive(Clone, Debug)]
+pub struct PlanarData {
+    /// Angle values (rad).
+    pub angle: Vec<f64>,
+    /// `cos` of each angle.
+    pub cos: Vec<f64>,
+    /// `sin` of each angle.
+    pub sin: Vec<f64>,
+    /// Inertial position of each point (m).
+    pub pos: Vec<[f64; 2]>,
+    /// Point Jacobians, `[point][axis][q index]` flattened.
+    pub jac: Vec<f64>,
+    nq: usize,
+}
+
+impl PlanarData {
+    /// `∂p_axis/∂q_i` of point `p`.
+    #[inline]
+    pub fn jac_at(&self, p: usize, axis: usize, i: usize) -> f64 {
+        self.jac[(p * 2 + axis) * self.nq + i]
+    }
+
+    /// The row `∂p_axis/∂q` of point `p`.
+    #[inline]
+    pub fn jac_row(&self, p: usize, axis: usize) -> &[f64] {
+        let s = (p * 2 + axis) * self.nq;
+        &self.jac[s..s + self.nq]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fd::{FdTolerance, check_jacobian};
+
+    fn paper_q() -> [f64; NQ] {
+        [0.0, 0.6, 0.0, 0.0, 245f64.to_radians(), 0.0, 255f64.to_radians()]
+    }
+
+    #[test]
+    fn spec_test_vector() {
+        let (ch, ix) = PlanarChains::two_leg(&PlanarGeometry::default());
+        let mut d = ch.new_data();
+        ch.eval_positions(&paper_q(), &mut d);
+        let t3 = d.pos[ix.tip[0]];
+        let t4 = d.pos[ix.tip[1]];
+        assert!((t3[0] + 0.594006).abs() < 1e-6 && (t3[1] - 0.219351).abs() < 1e-6, "{t3:?}");
+        assert!((t4[0] - 0.525210).abs() < 1e-6 && (t4[1] - 0.194311).abs() < 1e-6, "{t4:?}");
+    }
+
+    #[test]
+    fn spec_formulas_in_body_frame() {
+        // SPEC §1.4 written out literally, at an arbitrary configuration.
+        let g = PlanarGeometry::default();
+        let (ch, ix) = PlanarChains::two_leg(&g);
+        let mut d = ch.new_data();
+        let q = [0.1, 0.5, 0.3, 0.2, 4.0, -0.3, 4.3];
+        ch.eval_positions(&q, &mut d);
+        for leg in 0..2 {
+            let s = side_sign(leg);
+            let (t2, t3) = (q[theta2_index(leg)], q[theta3_index(leg)]);
+            let hip = [s * g.d, 0.0];
+            let knee = [hip[0] + s * g.a * t2.cos(), hip[1] - g.a * t2.sin()];
+            let tip = [knee[0] - s * g.c * (t2 + t3).cos(), knee[1] + g.c * (t2 + t3).sin()];
+            let (sp, cp) = q[PHI_Z].sin_cos();
+            let to_world = |p: [f64; 2]| [q[0] + cp * p[0] - sp * p[1], q[1] + sp * p[0] + cp * p[1]];
+            for (want, got) in [(hip, ix.hip[leg]), (knee, ix.knee[leg]), (tip, ix.tip[leg])] {
+                let w = to_world(want);
+                let p = d.pos[got];
+                assert!((w[0] - p[0]).abs() < 1e-12 && (w[1] - p[1]).abs() < 1e-12);
+            }
+        }
+    }
+
+    #[test]
+    fn point_jacobians_match_finite_differences() {
+        let (ch, _) = PlanarChains::two_leg(&PlanarGeometry::default());
+        let mut d = ch.new_data();
+        let q = [0.1, 0.5, 0.3, 0.2, 4.0, -0.3, 4.3];
+        ch.eval_positions(&q, &mut d);
+        ch.eval_jacobians(&mut d);
+        let np = ch.points.len();
+        let mut work = ch.new_data();
+        check_jacobian(
+            &q,
+            2 * np,
+            |x, out| {
+                ch.eval_positions(x, &mut work);
+                for p in 0..np {
+                    out[2 * p] = work.pos[p][0];
+                    out[2 * p + 1] = work.pos[p][1];
+                }
+            },
+            |i, j| d.jac_at(i / 2, i % 2, j),
+            FdTolerance::default(),
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+    }
+
+    #[test]
+    fn bias_acceleration_matches_second_difference() {
+        // p(q + t·q̇) has second derivative J̇q̇ at t = 0 (q̈ = 0).
+        let (ch, _) = PlanarChains::two_leg(&PlanarGeometry::default());
+        let mut d = ch.new_data();
+        let q = [0.1, 0.5, 0.3, 0.2, 4.0, -0.3, 4.3];
+        let qd = [0.4, -0.2, 1.1, -2.0, 3.0, 0.7, -1.5];
+        ch.eval_positions(&q, &mut d);
+        let h = 1e-4;
+        let at = |t: f64| {
+            let mut w = ch.new_data();
+            let x: Vec<f64> = q.iter().zip(qd).map(|(a, b)| a + t * b).collect();
+            ch.eval_positions(&x, &mut w);
+            w.pos
+        };
+        let (pp, p0, pm) = (at(h), at(0.0), at(-h));
+        for p in 0..ch.points.len() {
+            let b = ch.point_bias_acceleration(&d, p, &qd);
+            for k in 0..2 {
+                let fd = (pp[p][k] - 2.0 * p0[p][k] + pm[p][k]) / (h * h);
+                assert!((fd - b[k]).abs() < 1e-5 * (1.0 + b[k].abs()), "point {p} axis {k}: {fd} vs {}", b[k]);
+            }
+        }
+    }
+}

@@ -1,0 +1,1 @@
+//! fbd-sim (to be written).

@@ -1,0 +1,1 @@
+//! fbd-solver (to be written).

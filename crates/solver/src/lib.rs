@@ -1,1 +1,20 @@
-//! fbd-solver (to be written).
+//! # fbd-solver
+//!
+//! Newton's method for square nonlinear systems `r(x) = 0` with a sparse
+//! analytic Jacobian, factored by faer's sparse LU.
+//!
+//! * A system describes itself through [`NewtonSystem`]: its dimension, a
+//!   *pattern key* (equal keys ⇔ equal sparsity patterns), the pattern, and an
+//!   evaluation of residual and Jacobian values.
+//! * [`NewtonSolver`] keeps, per pattern key, the CSC structure, a dense
+//!   `(row, col) → slot` map and faer's symbolic LU (computed once per
+//!   pattern); each iteration refactors numerically into reused buffers.
+//!   After the first solve of a pattern, solving does not allocate.
+
+mod error;
+mod newton;
+mod system;
+
+pub use error::SolverError;
+pub use newton::{NewtonParams, NewtonReport, NewtonSolver};
+pub use system::{JacobianSink, NewtonSystem};

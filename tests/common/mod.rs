@@ -1,0 +1,4 @@
+//! Shared helpers of the workspace-level tests.
+#![allow(dead_code)]
+
+pub mod strategies;

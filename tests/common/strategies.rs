@@ -1,0 +1,2 @@
+//! Bounded, physical proptest strategies: the one place tests draw random
+//! configurations from.

@@ -1,1 +1,19 @@
-//! fbd-contact (to be written).
+//! # fbd-contact
+//!
+//! The foot–soil interaction of the paper (§5.4, SPEC §3): a rigid terrain
+//! `y = ϱ(x)` with its local tangent and normal ([`terrain`]), and the
+//! three-state contact machine ST1 (no contact), ST2 (contact without
+//! sliding), ST3 (contact with sliding) with every switching rule
+//! ([`mode`]).
+//!
+//! The crate is pure logic: it decides which equations a contact point
+//! contributes; `fbd-dynamics` assembles them and `fbd-sim` re-solves a step
+//! until the states are consistent.
+
+pub mod error;
+pub mod mode;
+pub mod terrain;
+
+pub use error::ContactError;
+pub use mode::{ContactParams, ContactState, Friction, StateCode, Trial, transition};
+pub use terrain::Terrain;

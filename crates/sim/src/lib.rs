@@ -1,1 +1,38 @@
-//! fbd-sim (to be written).
+//! # fbd-sim
+//!
+//! Composes kinematics, FBD assembly, contact and the Newton solver into a
+//! simulation of the paper's planar 7-DOF model.
+//!
+//! * [`Model`] (immutable, validated from [`PlanarParams`]) and [`Data`]
+//!   (the mutable workspace built from it);
+//! * [`step`] — one staged time step (kinematics → predictor → solve →
+//!   contact check → accept), see [`mod@step`];
+//! * [`run`] — the whole loop with per-row callback and a [`RunSummary`].
+//!
+//! ```
+//! use fbd_sim::{Model, PlanarParams, run_collect};
+//! let mut p = PlanarParams::default();
+//! p.duration = 0.05;
+//! let model = Model::planar(&p).unwrap();
+//! let (rows, summary) = run_collect(&model);
+//! assert!(summary.error.is_none());
+//! assert_eq!(rows.len(), 6);
+//! ```
+
+mod data;
+pub mod energy;
+mod error;
+mod model;
+mod params;
+pub mod record;
+mod run;
+pub mod step;
+mod system;
+
+pub use data::Data;
+pub use error::SimError;
+pub use model::Model;
+pub use params::PlanarParams;
+pub use record::{Event, StepRecord};
+pub use run::{RunSummary, run, run_collect};
+pub use step::step;

@@ -1,0 +1,336 @@
+//! Residual and analytic Jacobian of one time step, assembled body by body.
+//!
+//! Unknowns `z = [q[k+1] | joint forces (x, y) | contact forces (Fa, N)]`,
+//! equations `[3 per body (x, y, rotation) | 2 per contact]` (see
+//! [`crate::Layout`]). Rows are in newtons (N·m for rotation rows); contact
+//! position rows are multiplied by `K = M/Δt²` so that they are forces too,
+//! which keeps the Jacobian well scaled for partial pivoting.
+//!
+//! The Jacobian is written entry by entry through a [`JacobianSink`]; the
+//! same code path with [`pattern`] declares the structure, so the two cannot
+//! drift apart.
+
+use crate::body::{BodyStep, cross};
+use crate::mechanism::Mechanism;
+use fbd_contact::{ContactState, Terrain};
+use fbd_kinematics::planar::PlanarData;
+
+/// Receives Jacobian entries.
+pub trait JacobianSink {
+    /// `false` for a residual-only evaluation.
+    const ACTIVE: bool;
+    /// Adds `v` to entry `(row, col)`.
+    fn add(&mut self, row: usize, col: usize, v: f64);
+}
+
+/// A sink that ignores entries: residual-only evaluation.
+pub struct NoJacobian;
+
+impl JacobianSink for NoJacobian {
+    const ACTIVE: bool = false;
+    #[inline]
+    fn add(&mut self, _: usize, _: usize, _: f64) {}
+}
+
+struct PatternSink<'a>(&'a mut Vec<(usize, usize)>);
+
+impl JacobianSink for PatternSink<'_> {
+    const ACTIVE: bool = true;
+    #[inline]
+    fn add(&mut self, row: usize, col: usize, _: f64) {
+        self.0.push((row, col));
+    }
+}
+
+/// The equations a contact point contributes in this step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactEquation {
+    /// ST1 / ST2 (with anchor) / ST3 (with direction).
+    pub state: ContactState,
+    /// Unit tangent of the terrain frame the forces are expressed in.
+    pub tangent: [f64; 2],
+    /// Unit normal of that frame.
+    pub normal: [f64; 2],
+    /// Dynamic friction coefficient μD (used in ST3).
+    pub mu_dynamic: f64,
+}
+
+impl Default for ContactEquation {
+    fn default() -> Self {
+        Self {
+            state: ContactState::Free,
+            tangent: [1.0, 0.0],
+            normal: [0.0, 1.0],
+            mu_dynamic: 0.0,
+        }
+    }
+}
+
+/// Where the previous configuration comes from.
+#[derive(Clone, Copy, Debug)]
+pub enum History<'a> {
+    /// `k ≥ 1`: the configuration before, kept in [`FbdData`] by [`advance`].
+    Previous,
+    /// `k = 0`: the initial generalised velocity `q̇(0)`.
+    Initial {
+        /// `q̇(0)`.
+        qdot: &'a [f64],
+    },
+}
+
+/// Mutable workspace of the assembly (allocated once per mechanism).
+#[derive(Clone, Debug)]
+pub struct FbdData {
+    /// Kinematics at `q[k−1]`.
+    pub kin_prev: PlanarData,
+    /// Kinematics at `q[k]` (positions and Jacobians).
+    pub kin: PlanarData,
+    /// Kinematics at the current Newton iterate of `q[k+1]`.
+    pub kin_next: PlanarData,
+    /// Per-body constants of this step.
+    pub body: Vec<BodyStep>,
+    /// Per-contact equations of this step.
+    pub contact: Vec<ContactEquation>,
+    /// Joint torques at `k` (N·m), positive towards larger joint angles.
+    pub torque: Vec<f64>,
+    /// Time step (s).
+    pub dt: f64,
+    /// Scale of contact position rows, `M/Δt²` (N/m).
+    pub position_gain: f64,
+    acc: Vec<[f64; 3]>,
+}
+
+impl FbdData {
+    /// A workspace for `mech`.
+    pub fn new(mech: &Mechanism) -> Self {
+        let kin = mech.chains.new_data();
+        Self {
+            kin_prev: kin.clone(),
+            kin_next: kin.clone(),
+            kin,
+            body: vec![BodyStep::default(); mech.bodies.len()],
+            contact: vec![ContactEquation::default(); mech.contacts.len()],
+            torque: vec![0.0; mech.joints.len()],
+            dt: 0.0,
+            position_gain: 0.0,
+            acc: vec![[0.0; 3]; mech.bodies.len()],
+        }
+    }
+
+    /// Body coordinates `(X, Y, ψ)` of body `b` in the kinematics `kin`.
+    #[inline]
+    pub fn body_coords(mech: &Mechanism, kin: &PlanarData, b: usize) -> [f64; 3] {
+        let spec = &mech.bodies[b];
+        let p = kin.pos[spec.com];
+        [p[0], p[1], kin.angle[spec.angle]]
+    }
+}
+
+/// Sets `q[k]` (used at `k = 0`; afterwards [`advance`] does it).
+pub fn set_configuration(mech: &Mechanism, data: &mut FbdData, q: &[f64]) {
+    mech.chains.eval_positions(q, &mut data.kin);
+    mech.chains.eval_jacobians(&mut data.kin);
+}
+
+/// Stage "kinematics at k": the per-body constants of this step's second
+/// differences, given `q[k]` already set.
+pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, dt: f64) {
+    data.dt = dt;
+    data.position_gain = mech.total_mass() / (dt * dt);
+    for b in 0..mech.bodies.len() {
+        let x_k = FbdData::body_coords(mech, &data.kin, b);
+        data.body[b] = match history {
+            History::Previous => BodyStep::from_history(x_k, FbdData::body_coords(mech, &data.kin_prev, b)),
+            History::Initial { qdot } => {
+                let spec = &mech.bodies[b];
+                let v = mech.chains.point_velocity(&data.kin, spec.com, qdot);
+                let w = mech.chains.angles[spec.angle].rate(qdot);
+                BodyStep::from_velocity(x_k, [v[0], v[1], w], dt)
+            }
+        };
+    }
+}
+
+/// Accepts `q[k+1]`: `q[k]` becomes the previous configuration and `q[k+1]`
+/// the current one.
+pub fn advance(mech: &Mechanism, data: &mut FbdData, q_next: &[f64]) {
+    std::mem::swap(&mut data.kin_prev, &mut data.kin);
+    mech.chains.eval_positions(q_next, &mut data.kin);
+    mech.chains.eval_jacobians(&mut data.kin);
+}
+
+/// A key identifying the sparsity pattern: the contact states' codes in
+/// base 3 (the slide direction changes values, not structure).
+pub fn pattern_key(data: &FbdData) -> u64 {
+    data.contact
+        .iter()
+        .fold(0u64, |k, c| k * 3 + c.state.code() as u64)
+}
+
+/// Pushes every structural `(row, col)` of the Jacobian for the current
+/// contact states.
+pub fn pattern(mech: &Mechanism, data: &FbdData, entries: &mut Vec<(usize, usize)>) {
+    let mut sink = PatternSink(entries);
+    force_entries(mech, data, &mut sink);
+    position_entries(mech, &Terrain::None, data, &mut sink);
+}
+
+/// Residual `r(z)` and, through `jac`, the analytic Jacobian.
+pub fn eval<S: JacobianSink>(mech: &Mechanism, terrain: &Terrain, data: &mut FbdData, z: &[f64], r: &mut [f64], jac: &mut S) {
+    let lay = mech.layout();
+    assert_eq!(z.len(), lay.dim(), "unknown vector has the wrong length");
+    assert_eq!(r.len(), lay.dim(), "residual vector has the wrong length");
+    let nq = lay.nq;
+    mech.chains.eval_positions(&z[..nq], &mut data.kin_next);
+    if S::ACTIVE {
+        mech.chains.eval_jacobians(&mut data.kin_next);
+    }
+    let dt = data.dt;
+    // Sum of applied forces and moments per body, at configuration k.
+    for (b, acc) in data.acc.iter_mut().enumerate() {
+        *acc = [0.0, -mech.bodies[b].mass * mech.gravity, 0.0];
+    }
+    for (j, spec) in mech.joints.iter().enumerate() {
+        let f = [z[lay.joint_force(j, 0)], z[lay.joint_force(j, 1)]];
+        let p = data.kin.pos[spec.point];
+        let tz = spec.axis_z * data.torque[j];
+        for (b, sgn) in [(spec.child, 1.0), (spec.parent, -1.0)] {
+            let c = data.body[b].com_k;
+            let a = &mut data.acc[b];
+            a[0] += sgn * f[0];
+            a[1] += sgn * f[1];
+            a[2] += sgn * (cross([p[0] - c[0], p[1] - c[1]], f) + tz);
+        }
+    }
+    for (ci, spec) in mech.contacts.iter().enumerate() {
+        let eq = &data.contact[ci];
+        let (fa, n) = (z[lay.contact_fa(ci)], z[lay.contact_n(ci)]);
+        let f = [fa * eq.tangent[0] + n * eq.normal[0], fa * eq.tangent[1] + n * eq.normal[1]];
+        let p = data.kin.pos[spec.point];
+        let c = data.body[spec.body].com_k;
+        let a = &mut data.acc[spec.body];
+        a[0] += f[0];
+        a[1] += f[1];
+        a[2] += cross([p[0] - c[0], p[1] - c[1]], f);
+    }
+    for (b, spec) in mech.bodies.iter().enumerate() {
+        let x = FbdData::body_coords(mech, &data.kin_next, b);
+        let bs = &data.body[b];
+        let row = lay.body_row(b);
+        let a = data.acc[b];
+        r[row] = spec.mass * bs.acceleration(0, x[0], dt) - a[0];
+        r[row + 1] = spec.mass * bs.acceleration(1, x[1], dt) - a[1];
+        r[row + 2] = spec.versor_z * (spec.inertia * bs.acceleration(2, x[2], dt) - a[2]);
+    }
+    let k = data.position_gain;
+    for (ci, spec) in mech.contacts.iter().enumerate() {
+        let eq = &data.contact[ci];
+        let row = lay.contact_row(ci);
+        let (fa, n) = (z[lay.contact_fa(ci)], z[lay.contact_n(ci)]);
+        let p = data.kin_next.pos[spec.point];
+        match eq.state {
+            ContactState::Free => {
+                r[row] = fa;
+                r[row + 1] = n;
+            }
+            ContactState::Stick { anchor } => {
+                r[row] = k * (p[0] - anchor[0]);
+                r[row + 1] = k * (p[1] - anchor[1]);
+            }
+            ContactState::Slide { dir } => {
+                r[row] = fa + dir * eq.mu_dynamic * n;
+                r[row + 1] = k * terrain.clearance(p);
+            }
+        }
+    }
+    if S::ACTIVE {
+        force_entries(mech, data, jac);
+        position_entries(mech, terrain, data, jac);
+    }
+}
+
+/// Entries in the force columns (they do not depend on the iterate).
+fn force_entries<S: JacobianSink>(mech: &Mechanism, data: &FbdData, jac: &mut S) {
+    let lay = mech.layout();
+    for (j, spec) in mech.joints.iter().enumerate() {
+        let (cx, cy) = (lay.joint_force(j, 0), lay.joint_force(j, 1));
+        let p = data.kin.pos[spec.point];
+        for (b, sgn) in [(spec.child, 1.0), (spec.parent, -1.0)] {
+            let c = data.body[b].com_k;
+            let v = mech.bodies[b].versor_z;
+            let row = lay.body_row(b);
+            let (rx, ry) = (p[0] - c[0], p[1] - c[1]);
+            jac.add(row, cx, -sgn);
+            jac.add(row + 1, cy, -sgn);
+            // −v·∂(r × F)/∂F = −v·(−ry, rx)
+            jac.add(row + 2, cx, v * sgn * ry);
+            jac.add(row + 2, cy, -v * sgn * rx);
+        }
+    }
+    for (ci, spec) in mech.contacts.iter().enumerate() {
+        let eq = &data.contact[ci];
+        let (ca, cn) = (lay.contact_fa(ci), lay.contact_n(ci));
+        let p = data.kin.pos[spec.point];
+        let c = data.body[spec.body].com_k;
+        let rr = [p[0] - c[0], p[1] - c[1]];
+        let v = mech.bodies[spec.body].versor_z;
+        let row = lay.body_row(spec.body);
+        jac.add(row, ca, -eq.tangent[0]);
+        jac.add(row, cn, -eq.normal[0]);
+        jac.add(row + 1, ca, -eq.tangent[1]);
+        jac.add(row + 1, cn, -eq.normal[1]);
+        jac.add(row + 2, ca, -v * cross(rr, eq.tangent));
+        jac.add(row + 2, cn, -v * cross(rr, eq.normal));
+        let crow = lay.contact_row(ci);
+        match eq.state {
+            ContactState::Free => {
+                jac.add(crow, ca, 1.0);
+                jac.add(crow + 1, cn, 1.0);
+            }
+            ContactState::Stick { .. } => {}
+            ContactState::Slide { dir } => {
+                jac.add(crow, ca, 1.0);
+                jac.add(crow, cn, dir * eq.mu_dynamic);
+            }
+        }
+    }
+}
+
+/// Entries in the `q[k+1]` columns: `∂(second difference)/∂q` of every body
+/// and the contact position rows, at the iterate `data.kin_next`.
+fn position_entries<S: JacobianSink>(mech: &Mechanism, terrain: &Terrain, data: &FbdData, jac: &mut S) {
+    let lay = mech.layout();
+    let kin_next = &data.kin_next;
+    let dt2 = data.dt * data.dt;
+    for (b, spec) in mech.bodies.iter().enumerate() {
+        let row = lay.body_row(b);
+        let g = spec.mass * data.body[b].c_next / dt2;
+        for &i in mech.point_columns(spec.com) {
+            jac.add(row, i, g * kin_next.jac_at(spec.com, 0, i));
+            jac.add(row + 1, i, g * kin_next.jac_at(spec.com, 1, i));
+        }
+        let gi = spec.versor_z * spec.inertia * data.body[b].c_next / dt2;
+        for &(i, coef) in &mech.chains.angles[spec.angle].terms {
+            jac.add(row + 2, i, gi * coef);
+        }
+    }
+    let k = data.position_gain;
+    for (ci, spec) in mech.contacts.iter().enumerate() {
+        let row = lay.contact_row(ci);
+        match data.contact[ci].state {
+            ContactState::Free => {}
+            ContactState::Stick { .. } => {
+                for &i in mech.point_columns(spec.point) {
+                    jac.add(row, i, k * kin_next.jac_at(spec.point, 0, i));
+                    jac.add(row + 1, i, k * kin_next.jac_at(spec.point, 1, i));
+                }
+            }
+            ContactState::Slide { .. } => {
+                let s = terrain.slope(kin_next.pos[spec.point][0]);
+                for &i in mech.point_columns(spec.point) {
+                    jac.add(row + 1, i, k * (kin_next.jac_at(spec.point, 1, i) - s * kin_next.jac_at(spec.point, 0, i)));
+                }
+            }
+        }
+    }
+}

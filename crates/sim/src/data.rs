@@ -1,0 +1,74 @@
+//! The mutable workspace of a run ([`Data`]), built from a [`Model`].
+
+use crate::Model;
+use crate::record::Event;
+use fbd_contact::ContactState;
+use fbd_dynamics::FbdData;
+use fbd_solver::NewtonSolver;
+
+/// Everything that changes during a run. All buffers are allocated here,
+/// once; the stepping loop reuses them.
+#[derive(Debug)]
+pub struct Data {
+    /// Index of the next step to solve.
+    pub k: usize,
+    /// `q[k−1]` (meaningful for `k ≥ 1`).
+    pub q_prev: Vec<f64>,
+    /// `q[k]`.
+    pub q: Vec<f64>,
+    /// Unknowns of the step: `[q[k+1] | joint forces | contact forces]`; the
+    /// last solution, reused as the next step's starting guess for the forces.
+    pub z: Vec<f64>,
+    /// State each contact point was last solved in (accepted).
+    pub states: Vec<ContactState>,
+    /// FBD assembly workspace.
+    pub fbd: FbdData,
+    /// Newton solver with its cached factorisations.
+    pub solver: NewtonSolver,
+    /// Contact events so far.
+    pub events: Vec<Event>,
+    /// Newton iterations so far.
+    pub newton_iterations: usize,
+    /// Per-row convergence scales of the current contact states.
+    pub(crate) scales: Vec<f64>,
+    /// Trial states of the state search.
+    pub(crate) trial: Vec<ContactState>,
+    /// State combinations visited in the current step's search.
+    pub(crate) visited: Vec<u64>,
+}
+
+impl Data {
+    /// A fresh workspace at the model's initial state.
+    pub fn new(model: &Model) -> Self {
+        let mech = &model.mech;
+        let lay = mech.layout();
+        let mut fbd = FbdData::new(mech);
+        fbd_dynamics::set_configuration(mech, &mut fbd, &model.params.q0);
+        let mut z = vec![0.0; lay.dim()];
+        z[..lay.nq].copy_from_slice(&model.params.q0);
+        Self {
+            k: 0,
+            q_prev: model.params.q0.to_vec(),
+            q: model.params.q0.to_vec(),
+            z,
+            states: model.initial_states.clone(),
+            fbd,
+            solver: NewtonSolver::new(model.newton),
+            events: Vec::with_capacity(64),
+            newton_iterations: 0,
+            scales: vec![1.0; lay.dim()],
+            trial: model.initial_states.clone(),
+            visited: Vec::with_capacity(64),
+        }
+    }
+
+    /// Symbolic factorisations done so far (one per contact-state pattern).
+    pub fn symbolic_factorizations(&self) -> usize {
+        self.solver.symbolic_factorizations()
+    }
+
+    /// Time of the next step to solve (s).
+    pub fn time(&self, model: &Model) -> f64 {
+        self.k as f64 * model.dt()
+    }
+}

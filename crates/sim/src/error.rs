@@ -1,0 +1,74 @@
+//! Errors of a simulation.
+
+use fbd_solver::SolverError;
+
+/// Why a model could not be built or a run stopped.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SimError {
+    /// A parameter is out of its domain. `key` is the configuration key
+    /// (SPEC §4), e.g. `leg.upper_mass`.
+    #[error("{key}: {what} (got {got}, expected {expected})")]
+    InvalidParameter {
+        /// Dotted configuration key.
+        key: String,
+        /// What is wrong.
+        what: String,
+        /// The offending value.
+        got: String,
+        /// What is accepted.
+        expected: String,
+    },
+    /// A contact point starts below the terrain.
+    #[error("initial.{leg}: {point} starts {depth:.6} m below the terrain (got depth {depth:.6} m, expected ≤ 1e-9 m)")]
+    InitialPenetration {
+        /// The leg table, e.g. `leg3`.
+        leg: String,
+        /// The point, e.g. `tip3`.
+        point: String,
+        /// How deep (m).
+        depth: f64,
+    },
+    /// Newton's method failed.
+    #[error("step {step} (t = {t:.6} s): {source}")]
+    Newton {
+        /// Step index k.
+        step: usize,
+        /// Time k·Δt (s).
+        t: f64,
+        /// The solver's error (names the residual).
+        source: SolverError,
+    },
+    /// The contact-state search revisited a state combination.
+    #[error("step {step} (t = {t:.6} s): the contact-state search cycles at [{states}] (residual {residual:.3e})")]
+    Cycling {
+        /// Step index k.
+        step: usize,
+        /// Time k·Δt (s).
+        t: f64,
+        /// The state combination seen twice, e.g. `tip3=ST2 tip4=ST3`.
+        states: String,
+        /// Scaled residual of the last solve.
+        residual: f64,
+    },
+    /// The state became NaN or infinite.
+    #[error("step {step} (t = {t:.6} s): the state is not finite (residual {residual:.3e})")]
+    NonFinite {
+        /// Step index k.
+        step: usize,
+        /// Time k·Δt (s).
+        t: f64,
+        /// Scaled residual of the last solve.
+        residual: f64,
+    },
+}
+
+impl SimError {
+    /// The step at which a run-time error occurred (`None` for set-up
+    /// errors).
+    pub fn step(&self) -> Option<usize> {
+        match self {
+            SimError::Newton { step, .. } | SimError::Cycling { step, .. } | SimError::NonFinite { step, .. } => Some(*step),
+            _ => None,
+        }
+    }
+}

@@ -1,0 +1,138 @@
+//! The immutable [`Model`] of a planar run, validated from [`PlanarParams`].
+
+use crate::{PlanarParams, SimError};
+use fbd_contact::{ContactParams, ContactState};
+use fbd_dynamics::{Mechanism, TwoLegInertia};
+use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex};
+use fbd_solver::NewtonParams;
+
+/// Everything fixed during a run: parameters, mechanism, tolerances.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The parameters the model was built from.
+    pub params: PlanarParams,
+    /// Bodies, joints and contact points.
+    pub mech: Mechanism,
+    /// Named points and angles of the two-leg model.
+    pub index: TwoLegIndex,
+    /// Contact switching tolerances.
+    pub contact: ContactParams,
+    /// Newton tolerances.
+    pub newton: NewtonParams,
+    /// Steps to solve: `round(duration/dt) + 1`.
+    pub steps: usize,
+    /// Hexapod leg number (3 or 4) of each contact point.
+    pub contact_leg: Vec<usize>,
+    /// Contact state of each point at `t = 0` (SPEC §3).
+    pub initial_states: Vec<ContactState>,
+}
+
+fn check(ok: bool, key: &str, what: &str, got: impl std::fmt::Display, expected: &str) -> Result<(), SimError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(SimError::InvalidParameter {
+            key: key.into(),
+            what: what.into(),
+            got: got.to_string(),
+            expected: expected.into(),
+        })
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<(), SimError> {
+    check(v.is_finite() && v > 0.0, key, "must be positive and finite", v, "a finite value > 0")
+}
+
+impl Model {
+    /// Validates `params` and builds the model. Errors name the
+    /// configuration key at fault.
+    pub fn planar(params: &PlanarParams) -> Result<Self, SimError> {
+        let p = params;
+        positive("time.dt", p.dt)?;
+        positive("time.duration", p.duration)?;
+        check(p.dt <= p.duration, "time.dt", "must not exceed time.duration", p.dt, "dt ≤ duration")?;
+        let steps_f = (p.duration / p.dt).round();
+        check(steps_f <= 1e9, "time.duration", "needs too many steps", steps_f, "duration/dt ≤ 1e9")?;
+        check(p.gravity.is_finite(), "world.gravity", "must be finite", p.gravity, "a finite value")?;
+        positive("body.mass", p.body_mass)?;
+        positive("body.inertia", p.body_inertia)?;
+        positive("body.side", p.side)?;
+        positive("leg.upper_length", p.upper_length)?;
+        positive("leg.upper_mass", p.upper_mass)?;
+        positive("leg.upper_inertia", p.upper_inertia)?;
+        positive("leg.lower_length", p.lower_length)?;
+        positive("leg.lower_mass", p.lower_mass)?;
+        positive("leg.lower_inertia", p.lower_inertia)?;
+        for (key, v) in [("leg.upper_com", p.upper_com), ("leg.lower_com", p.lower_com)] {
+            check(v.is_finite() && (0.0..=1.0).contains(&v), key, "must lie on the link", v, "a fraction in [0, 1]")?;
+        }
+        let names = ["initial.position", "initial.position", "initial.phi_z_deg", "initial.leg3.theta_deg", "initial.leg3.theta_deg", "initial.leg4.theta_deg", "initial.leg4.theta_deg"];
+        let rates = ["initial.velocity", "initial.velocity", "initial.omega_z_deg", "initial.leg3.rate_deg", "initial.leg3.rate_deg", "initial.leg4.rate_deg", "initial.leg4.rate_deg"];
+        for i in 0..7 {
+            check(p.q0[i].is_finite(), names[i], "must be finite", p.q0[i], "a finite value")?;
+            check(p.qdot0[i].is_finite(), rates[i], "must be finite", p.qdot0[i], "a finite value")?;
+        }
+        if let fbd_contact::Terrain::Flat { height } = p.terrain {
+            check(height.is_finite(), "terrain.height", "must be finite", height, "a finite value")?;
+        }
+        check(p.friction.mu_static.is_finite() && p.friction.mu_static >= 0.0, "terrain.mu_static", "must be finite and ≥ 0", p.friction.mu_static, "0 ≤ mu_static")?;
+        check(
+            p.friction.mu_dynamic.is_finite() && p.friction.mu_dynamic >= 0.0 && p.friction.mu_dynamic <= p.friction.mu_static,
+            "terrain.mu_dynamic",
+            "must satisfy 0 ≤ mu_dynamic ≤ mu_static",
+            p.friction.mu_dynamic,
+            &format!("0 ≤ mu_dynamic ≤ {}", p.friction.mu_static),
+        )?;
+        check(p.stride >= 1, "output.stride", "must be at least 1", p.stride, "an integer ≥ 1")?;
+
+        let geometry = PlanarGeometry {
+            d: p.side * (std::f64::consts::PI / 6.0).cos(),
+            a: p.upper_length,
+            c: p.lower_length,
+            upper_com: p.upper_com,
+            lower_com: p.lower_com,
+        };
+        let inertia = TwoLegInertia {
+            body_mass: p.body_mass,
+            body_inertia: p.body_inertia,
+            upper_mass: p.upper_mass,
+            upper_inertia: p.upper_inertia,
+            lower_mass: p.lower_mass,
+            lower_inertia: p.lower_inertia,
+        };
+        let (mech, index) = Mechanism::two_leg(&geometry, &inertia, p.gravity, p.contact_points);
+        let contact = ContactParams::default();
+        let contact_leg: Vec<usize> = mech
+            .contacts
+            .iter()
+            .map(|c| if c.name.ends_with('3') { 3 } else { 4 })
+            .collect();
+        let mut kin = mech.chains.new_data();
+        mech.chains.eval_positions(&p.q0, &mut kin);
+        let mut initial_states = Vec::with_capacity(mech.contacts.len());
+        for (ci, c) in mech.contacts.iter().enumerate() {
+            let state = ContactState::initial(kin.pos[c.point], &p.terrain, contact.initial_tol).map_err(|depth| SimError::InitialPenetration {
+                leg: format!("leg{}", contact_leg[ci]),
+                point: c.name.clone(),
+                depth,
+            })?;
+            initial_states.push(state);
+        }
+        Ok(Self {
+            params: p.clone(),
+            mech,
+            index,
+            contact,
+            newton: NewtonParams::default(),
+            steps: steps_f as usize + 1,
+            contact_leg,
+            initial_states,
+        })
+    }
+
+    /// Time step (s).
+    pub fn dt(&self) -> f64 {
+        self.params.dt
+    }
+}

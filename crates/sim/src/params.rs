@@ -1,0 +1,89 @@
+//! Physical and numerical parameters of a planar run, in SI units and
+//! radians. The CLI fills them from a TOML configuration (degrees there).
+
+use fbd_contact::{Friction, Terrain};
+use fbd_dynamics::mechanism::ContactPoints;
+
+/// Everything that defines a planar simulation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlanarParams {
+    /// Time step Δt (s). Default 0.01, the paper's §6 value.
+    pub dt: f64,
+    /// Simulated duration (s); the run solves `round(duration/dt) + 1` steps
+    /// so that the output covers `[0, duration]`. Default 0.45: touchdown,
+    /// sticking and sliding of both legs, before the body reaches the floor.
+    pub duration: f64,
+    /// Gravitational acceleration (m/s²). Default 9.81.
+    pub gravity: f64,
+    /// Central body mass (kg). Default 10.0 (chosen, with the other masses,
+    /// so that the paper's reported events come out: see the README).
+    pub body_mass: f64,
+    /// Central body inertia about Z through R (kg·m²). Default 0.3.
+    pub body_inertia: f64,
+    /// Side `L` of the hexagonal body; hips at `d = L·cos(π/6)` (m).
+    /// Default 0.25 (the SPEC §1.4 test geometry).
+    pub side: f64,
+    /// Upper link length `a` (m). Default 0.2.
+    pub upper_length: f64,
+    /// Upper link mass (kg). Default 0.3.
+    pub upper_mass: f64,
+    /// Upper link inertia about its centre of mass (kg·m²). Default: the
+    /// uniform rod `m·a²/12`.
+    pub upper_inertia: f64,
+    /// Upper link centre of mass, fraction of `a` from the hip. Default 0.5.
+    pub upper_com: f64,
+    /// Lower link length `c` (m). Default 0.42.
+    pub lower_length: f64,
+    /// Lower link mass (kg). Default 1.1 (a heavy foot).
+    pub lower_mass: f64,
+    /// Lower link inertia about its centre of mass (kg·m²). Default: the
+    /// uniform rod `m·c²/12`.
+    pub lower_inertia: f64,
+    /// Lower link centre of mass, fraction of `c` from the knee. Default 0.75
+    /// (towards the foot).
+    pub lower_com: f64,
+    /// Initial generalised coordinates `(Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)`
+    /// (m, rad). Default: the paper's §6 table, `(0, 0.6, 0, 0, 245°, 0, 255°)`.
+    pub q0: [f64; 7],
+    /// Initial generalised velocities (m/s, rad/s). Default zero.
+    pub qdot0: [f64; 7],
+    /// Terrain. Default flat ground at y = 0.
+    pub terrain: Terrain,
+    /// Soil friction. Default μS = 0.4, μD = 0.3 (paper §6).
+    pub friction: Friction,
+    /// Which points can touch the terrain. Default: the tips only.
+    pub contact_points: ContactPoints,
+    /// Write every `stride`-th step. Default 1.
+    pub stride: usize,
+}
+
+impl Default for PlanarParams {
+    fn default() -> Self {
+        let upper_mass = 0.3;
+        let upper_length = 0.2;
+        let lower_mass = 1.1;
+        let lower_length = 0.42;
+        Self {
+            dt: 0.01,
+            duration: 0.45,
+            gravity: 9.81,
+            body_mass: 10.0,
+            body_inertia: 0.3,
+            side: 0.25,
+            upper_length,
+            upper_mass,
+            upper_inertia: upper_mass * upper_length * upper_length / 12.0,
+            upper_com: 0.5,
+            lower_length,
+            lower_mass,
+            lower_inertia: lower_mass * lower_length * lower_length / 12.0,
+            lower_com: 0.75,
+            q0: [0.0, 0.6, 0.0, 0.0, 245f64.to_radians(), 0.0, 255f64.to_radians()],
+            qdot0: [0.0; 7],
+            terrain: Terrain::Flat { height: 0.0 },
+            friction: Friction::default(),
+            contact_points: ContactPoints::default(),
+            stride: 1,
+        }
+    }
+}

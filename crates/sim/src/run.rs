@@ -1,0 +1,75 @@
+//! The stepping loop of a whole run.
+
+use crate::record::{Event, StepRecord};
+use crate::{Data, Model, SimError, step};
+use std::time::Instant;
+
+/// Outcome of [`run`].
+#[derive(Clone, Debug)]
+pub struct RunSummary {
+    /// Steps solved.
+    pub steps: usize,
+    /// Newton iterations over all steps.
+    pub newton_iterations: usize,
+    /// Wall time of the stepping loop alone (s): the time inside [`step`],
+    /// not the observer's.
+    pub wall_seconds: f64,
+    /// Symbolic factorisations (one per contact-state pattern met).
+    pub symbolic_factorizations: usize,
+    /// Contact events.
+    pub events: Vec<Event>,
+    /// Why the run stopped early, if it did.
+    pub error: Option<SimError>,
+}
+
+impl RunSummary {
+    /// Steps per second of wall time.
+    pub fn steps_per_second(&self) -> f64 {
+        if self.wall_seconds > 0.0 {
+            self.steps as f64 / self.wall_seconds
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Runs `model` from its initial state to the end (or the first error),
+/// handing every `stride`-th record to `on_row`.
+pub fn run(model: &Model, mut on_row: impl FnMut(&StepRecord)) -> RunSummary {
+    let mut data = Data::new(model);
+    let stride = model.params.stride.max(1);
+    let mut wall = 0.0;
+    let mut error = None;
+    for k in 0..model.steps {
+        let start = Instant::now();
+        let result = step(model, &mut data);
+        wall += start.elapsed().as_secs_f64();
+        match result {
+            Ok(rec) => {
+                if k % stride == 0 {
+                    on_row(&rec);
+                }
+            }
+            Err(e) => {
+                error = Some(e);
+                break;
+            }
+        }
+    }
+    RunSummary {
+        steps: data.k,
+        newton_iterations: data.newton_iterations,
+        wall_seconds: wall,
+        symbolic_factorizations: data.symbolic_factorizations(),
+        events: data.events,
+        error,
+    }
+}
+
+/// Runs `model` and keeps every written record in memory (for tests and
+/// small runs).
+pub fn run_collect(model: &Model) -> (Vec<StepRecord>, RunSummary) {
+    let mut rows = Vec::with_capacity(model.steps / model.params.stride.max(1) + 1);
+    let summary = run(model, |r| rows.push(*r));
+    (rows, summary)
+}

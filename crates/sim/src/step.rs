@@ -1,0 +1,203 @@
+//! One time step, in stages:
+//!
+//! 1. **kinematics at k**: the per-body constants of the second differences;
+//! 2. **predictor**: a starting guess for `q[k+1]` (forces from the last step);
+//! 3. **solve**: Newton on the FBD equations with the current contact states;
+//! 4. **contact check**: every point's switching rule on the trial solution;
+//!    any switch → back to 3 (a repeated state combination is an error);
+//! 5. **accept**: record, events, and `q[k+1]` becomes the current state.
+
+use crate::energy;
+use crate::record::{Event, MAX_CONTACTS, MAX_JOINTS, StepRecord};
+use crate::system::{StepSystem, row_scales};
+use crate::{Data, Model, SimError};
+use fbd_contact::{ContactState, StateCode, Trial, transition};
+use fbd_dynamics::{ContactEquation, History, advance, prepare_step};
+
+/// Solves step `data.k` and advances the state to `k + 1`.
+pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
+    let mech = &model.mech;
+    let dt = model.dt();
+    let k = data.k;
+    let t = k as f64 * dt;
+    let nq = mech.layout().nq;
+
+    // 1. Kinematics at k.
+    let history = if k == 0 {
+        History::Initial { qdot: &model.params.qdot0 }
+    } else {
+        History::Previous
+    };
+    prepare_step(mech, &mut data.fbd, history, dt);
+
+    // 2. Predictor: constant-velocity extrapolation of q.
+    for i in 0..nq {
+        data.z[i] = if k == 0 {
+            data.q[i] + dt * model.params.qdot0[i]
+        } else {
+            2.0 * data.q[i] - data.q_prev[i]
+        };
+    }
+
+    // 3–4. Solve, check the contact states, re-solve until consistent.
+    data.trial.copy_from_slice(&data.states);
+    data.visited.clear();
+    data.visited.push(states_key(&data.trial));
+    let mut newton_iterations = 0;
+    let mut trials = 0;
+    loop {
+        trials += 1;
+        set_contact_equations(model, data);
+        row_scales(mech, &data.fbd, &mut data.scales);
+        let mut sys = StepSystem {
+            mech,
+            terrain: &model.params.terrain,
+            fbd: &mut data.fbd,
+            scales: &data.scales,
+        };
+        let report = data.solver.solve(&mut sys, &mut data.z).map_err(|source| SimError::Newton { step: k, t, source })?;
+        newton_iterations += report.iterations;
+        if data.z.iter().any(|v| !v.is_finite()) {
+            return Err(SimError::NonFinite {
+                step: k,
+                t,
+                residual: report.residual,
+            });
+        }
+        mech.chains.eval_positions(&data.z[..nq], &mut data.fbd.kin_next);
+        if !check_contacts(model, data) {
+            break;
+        }
+        let key = states_key(&data.trial);
+        if data.visited.contains(&key) {
+            return Err(SimError::Cycling {
+                step: k,
+                t,
+                states: describe_states(model, &data.trial),
+                residual: report.residual,
+            });
+        }
+        data.visited.push(key);
+    }
+    data.newton_iterations += newton_iterations;
+
+    // 5. Accept.
+    let record = make_record(model, data, newton_iterations, trials);
+    for c in 0..mech.contacts.len() {
+        let (from, to) = (data.states[c].code(), data.trial[c].code());
+        if from != to {
+            data.events.push(Event {
+                t,
+                step: k,
+                contact: c,
+                name: mech.contacts[c].name.clone(),
+                leg: model.contact_leg[c],
+                from,
+                to,
+            });
+        }
+    }
+    data.states.copy_from_slice(&data.trial);
+    data.q_prev.copy_from_slice(&data.q);
+    data.q.copy_from_slice(&data.z[..nq]);
+    advance(mech, &mut data.fbd, &data.z[..nq]);
+    data.k += 1;
+    Ok(record)
+}
+
+/// The equations of each contact point for its trial state: the terrain
+/// frame at the anchor (ST2), under the point at k (ST1, ST3).
+fn set_contact_equations(model: &Model, data: &mut Data) {
+    let terrain = &model.params.terrain;
+    for (c, spec) in model.mech.contacts.iter().enumerate() {
+        let state = data.trial[c];
+        let x = match state {
+            ContactState::Stick { anchor } => anchor[0],
+            _ => data.fbd.kin.pos[spec.point][0],
+        };
+        let (tangent, normal) = terrain.frame(x);
+        data.fbd.contact[c] = ContactEquation {
+            state,
+            tangent,
+            normal,
+            mu_dynamic: model.params.friction.mu_dynamic,
+        };
+    }
+}
+
+/// Applies the switching rules to the trial solution; `true` if any point
+/// switched.
+fn check_contacts(model: &Model, data: &mut Data) -> bool {
+    let lay = model.mech.layout();
+    let mut changed = false;
+    for (c, spec) in model.mech.contacts.iter().enumerate() {
+        let eq = &data.fbd.contact[c];
+        let trial = Trial {
+            p_k: data.fbd.kin.pos[spec.point],
+            p_next: data.fbd.kin_next.pos[spec.point],
+            fa: data.z[lay.contact_fa(c)],
+            n: data.z[lay.contact_n(c)],
+            tangent: eq.tangent,
+            dt: model.dt(),
+        };
+        if let Some(next) = transition(&data.trial[c], &trial, &model.params.terrain, &model.params.friction, &model.contact) {
+            data.trial[c] = next;
+            changed = true;
+        }
+    }
+    changed
+}
+
+fn states_key(states: &[ContactState]) -> u64 {
+    states.iter().fold(0, |k, s| k * 4 + s.key())
+}
+
+fn describe_states(model: &Model, states: &[ContactState]) -> String {
+    model
+        .mech
+        .contacts
+        .iter()
+        .zip(states)
+        .map(|(c, s)| format!("{}={}", c.name, s.code()))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+fn make_record(model: &Model, data: &Data, newton_iterations: usize, state_trials: usize) -> StepRecord {
+    let mech = &model.mech;
+    let lay = mech.layout();
+    let nc = mech.contacts.len().min(MAX_CONTACTS);
+    let mut r = StepRecord {
+        step: data.k,
+        t: data.k as f64 * model.dt(),
+        q: [0.0; 7],
+        contacts: nc,
+        point: [[0.0; 2]; MAX_CONTACTS],
+        state: [StateCode::St1; MAX_CONTACTS],
+        fa: [0.0; MAX_CONTACTS],
+        n: [0.0; MAX_CONTACTS],
+        joint_force: [[0.0; 2]; MAX_JOINTS],
+        torque: [0.0; MAX_JOINTS],
+        kinetic: 0.0,
+        potential: energy::potential(mech, &data.fbd.kin),
+        newton_iterations,
+        state_trials,
+    };
+    r.q.copy_from_slice(&data.q[..7]);
+    for c in 0..nc {
+        r.point[c] = data.fbd.kin.pos[mech.contacts[c].point];
+        r.state[c] = data.trial[c].code();
+        r.fa[c] = data.z[lay.contact_fa(c)];
+        r.n[c] = data.z[lay.contact_n(c)];
+    }
+    for j in 0..lay.joints.min(MAX_JOINTS) {
+        r.joint_force[j] = [data.z[lay.joint_force(j, 0)], data.z[lay.joint_force(j, 1)]];
+        r.torque[j] = data.fbd.torque[j];
+    }
+    r.kinetic = if data.k == 0 {
+        energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)
+    } else {
+        energy::kinetic_central(mech, &data.fbd.kin_prev, &data.fbd.kin_next, model.dt())
+    };
+    r
+}

@@ -1,0 +1,72 @@
+//! One step's FBD equations seen as a [`NewtonSystem`].
+
+use fbd_contact::{ContactState, Terrain};
+use fbd_dynamics::{FbdData, JacobianSink, Mechanism, NoJacobian};
+use fbd_solver::NewtonSystem;
+
+/// Adapts the solver's sink to the assembly's sink trait.
+struct Sink<'s, 'a>(&'s mut fbd_solver::JacobianSink<'a>);
+
+impl JacobianSink for Sink<'_, '_> {
+    const ACTIVE: bool = true;
+    #[inline]
+    fn add(&mut self, row: usize, col: usize, v: f64) {
+        self.0.add(row, col, v);
+    }
+}
+
+/// The step's residual and Jacobian (borrowing the model and workspace).
+pub(crate) struct StepSystem<'a> {
+    pub mech: &'a Mechanism,
+    pub terrain: &'a Terrain,
+    pub fbd: &'a mut FbdData,
+    pub scales: &'a [f64],
+}
+
+impl NewtonSystem for StepSystem<'_> {
+    fn dim(&self) -> usize {
+        self.mech.layout().dim()
+    }
+    fn pattern_key(&self) -> u64 {
+        fbd_dynamics::pattern_key(self.fbd)
+    }
+    fn pattern(&self, entries: &mut Vec<(usize, usize)>) {
+        fbd_dynamics::pattern(self.mech, self.fbd, entries);
+    }
+    fn eval(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut fbd_solver::JacobianSink<'_>>) {
+        match jac {
+            Some(j) => fbd_dynamics::eval(self.mech, self.terrain, self.fbd, x, r, &mut Sink(j)),
+            None => fbd_dynamics::eval(self.mech, self.terrain, self.fbd, x, r, &mut NoJacobian),
+        }
+    }
+    fn residual_scale(&self, row: usize) -> f64 {
+        self.scales[row]
+    }
+}
+
+/// Convergence scales of every row for the current contact states: forces
+/// to `1e-9 ×` the weight (with a round-off floor that grows as `M/Δt²`),
+/// moments to that times the length scale, contact positions to `1e-12` m.
+pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, scales: &mut [f64]) {
+    let lay = mech.layout();
+    let k = fbd.position_gain;
+    let force = mech.total_mass() * mech.gravity.abs().max(1.0) + 1e-6 * k;
+    let moment = force * mech.length_scale();
+    for b in 0..lay.bodies {
+        let row = lay.body_row(b);
+        scales[row] = force;
+        scales[row + 1] = force;
+        scales[row + 2] = moment;
+    }
+    for (c, eq) in fbd.contact.iter().enumerate() {
+        let row = lay.contact_row(c);
+        let position = 1e-3 * k;
+        let (s0, s1) = match eq.state {
+            ContactState::Free => (force, force),
+            ContactState::Stick { .. } => (position, position),
+            ContactState::Slide { .. } => (force, position),
+        };
+        scales[row] = s0;
+        scales[row + 1] = s1;
+    }
+}

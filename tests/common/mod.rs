@@ -1,4 +1,5 @@
 //! Shared helpers of the workspace-level tests.
 #![allow(dead_code)]
 
+pub mod physics;
 pub mod strategies;

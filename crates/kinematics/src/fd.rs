@@ -94,7 +94,10 @@ pub fn check_jacobian(
             let a = jac(i, j);
             let d = numeric[i * n + j];
             let tolerance = tol.rel * a.abs().max(d.abs()) + tol.abs;
-            if !((a - d).abs() <= tolerance) {
+            // Written negated so that a NaN on either side fails.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            let fails = !((a - d).abs() <= tolerance);
+            if fails {
                 return Err(FdMismatch {
                     i,
                     j,

@@ -35,6 +35,11 @@ pub struct Data {
     pub(crate) trial: Vec<ContactState>,
     /// State combinations visited in the current step's search.
     pub(crate) visited: Vec<u64>,
+    /// Per contact, bit `i` set when the point was solved in state code `i`
+    /// (0 = ST1, 1 = ST2, 2 = ST3) during the current step's search.
+    pub(crate) seen: Vec<u8>,
+    /// Per contact, the tangential force of its last sticking trial.
+    pub(crate) stick_fa: Vec<f64>,
 }
 
 impl Data {
@@ -59,6 +64,8 @@ impl Data {
             scales: vec![1.0; lay.dim()],
             trial: model.initial_states.clone(),
             visited: Vec::with_capacity(64),
+            seen: vec![0; lay.contacts],
+            stick_fa: vec![0.0; lay.contacts],
         }
     }
 

@@ -4,15 +4,22 @@
 //! 2. **predictor**: a starting guess for `q[k+1]` (forces from the last step);
 //! 3. **solve**: Newton on the FBD equations with the current contact states;
 //! 4. **contact check**: every point's switching rule on the trial solution;
-//!    any switch → back to 3 (a repeated state combination is an error);
+//!    any switch → back to 3. A repeated state combination means no
+//!    combination the rules reach is consistent; before giving up, a point
+//!    that flip-flopped between ST1 (it penetrates when free) and ST2 (it
+//!    would pull on the ground when stuck) is tried in ST3, sliding opposite
+//!    to the friction sticking needed — the remaining candidate of Coulomb's
+//!    law. A cycle after that is an error;
 //! 5. **accept**: record, events, and `q[k+1]` becomes the current state.
 
 use crate::energy;
 use crate::record::{Event, MAX_CONTACTS, MAX_JOINTS, StepRecord};
-use crate::system::{StepSystem, row_scales};
+pub use crate::system::StepSystem;
+use crate::system::row_scales;
 use crate::{Data, Model, SimError};
 use fbd_contact::{ContactState, StateCode, Trial, transition};
 use fbd_dynamics::{ContactEquation, History, advance, prepare_step};
+use fbd_solver::NewtonSolver;
 
 /// Solves step `data.k` and advances the state to `k + 1`.
 pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
@@ -22,40 +29,15 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     let t = k as f64 * dt;
     let nq = mech.layout().nq;
 
-    // 1. Kinematics at k.
-    let history = if k == 0 {
-        History::Initial { qdot: &model.params.qdot0 }
-    } else {
-        History::Previous
-    };
-    prepare_step(mech, &mut data.fbd, history, dt);
-
-    // 2. Predictor: constant-velocity extrapolation of q.
-    for i in 0..nq {
-        data.z[i] = if k == 0 {
-            data.q[i] + dt * model.params.qdot0[i]
-        } else {
-            2.0 * data.q[i] - data.q_prev[i]
-        };
-    }
-
-    // 3–4. Solve, check the contact states, re-solve until consistent.
-    data.trial.copy_from_slice(&data.states);
-    data.visited.clear();
-    data.visited.push(states_key(&data.trial));
+    // 1–2. Kinematics at k, predictor.
+    prepare(model, data);
+    let mut fallback_used = false;
     let mut newton_iterations = 0;
     let mut trials = 0;
     loop {
         trials += 1;
-        set_contact_equations(model, data);
-        row_scales(mech, &data.fbd, &mut data.scales);
-        let mut sys = StepSystem {
-            mech,
-            terrain: &model.params.terrain,
-            fbd: &mut data.fbd,
-            scales: &data.scales,
-        };
-        let report = data.solver.solve(&mut sys, &mut data.z).map_err(|source| SimError::Newton { step: k, t, source })?;
+        let (mut sys, solver, z) = system(model, data);
+        let report = solver.solve(&mut sys, z).map_err(|source| SimError::Newton { step: k, t, source })?;
         newton_iterations += report.iterations;
         if data.z.iter().any(|v| !v.is_finite()) {
             return Err(SimError::NonFinite {
@@ -68,7 +50,21 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
         if !check_contacts(model, data) {
             break;
         }
-        let key = states_key(&data.trial);
+        let mut key = states_key(&data.trial);
+        if data.visited.contains(&key) && !fallback_used {
+            fallback_used = true;
+            let mut forced = false;
+            for c in 0..mech.contacts.len() {
+                if data.seen[c] & 0b11 == 0b11 && !matches!(data.trial[c], ContactState::Slide { .. }) {
+                    data.trial[c] = ContactState::Slide { dir: -data.stick_fa[c].signum() };
+                    forced = true;
+                }
+            }
+            if forced {
+                data.visited.clear();
+                key = states_key(&data.trial);
+            }
+        }
         if data.visited.contains(&key) {
             return Err(SimError::Cycling {
                 step: k,
@@ -103,6 +99,51 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     advance(mech, &mut data.fbd, &data.z[..nq]);
     data.k += 1;
     Ok(record)
+}
+
+/// Stages 1–2 of [`step`]: the per-body constants of step `data.k` and the
+/// predictor of `q[k+1]` in `data.z` (the forces keep the last solution);
+/// the trial contact states start from the accepted ones. Public for
+/// benchmarks, which time the stages one by one.
+pub fn prepare(model: &Model, data: &mut Data) {
+    let mech = &model.mech;
+    let dt = model.dt();
+    let k = data.k;
+    let nq = mech.layout().nq;
+    let history = if k == 0 {
+        History::Initial { qdot: &model.params.qdot0 }
+    } else {
+        History::Previous
+    };
+    prepare_step(mech, &mut data.fbd, history, dt);
+
+    // Predictor: constant-velocity extrapolation of q.
+    for i in 0..nq {
+        data.z[i] = if k == 0 {
+            data.q[i] + dt * model.params.qdot0[i]
+        } else {
+            2.0 * data.q[i] - data.q_prev[i]
+        };
+    }
+    data.trial.copy_from_slice(&data.states);
+    data.visited.clear();
+    data.visited.push(states_key(&data.trial));
+    data.seen.fill(0);
+}
+
+/// Stage 3's inputs for the current trial states (contact equations, row
+/// scales), split from `data`: the step's [`NewtonSystem`](fbd_solver::NewtonSystem),
+/// the solver and the unknowns `z`. Public for benchmarks.
+pub fn system<'a>(model: &'a Model, data: &'a mut Data) -> (StepSystem<'a>, &'a mut NewtonSolver, &'a mut [f64]) {
+    set_contact_equations(model, data);
+    row_scales(&model.mech, &data.fbd, &mut data.scales);
+    let sys = StepSystem {
+        mech: &model.mech,
+        terrain: &model.params.terrain,
+        fbd: &mut data.fbd,
+        scales: &data.scales,
+    };
+    (sys, &mut data.solver, &mut data.z)
 }
 
 /// The equations of each contact point for its trial state: the terrain
@@ -140,6 +181,10 @@ fn check_contacts(model: &Model, data: &mut Data) -> bool {
             tangent: eq.tangent,
             dt: model.dt(),
         };
+        data.seen[c] |= 1 << data.trial[c].key().min(2);
+        if matches!(data.trial[c], ContactState::Stick { .. }) {
+            data.stick_fa[c] = trial.fa;
+        }
         if let Some(next) = transition(&data.trial[c], &trial, &model.params.terrain, &model.params.friction, &model.contact) {
             data.trial[c] = next;
             changed = true;

@@ -15,12 +15,13 @@ impl JacobianSink for Sink<'_, '_> {
     }
 }
 
-/// The step's residual and Jacobian (borrowing the model and workspace).
-pub(crate) struct StepSystem<'a> {
-    pub mech: &'a Mechanism,
-    pub terrain: &'a Terrain,
-    pub fbd: &'a mut FbdData,
-    pub scales: &'a [f64],
+/// One step's FBD equations as a [`NewtonSystem`] (borrowing the model and
+/// the workspace); built by [`crate::step::system`].
+pub struct StepSystem<'a> {
+    pub(crate) mech: &'a Mechanism,
+    pub(crate) terrain: &'a Terrain,
+    pub(crate) fbd: &'a mut FbdData,
+    pub(crate) scales: &'a [f64],
 }
 
 impl NewtonSystem for StepSystem<'_> {

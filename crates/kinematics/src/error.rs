@@ -1,0 +1,46 @@
+//! Typed errors of the kinematics crate.
+
+use thiserror::Error;
+
+/// Why an inverse-kinematics problem has no (unique) solution.
+#[derive(Clone, Debug, PartialEq, Error)]
+pub enum KinematicsError {
+    /// The target is farther from the hip than `a + c`, or closer than
+    /// `|a − c|`: no knee angle reaches it.
+    #[error(
+        "target at distance {distance:.6} m from the hip is out of reach: \
+         the leg reaches distances in [{min_reach:.6}, {max_reach:.6}] m"
+    )]
+    Unreachable {
+        /// Distance from the hip (origin of the leg's frame 0) to the target (m).
+        distance: f64,
+        /// Smallest reachable distance, `|a − c|` (m).
+        min_reach: f64,
+        /// Largest reachable distance, `a + c` (m).
+        max_reach: f64,
+    },
+    /// The target lies on the θ1 axis (the hip's vertical axis, `z0` of the
+    /// leg base frame), so θ1 is undetermined.
+    #[error(
+        "target lies on the θ1 axis (radial distance {radial:.3e} m ≤ {tolerance:.3e} m): \
+         θ1 is undetermined"
+    )]
+    SingularHip {
+        /// Distance of the target from the θ1 axis (m).
+        radial: f64,
+        /// The tolerance it fell below (m).
+        tolerance: f64,
+    },
+    /// A coordinate of the target (or of the body pose) is NaN or infinite.
+    #[error("non-finite target coordinate")]
+    NonFinite,
+    /// The inverse kinematics of one leg of a stance failed.
+    #[error("leg {leg}: {source}")]
+    Leg {
+        /// Leg number, 1–6 (SPEC §1.2 numbering).
+        leg: usize,
+        /// Why this leg failed.
+        #[source]
+        source: Box<KinematicsError>,
+    },
+}

@@ -1,0 +1,116 @@
+//! The central body's pose in the inertial frame (SPEC §1.3).
+//!
+//! `p_inertial = R + Rot·p_body`, with `Rot = Rx(φx)·Rz(φz)·Ry(φy)`: rotations
+//! about the *inertial* axes applied in the sequence Y, then Z, then X (the
+//! paper's "(Y, Z, X)" sequence). `Ra(φ)` is the right-handed rotation by φ
+//! about axis `a`. Inertial `Y` is vertical, up.
+
+use nalgebra::{Matrix3, Vector3};
+
+/// Right-handed rotation by `phi` about the X axis.
+pub fn rot_x(phi: f64) -> Matrix3<f64> {
+    let (s, c) = phi.sin_cos();
+    Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+}
+
+/// Right-handed rotation by `phi` about the Y axis.
+pub fn rot_y(phi: f64) -> Matrix3<f64> {
+    let (s, c) = phi.sin_cos();
+    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+}
+
+/// Right-handed rotation by `phi` about the Z axis.
+pub fn rot_z(phi: f64) -> Matrix3<f64> {
+    let (s, c) = phi.sin_cos();
+    Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
+}
+
+/// Position and orientation of the central body (6 DOF).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyPose {
+    /// `R = (Rx, Ry, Rz)`: the central body's centre of mass, inertial (m).
+    pub position: Vector3<f64>,
+    /// `(φx, φy, φz)`: rotation angles about the inertial axes (rad), applied
+    /// Y first, then Z, then X.
+    pub phi: Vector3<f64>,
+}
+
+impl Default for BodyPose {
+    /// The identity pose:
+    /// * `position = (0, 0, 0)`,
+    /// * `phi = (0, 0, 0)`.
+    fn default() -> Self {
+        Self {
+            position: Vector3::zeros(),
+            phi: Vector3::zeros(),
+        }
+    }
+}
+
+impl BodyPose {
+    /// A pose from `R = (Rx, Ry, Rz)` and `(φx, φy, φz)`.
+    pub fn new(position: [f64; 3], phi: [f64; 3]) -> Self {
+        Self {
+            position: Vector3::from(position),
+            phi: Vector3::from(phi),
+        }
+    }
+
+    /// `Rot = Rx(φx)·Rz(φz)·Ry(φy)`, body → inertial, in closed form
+    /// (three `sin_cos`).
+    #[inline]
+    pub fn rotation(&self) -> Matrix3<f64> {
+        let (sx, cx) = self.phi.x.sin_cos();
+        let (sy, cy) = self.phi.y.sin_cos();
+        let (sz, cz) = self.phi.z.sin_cos();
+        Matrix3::new(
+            cz * cy,
+            -sz,
+            cz * sy,
+            cx * sz * cy + sx * sy,
+            cx * cz,
+            cx * sz * sy - sx * cy,
+            sx * sz * cy - cx * sy,
+            sx * cz,
+            sx * sz * sy + cx * cy,
+        )
+    }
+
+    /// A body-frame point in the inertial frame: `R + Rot·p`.
+    pub fn to_inertial(&self, p_body: &Vector3<f64>) -> Vector3<f64> {
+        self.position + self.rotation() * p_body
+    }
+
+    /// An inertial point in the body frame: `Rotᵀ·(p − R)`.
+    pub fn to_body(&self, p_inertial: &Vector3<f64>) -> Vector3<f64> {
+        self.rotation().transpose() * (p_inertial - self.position)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn closed_form_matches_product() {
+        let p = BodyPose::new([0.1, 0.2, 0.3], [0.4, -0.9, 1.3]);
+        let want = rot_x(p.phi.x) * rot_z(p.phi.z) * rot_y(p.phi.y);
+        assert!((p.rotation() - want).norm() < 1e-15);
+    }
+
+    #[test]
+    fn right_handed_elementary_rotations() {
+        let q = std::f64::consts::FRAC_PI_2;
+        let (ex, ey, ez) = (Vector3::x(), Vector3::y(), Vector3::z());
+        assert!((rot_x(q) * ey - ez).norm() < 1e-15);
+        assert!((rot_y(q) * ez - ex).norm() < 1e-15);
+        assert!((rot_z(q) * ex - ey).norm() < 1e-15);
+    }
+
+    #[test]
+    fn round_trip() {
+        let p = BodyPose::new([0.1, 0.2, 0.3], [0.4, -0.9, 1.3]);
+        let x = Vector3::new(-0.3, 0.8, 0.05);
+        assert!((p.to_body(&p.to_inertial(&x)) - x).norm() < 1e-14);
+    }
+}

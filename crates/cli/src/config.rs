@@ -1,0 +1,1223 @@
+//! The TOML configuration of SPEC §4.
+//!
+//! * Every table and key is optional; omitted keys take the built-in default
+//!   experiment ([`fbd_sim::PlanarParams::default`], the paper's §6 falling
+//!   experiment). Omitted link inertias default to the uniform rod `m·l²/12`
+//!   of the configured mass and length.
+//! * Unknown keys are errors (`deny_unknown_fields` everywhere).
+//! * Angles are degrees in the file and stay degrees in these structs, so
+//!   that [`Config::to_toml`] writes back exactly the numbers that were read;
+//!   they are converted to radians only by [`PlanarConfig::params`] and
+//!   [`HexapodConfig::joints_rad`].
+//!
+//! Loading ([`load`], [`parse_str`]) happens in two phases so that errors in
+//! the file point at the file: the text is deserialized as written (errors
+//! carry `file:line:col`), then optional dotted-key [`Override`]s are applied
+//! to the parsed [`toml::Table`] one at a time and the result deserialized
+//! again (errors name the override).
+
+use std::fmt;
+use std::path::Path;
+
+use fbd_contact::{Friction, Terrain};
+use fbd_dynamics::ContactPoints;
+use fbd_sim::{Model, PlanarParams, SimError};
+use serde::{Deserialize, Serialize};
+
+/// Fixed-length arrays of numbers: serde's `[f64; N]` would silently
+/// ignore extra elements of a TOML array, so the length is checked here.
+mod fixed {
+    use serde::de::{Deserialize, Deserializer, Error};
+
+    fn check<E: Error, const N: usize>(v: Vec<f64>) -> Result<[f64; N], E> {
+        let len = v.len();
+        v.try_into()
+            .map_err(|_| E::invalid_length(len, &format!("an array of {N} numbers").as_str()))
+    }
+
+    pub fn de<'de, D: Deserializer<'de>, const N: usize>(d: D) -> Result<[f64; N], D::Error> {
+        check(Vec::<f64>::deserialize(d)?)
+    }
+
+    pub fn opt<'de, D: Deserializer<'de>, const N: usize>(
+        d: D,
+    ) -> Result<Option<[f64; N]>, D::Error> {
+        Option::<Vec<f64>>::deserialize(d)?.map(check).transpose()
+    }
+}
+
+/// Why a configuration could not be used. Every variant displays as one
+/// line that names the file, and where possible the line, column and key.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    /// The file could not be read as text (missing, a directory, empty, not
+    /// UTF-8).
+    #[error("{file}: {what}")]
+    Unreadable {
+        /// The file as given.
+        file: String,
+        /// What is wrong.
+        what: String,
+    },
+    /// The file exists but reading it failed (permissions, I/O).
+    #[error("{file}: cannot read: {what}")]
+    Io {
+        /// The file as given.
+        file: String,
+        /// The operating system's message.
+        what: String,
+    },
+    /// TOML syntax, a value of the wrong type, or an unknown key.
+    #[error("{file}:{line}:{col}: {message}")]
+    Syntax {
+        /// The file as given.
+        file: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column (characters).
+        col: usize,
+        /// What is wrong, prefixed with the dotted key when known.
+        message: String,
+    },
+    /// A value out of its domain: `message` reads
+    /// `<table>.<key>: <what> (got X, expected Y)`.
+    #[error("{file}: {message}")]
+    Semantic {
+        /// The file as given.
+        file: String,
+        /// `table.key: what (got X, expected Y)`.
+        message: String,
+    },
+    /// A dotted-key override is malformed or does not fit the schema.
+    #[error("{file}: override `{key}`: {message}")]
+    Override {
+        /// The file the override applies to.
+        file: String,
+        /// The dotted key, e.g. `terrain.mu_static`.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl ConfigError {
+    /// `true` for operating-system read failures (exit status 4 rather
+    /// than 2).
+    pub fn is_io(&self) -> bool {
+        matches!(self, ConfigError::Io { .. })
+    }
+
+    fn semantic(file: &str, key: &str, what: &str, got: impl fmt::Display, expected: &str) -> Self {
+        ConfigError::Semantic {
+            file: file.to_owned(),
+            message: format!("{key}: {what} (got {got}, expected {expected})"),
+        }
+    }
+}
+
+/// Which model a configuration describes (`model = "planar" | "hexapod"`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ModelKind {
+    /// The 7-DOF planar two-leg model (SPEC §1.4).
+    #[default]
+    Planar,
+    /// The 24-DOF hexapod (SPEC §1.3).
+    Hexapod,
+}
+
+impl ModelKind {
+    /// `"planar"` or `"hexapod"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ModelKind::Planar => "planar",
+            ModelKind::Hexapod => "hexapod",
+        }
+    }
+}
+
+/// `[time]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TimeConfig {
+    /// Time step Δt (s).
+    pub dt: f64,
+    /// Simulated duration (s).
+    pub duration: f64,
+}
+
+impl Default for TimeConfig {
+    fn default() -> Self {
+        let p = PlanarParams::default();
+        Self {
+            dt: p.dt,
+            duration: p.duration,
+        }
+    }
+}
+
+/// `[world]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WorldConfig {
+    /// Gravitational acceleration (m/s²), acting along −Y.
+    pub gravity: f64,
+}
+
+impl Default for WorldConfig {
+    fn default() -> Self {
+        Self {
+            gravity: PlanarParams::default().gravity,
+        }
+    }
+}
+
+/// `[body]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct BodyConfig {
+    /// Central body mass (kg).
+    pub mass: f64,
+    /// Central body inertia about Z through its centre of mass (kg·m²).
+    pub inertia: f64,
+    /// Side `L` of the hexagonal body (m); hips at `d = L·cos(π/6)`.
+    pub side: f64,
+}
+
+impl Default for BodyConfig {
+    fn default() -> Self {
+        let p = PlanarParams::default();
+        Self {
+            mass: p.body_mass,
+            inertia: p.body_inertia,
+            side: p.side,
+        }
+    }
+}
+
+/// `[leg]`: all legs alike.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct LegConfig {
+    /// Upper link length `a` (m).
+    pub upper_length: f64,
+    /// Upper link mass (kg).
+    pub upper_mass: f64,
+    /// Upper link inertia about its centre of mass (kg·m²); `None` until
+    /// [`Config::resolve`]d to the uniform rod `m·a²/12`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub upper_inertia: Option<f64>,
+    /// Upper link centre of mass, fraction of `a` from the hip.
+    pub upper_com: f64,
+    /// Lower link length `c` (m).
+    pub lower_length: f64,
+    /// Lower link mass (kg).
+    pub lower_mass: f64,
+    /// Lower link inertia about its centre of mass (kg·m²); `None` until
+    /// resolved to `m·c²/12`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lower_inertia: Option<f64>,
+    /// Lower link centre of mass, fraction of `c` from the knee.
+    pub lower_com: f64,
+}
+
+impl Default for LegConfig {
+    fn default() -> Self {
+        let p = PlanarParams::default();
+        Self {
+            upper_length: p.upper_length,
+            upper_mass: p.upper_mass,
+            upper_inertia: None,
+            upper_com: p.upper_com,
+            lower_length: p.lower_length,
+            lower_mass: p.lower_mass,
+            lower_inertia: None,
+            lower_com: p.lower_com,
+        }
+    }
+}
+
+impl LegConfig {
+    /// Upper link inertia, the rod default when omitted (kg·m²).
+    pub fn upper_inertia(&self) -> f64 {
+        self.upper_inertia
+            .unwrap_or(self.upper_mass * self.upper_length * self.upper_length / 12.0)
+    }
+
+    /// Lower link inertia, the rod default when omitted (kg·m²).
+    pub fn lower_inertia(&self) -> f64 {
+        self.lower_inertia
+            .unwrap_or(self.lower_mass * self.lower_length * self.lower_length / 12.0)
+    }
+}
+
+/// Ground kinds of `[terrain] kind`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TerrainKind {
+    /// Horizontal ground `y = height`.
+    #[default]
+    Flat,
+    /// No ground: every contact point stays in ST1.
+    None,
+}
+
+/// `[terrain]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct TerrainConfig {
+    /// Ground kind.
+    pub kind: TerrainKind,
+    /// Ground height for `kind = "flat"` (m).
+    pub height: f64,
+    /// Static friction coefficient μS.
+    pub mu_static: f64,
+    /// Dynamic friction coefficient μD (`0 ≤ μD ≤ μS`).
+    pub mu_dynamic: f64,
+}
+
+impl Default for TerrainConfig {
+    fn default() -> Self {
+        let p = PlanarParams::default();
+        let (kind, height) = match p.terrain {
+            Terrain::Flat { height } => (TerrainKind::Flat, height),
+            _ => (TerrainKind::None, 0.0),
+        };
+        Self {
+            kind,
+            height,
+            mu_static: p.friction.mu_static,
+            mu_dynamic: p.friction.mu_dynamic,
+        }
+    }
+}
+
+impl TerrainConfig {
+    /// The terrain of the simulator.
+    pub fn terrain(&self) -> Terrain {
+        match self.kind {
+            TerrainKind::Flat => Terrain::Flat {
+                height: self.height,
+            },
+            TerrainKind::None => Terrain::None,
+        }
+    }
+
+    /// The friction coefficients of the simulator.
+    pub fn friction(&self) -> Friction {
+        Friction {
+            mu_static: self.mu_static,
+            mu_dynamic: self.mu_dynamic,
+        }
+    }
+}
+
+/// A kind of point of every leg that can touch the terrain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PointKind {
+    /// The feet (always on in the paper).
+    Tips,
+    /// The knees.
+    Knees,
+    /// The hips.
+    Hips,
+}
+
+/// `[contact]` (an extension of SPEC §4).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ContactConfig {
+    /// Which points of every leg can touch the terrain; must include
+    /// `"tips"`. Default `["tips"]`.
+    pub points: Vec<PointKind>,
+}
+
+impl Default for ContactConfig {
+    fn default() -> Self {
+        Self {
+            points: vec![PointKind::Tips],
+        }
+    }
+}
+
+impl ContactConfig {
+    /// The simulator's contact-point switches.
+    pub fn contact_points(&self) -> ContactPoints {
+        ContactPoints {
+            tips: self.points.contains(&PointKind::Tips),
+            knees: self.points.contains(&PointKind::Knees),
+            hips: self.points.contains(&PointKind::Hips),
+        }
+    }
+}
+
+/// `[output]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputConfig {
+    /// Write every `stride`-th step to `trajectory.csv`.
+    pub stride: usize,
+}
+
+impl Default for OutputConfig {
+    fn default() -> Self {
+        Self {
+            stride: PlanarParams::default().stride,
+        }
+    }
+}
+
+/// `[initial.leg3]` / `[initial.leg4]` of the planar model.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlanarLegInitial {
+    /// `(θ2, θ3)` (deg); `None` until resolved to the leg's default.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "fixed::opt")]
+    pub theta_deg: Option<[f64; 2]>,
+    /// `(θ̇2, θ̇3)` (deg/s); `None` until resolved to zero.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "fixed::opt")]
+    pub rate_deg: Option<[f64; 2]>,
+}
+
+/// Default `(θ2, θ3)` of legs 3 and 4 (deg): the paper's §6 table.
+pub const PLANAR_THETA_DEG: [[f64; 2]; 2] = [[0.0, 245.0], [0.0, 255.0]];
+
+/// `[initial]` of the planar model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlanarInitial {
+    /// `(Rx, Ry)` (m).
+    #[serde(deserialize_with = "fixed::de")]
+    pub position: [f64; 2],
+    /// `(Ṙx, Ṙy)` (m/s).
+    #[serde(deserialize_with = "fixed::de")]
+    pub velocity: [f64; 2],
+    /// φz (deg).
+    pub phi_z_deg: f64,
+    /// φ̇z (deg/s).
+    pub omega_z_deg: f64,
+    /// Leg 3 (middle-left).
+    pub leg3: PlanarLegInitial,
+    /// Leg 4 (middle-right).
+    pub leg4: PlanarLegInitial,
+}
+
+impl Default for PlanarInitial {
+    fn default() -> Self {
+        let p = PlanarParams::default();
+        Self {
+            position: [p.q0[0], p.q0[1]],
+            velocity: [p.qdot0[0], p.qdot0[1]],
+            phi_z_deg: 0.0,
+            omega_z_deg: 0.0,
+            leg3: PlanarLegInitial::default(),
+            leg4: PlanarLegInitial::default(),
+        }
+    }
+}
+
+impl PlanarInitial {
+    /// `(θ2, θ3)` of leg 3 (`leg = 0`) or leg 4 (`leg = 1`), deg.
+    pub fn theta_deg(&self, leg: usize) -> [f64; 2] {
+        let l = if leg == 0 { &self.leg3 } else { &self.leg4 };
+        l.theta_deg.unwrap_or(PLANAR_THETA_DEG[leg])
+    }
+
+    /// `(θ̇2, θ̇3)` of leg 3 (`leg = 0`) or leg 4 (`leg = 1`), deg/s.
+    pub fn rate_deg(&self, leg: usize) -> [f64; 2] {
+        let l = if leg == 0 { &self.leg3 } else { &self.leg4 };
+        l.rate_deg.unwrap_or([0.0; 2])
+    }
+}
+
+/// `[initial.legN]` of the hexapod model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HexapodLegInitial {
+    /// `(θ1, θ2, θ3)` (deg).
+    #[serde(deserialize_with = "fixed::de")]
+    pub theta_deg: [f64; 3],
+    /// `(θ̇1, θ̇2, θ̇3)` (deg/s).
+    #[serde(deserialize_with = "fixed::de")]
+    pub rate_deg: [f64; 3],
+}
+
+impl Default for HexapodLegInitial {
+    /// The paper's leg-3 pose: `(0°, 0°, 245°)`, at rest.
+    fn default() -> Self {
+        Self {
+            theta_deg: [0.0, 0.0, 245.0],
+            rate_deg: [0.0; 3],
+        }
+    }
+}
+
+/// `[initial]` of the hexapod model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct HexapodInitial {
+    /// `(Rx, Ry, Rz)` (m).
+    #[serde(deserialize_with = "fixed::de")]
+    pub position: [f64; 3],
+    /// `(Ṙx, Ṙy, Ṙz)` (m/s).
+    #[serde(deserialize_with = "fixed::de")]
+    pub velocity: [f64; 3],
+    /// `(φx, φy, φz)` (deg).
+    #[serde(deserialize_with = "fixed::de")]
+    pub phi_deg: [f64; 3],
+    /// `(φ̇x, φ̇y, φ̇z)` (deg/s).
+    #[serde(deserialize_with = "fixed::de")]
+    pub omega_deg: [f64; 3],
+    /// Leg 1 (front-left).
+    pub leg1: HexapodLegInitial,
+    /// Leg 2 (front-right).
+    pub leg2: HexapodLegInitial,
+    /// Leg 3 (middle-left).
+    pub leg3: HexapodLegInitial,
+    /// Leg 4 (middle-right).
+    pub leg4: HexapodLegInitial,
+    /// Leg 5 (rear-left).
+    pub leg5: HexapodLegInitial,
+    /// Leg 6 (rear-right).
+    pub leg6: HexapodLegInitial,
+}
+
+impl Default for HexapodInitial {
+    fn default() -> Self {
+        Self {
+            position: [0.0, 0.6, 0.0],
+            velocity: [0.0; 3],
+            phi_deg: [0.0; 3],
+            omega_deg: [0.0; 3],
+            leg1: HexapodLegInitial::default(),
+            leg2: HexapodLegInitial::default(),
+            leg3: HexapodLegInitial::default(),
+            leg4: HexapodLegInitial::default(),
+            leg5: HexapodLegInitial::default(),
+            leg6: HexapodLegInitial::default(),
+        }
+    }
+}
+
+impl HexapodInitial {
+    /// The six leg tables, indexed by leg number − 1.
+    pub fn legs(&self) -> [&HexapodLegInitial; 6] {
+        [
+            &self.leg1, &self.leg2, &self.leg3, &self.leg4, &self.leg5, &self.leg6,
+        ]
+    }
+}
+
+/// A whole configuration file; `I` is the model's `[initial]` table.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConfigFile<I> {
+    /// `"planar"` or `"hexapod"`.
+    #[serde(default)]
+    pub model: ModelKind,
+    /// `[time]`.
+    #[serde(default)]
+    pub time: TimeConfig,
+    /// `[world]`.
+    #[serde(default)]
+    pub world: WorldConfig,
+    /// `[body]`.
+    #[serde(default)]
+    pub body: BodyConfig,
+    /// `[leg]`.
+    #[serde(default)]
+    pub leg: LegConfig,
+    /// `[initial]`.
+    #[serde(default)]
+    pub initial: I,
+    /// `[terrain]`.
+    #[serde(default)]
+    pub terrain: TerrainConfig,
+    /// `[contact]`.
+    #[serde(default)]
+    pub contact: ContactConfig,
+    /// `[output]`.
+    #[serde(default)]
+    pub output: OutputConfig,
+}
+
+/// A planar configuration.
+pub type PlanarConfig = ConfigFile<PlanarInitial>;
+/// A hexapod configuration.
+pub type HexapodConfig = ConfigFile<HexapodInitial>;
+
+impl Default for PlanarConfig {
+    /// The built-in default experiment, every key filled in.
+    fn default() -> Self {
+        let mut c = Self {
+            model: ModelKind::Planar,
+            time: TimeConfig::default(),
+            world: WorldConfig::default(),
+            body: BodyConfig::default(),
+            leg: LegConfig::default(),
+            initial: PlanarInitial::default(),
+            terrain: TerrainConfig::default(),
+            contact: ContactConfig::default(),
+            output: OutputConfig::default(),
+        };
+        c.resolve_common();
+        c.resolve_initial();
+        c
+    }
+}
+
+impl<I> ConfigFile<I> {
+    fn resolve_common(&mut self) {
+        self.leg.upper_inertia = Some(self.leg.upper_inertia());
+        self.leg.lower_inertia = Some(self.leg.lower_inertia());
+        let mut points = self.contact.points.clone();
+        points.sort();
+        points.dedup();
+        self.contact.points = points;
+    }
+
+    /// Checks the keys every model shares; errors name `table.key`.
+    pub fn validate_common(&self, file: &str) -> Result<(), ConfigError> {
+        let err = |key: &str, what: &str, got: &dyn fmt::Display, expected: &str| {
+            Err(ConfigError::semantic(file, key, what, got, expected))
+        };
+        let positive = |key: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                err(key, "must be positive and finite", &v, "a finite value > 0")
+            }
+        };
+        positive("time.dt", self.time.dt)?;
+        positive("time.duration", self.time.duration)?;
+        if self.time.dt > self.time.duration {
+            return err(
+                "time.dt",
+                "must not exceed time.duration",
+                &self.time.dt,
+                &format!("dt ≤ {}", self.time.duration),
+            );
+        }
+        if !self.world.gravity.is_finite() {
+            return err(
+                "world.gravity",
+                "must be finite",
+                &self.world.gravity,
+                "a finite value",
+            );
+        }
+        positive("body.mass", self.body.mass)?;
+        positive("body.inertia", self.body.inertia)?;
+        positive("body.side", self.body.side)?;
+        positive("leg.upper_length", self.leg.upper_length)?;
+        positive("leg.upper_mass", self.leg.upper_mass)?;
+        positive("leg.upper_inertia", self.leg.upper_inertia())?;
+        positive("leg.lower_length", self.leg.lower_length)?;
+        positive("leg.lower_mass", self.leg.lower_mass)?;
+        positive("leg.lower_inertia", self.leg.lower_inertia())?;
+        for (key, v) in [
+            ("leg.upper_com", self.leg.upper_com),
+            ("leg.lower_com", self.leg.lower_com),
+        ] {
+            if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
+                return err(key, "must lie on the link", &v, "a fraction in [0, 1]");
+            }
+        }
+        if self.terrain.kind == TerrainKind::Flat && !self.terrain.height.is_finite() {
+            return err(
+                "terrain.height",
+                "must be finite",
+                &self.terrain.height,
+                "a finite value",
+            );
+        }
+        let (ms, md) = (self.terrain.mu_static, self.terrain.mu_dynamic);
+        if !(ms.is_finite() && ms >= 0.0) {
+            return err(
+                "terrain.mu_static",
+                "must be finite and ≥ 0",
+                &ms,
+                "0 ≤ mu_static",
+            );
+        }
+        if !(md.is_finite() && md >= 0.0 && md <= ms) {
+            return err(
+                "terrain.mu_dynamic",
+                "must satisfy 0 ≤ mu_dynamic ≤ mu_static",
+                &md,
+                &format!("0 ≤ mu_dynamic ≤ {ms}"),
+            );
+        }
+        if !self.contact.points.contains(&PointKind::Tips) {
+            let got = format!(
+                "{:?}",
+                self.contact
+                    .points
+                    .iter()
+                    .map(|p| point_name(*p))
+                    .collect::<Vec<_>>()
+            );
+            return err(
+                "contact.points",
+                "must include the tips",
+                &got,
+                "a list containing \"tips\"",
+            );
+        }
+        if self.output.stride < 1 {
+            return err(
+                "output.stride",
+                "must be at least 1",
+                &self.output.stride,
+                "an integer ≥ 1",
+            );
+        }
+        Ok(())
+    }
+}
+
+fn point_name(p: PointKind) -> &'static str {
+    match p {
+        PointKind::Tips => "tips",
+        PointKind::Knees => "knees",
+        PointKind::Hips => "hips",
+    }
+}
+
+fn check_finite(file: &str, key: &str, values: &[f64]) -> Result<(), ConfigError> {
+    for v in values {
+        if !v.is_finite() {
+            let got = if values.len() == 1 {
+                v.to_string()
+            } else {
+                format!("{values:?}")
+            };
+            return Err(ConfigError::semantic(
+                file,
+                key,
+                "must be finite",
+                got,
+                "finite values",
+            ));
+        }
+    }
+    Ok(())
+}
+
+impl PlanarConfig {
+    fn resolve_initial(&mut self) {
+        for leg in 0..2 {
+            let (theta, rate) = (self.initial.theta_deg(leg), self.initial.rate_deg(leg));
+            let l = if leg == 0 {
+                &mut self.initial.leg3
+            } else {
+                &mut self.initial.leg4
+            };
+            l.theta_deg = Some(theta);
+            l.rate_deg = Some(rate);
+        }
+    }
+
+    /// Checks every key, in the file's units (degrees for `*_deg` keys).
+    /// The dynamic model may still reject the configuration (e.g. a tip
+    /// below the terrain): see [`PlanarConfig::model`].
+    pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        self.validate_common(file)?;
+        let i = &self.initial;
+        check_finite(file, "initial.position", &i.position)?;
+        check_finite(file, "initial.velocity", &i.velocity)?;
+        check_finite(file, "initial.phi_z_deg", &[i.phi_z_deg])?;
+        check_finite(file, "initial.omega_z_deg", &[i.omega_z_deg])?;
+        for (leg, name) in [(0, "leg3"), (1, "leg4")] {
+            check_finite(
+                file,
+                &format!("initial.{name}.theta_deg"),
+                &i.theta_deg(leg),
+            )?;
+            check_finite(file, &format!("initial.{name}.rate_deg"), &i.rate_deg(leg))?;
+        }
+        Ok(())
+    }
+
+    /// The simulator's parameters (SI units, radians).
+    pub fn params(&self) -> PlanarParams {
+        let i = &self.initial;
+        let [t3, t4] = [i.theta_deg(0), i.theta_deg(1)];
+        let [r3, r4] = [i.rate_deg(0), i.rate_deg(1)];
+        PlanarParams {
+            dt: self.time.dt,
+            duration: self.time.duration,
+            gravity: self.world.gravity,
+            body_mass: self.body.mass,
+            body_inertia: self.body.inertia,
+            side: self.body.side,
+            upper_length: self.leg.upper_length,
+            upper_mass: self.leg.upper_mass,
+            upper_inertia: self.leg.upper_inertia(),
+            upper_com: self.leg.upper_com,
+            lower_length: self.leg.lower_length,
+            lower_mass: self.leg.lower_mass,
+            lower_inertia: self.leg.lower_inertia(),
+            lower_com: self.leg.lower_com,
+            q0: [
+                i.position[0],
+                i.position[1],
+                i.phi_z_deg.to_radians(),
+                t3[0].to_radians(),
+                t3[1].to_radians(),
+                t4[0].to_radians(),
+                t4[1].to_radians(),
+            ],
+            qdot0: [
+                i.velocity[0],
+                i.velocity[1],
+                i.omega_z_deg.to_radians(),
+                r3[0].to_radians(),
+                r3[1].to_radians(),
+                r4[0].to_radians(),
+                r4[1].to_radians(),
+            ],
+            terrain: self.terrain.terrain(),
+            friction: self.terrain.friction(),
+            contact_points: self.contact.contact_points(),
+            stride: self.output.stride,
+        }
+    }
+
+    /// Validates and builds the dynamic model; errors name `table.key`
+    /// (prefixed with `file`).
+    pub fn model(&self, file: &str) -> Result<Model, ConfigError> {
+        self.validate(file)?;
+        Model::planar(&self.params()).map_err(|e: SimError| ConfigError::Semantic {
+            file: file.to_owned(),
+            message: e.to_string(),
+        })
+    }
+}
+
+impl HexapodConfig {
+    /// Checks every key, in the file's units.
+    pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        self.validate_common(file)?;
+        let i = &self.initial;
+        check_finite(file, "initial.position", &i.position)?;
+        check_finite(file, "initial.velocity", &i.velocity)?;
+        check_finite(file, "initial.phi_deg", &i.phi_deg)?;
+        check_finite(file, "initial.omega_deg", &i.omega_deg)?;
+        for (n, l) in i.legs().iter().enumerate() {
+            check_finite(
+                file,
+                &format!("initial.leg{}.theta_deg", n + 1),
+                &l.theta_deg,
+            )?;
+            check_finite(file, &format!("initial.leg{}.rate_deg", n + 1), &l.rate_deg)?;
+        }
+        Ok(())
+    }
+
+    /// `(θ1, θ2, θ3)` of every leg in radians, indexed by leg number − 1.
+    pub fn joints_rad(&self) -> [[f64; 3]; 6] {
+        self.initial
+            .legs()
+            .map(|l| l.theta_deg.map(f64::to_radians))
+    }
+
+    /// `(φx, φy, φz)` in radians.
+    pub fn phi_rad(&self) -> [f64; 3] {
+        self.initial.phi_deg.map(f64::to_radians)
+    }
+}
+
+/// A configuration of either model.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Config {
+    /// `model = "planar"` (or no `model` key).
+    Planar(Box<PlanarConfig>),
+    /// `model = "hexapod"`.
+    Hexapod(Box<HexapodConfig>),
+}
+
+impl Default for Config {
+    /// The built-in default experiment.
+    fn default() -> Self {
+        Config::Planar(Box::default())
+    }
+}
+
+const HEADER: &str = "\
+# The complete configuration of an fbd run: every key with the value used.
+# `fbd run` of this file repeats the run exactly.
+";
+
+impl Config {
+    /// The model kind.
+    pub fn model(&self) -> ModelKind {
+        match self {
+            Config::Planar(_) => ModelKind::Planar,
+            Config::Hexapod(_) => ModelKind::Hexapod,
+        }
+    }
+
+    /// Fills every omitted key with its default value (inertias, leg
+    /// angles) and normalises the contact-point list.
+    pub fn resolve(&mut self) {
+        match self {
+            Config::Planar(c) => {
+                c.model = ModelKind::Planar;
+                c.resolve_common();
+                c.resolve_initial();
+            }
+            Config::Hexapod(c) => {
+                c.model = ModelKind::Hexapod;
+                c.resolve_common();
+            }
+        }
+    }
+
+    /// Checks every key; errors name the file and `table.key`.
+    pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        match self {
+            Config::Planar(c) => c.validate(file),
+            Config::Hexapod(c) => c.validate(file),
+        }
+    }
+
+    /// The complete configuration as TOML: every key with its value, floats
+    /// written so that they read back bit-identical.
+    pub fn to_toml(&self) -> String {
+        let mut c = self.clone();
+        c.resolve();
+        let body = match &c {
+            Config::Planar(p) => toml::to_string(p),
+            Config::Hexapod(h) => toml::to_string(h),
+        };
+        // Serializing plain structs of numbers, strings and arrays cannot
+        // fail; keep a readable fallback rather than a panic.
+        let body = body.unwrap_or_else(|e| format!("# serialization failed: {e}\n"));
+        format!("{HEADER}{body}")
+    }
+}
+
+/// One dotted-key override, e.g. `terrain.mu_static = 0.5`, applied on top
+/// of a file by [`load_with_overrides`] / [`parse_str`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Override {
+    /// Dotted key, e.g. `initial.leg3.theta_deg`.
+    pub key: String,
+    /// The TOML value to set.
+    pub value: toml::Value,
+}
+
+impl Override {
+    /// An override of `key` with `value`.
+    pub fn new(key: impl Into<String>, value: impl Into<toml::Value>) -> Self {
+        Self {
+            key: key.into(),
+            value: value.into(),
+        }
+    }
+
+    /// Parses `KEY=VALUE` where VALUE is a TOML value (`0.5`, `[0.0, 0.6]`,
+    /// `"flat"`); a VALUE that is not valid TOML is taken as a string.
+    pub fn parse(spec: &str) -> Result<Self, String> {
+        let (key, value) = spec
+            .split_once('=')
+            .ok_or_else(|| format!("`{spec}`: expected KEY=VALUE"))?;
+        let key = key.trim();
+        if key.is_empty() || key.split('.').any(|s| s.trim().is_empty()) {
+            return Err(format!(
+                "`{spec}`: expected a dotted key such as terrain.mu_static"
+            ));
+        }
+        let value = value.trim();
+        let value = match format!("v = {value}").parse::<toml::Table>() {
+            Ok(mut t) => t
+                .remove("v")
+                .unwrap_or_else(|| toml::Value::String(value.to_owned())),
+            Err(_) => toml::Value::String(value.to_owned()),
+        };
+        Ok(Self {
+            key: key.split('.').map(str::trim).collect::<Vec<_>>().join("."),
+            value,
+        })
+    }
+}
+
+/// Sets the dotted `key` of `table` to `value`, creating intermediate
+/// tables. Fails when an intermediate key holds a non-table value.
+pub fn apply_override(
+    table: &mut toml::Table,
+    key: &str,
+    value: toml::Value,
+) -> Result<(), String> {
+    let mut parts: Vec<&str> = key.split('.').collect();
+    let last = parts.pop().unwrap_or_default();
+    let mut cur = table;
+    let mut path = String::new();
+    for p in parts {
+        if !path.is_empty() {
+            path.push('.');
+        }
+        path.push_str(p);
+        let entry = cur
+            .entry(p.to_owned())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        cur = match entry {
+            toml::Value::Table(t) => t,
+            other => return Err(format!("`{path}` is a {}, not a table", other.type_str())),
+        };
+    }
+    cur.insert(last.to_owned(), value);
+    Ok(())
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let mut start = offset;
+    while !text.is_char_boundary(start) {
+        start -= 1;
+    }
+    let before = &text[..start];
+    let line = before.matches('\n').count() + 1;
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    let col = before[line_start..].chars().count() + 1;
+    (line, col)
+}
+
+/// The message of a toml error, prefixed with the dotted key it concerns
+/// (when toml knows it and the message does not already say it).
+fn describe(err: &toml::de::Error) -> String {
+    let message = err.message().trim().replace('\n', "; ");
+    let mut plain = err.clone();
+    plain.set_input(None);
+    let rendered = plain.to_string();
+    let keys = rendered
+        .lines()
+        .rev()
+        .find_map(|l| l.strip_prefix("in `").and_then(|l| l.strip_suffix('`')));
+    match keys {
+        Some(k) if !k.is_empty() => format!("{k}: {message}"),
+        _ => message,
+    }
+}
+
+fn syntax_error(file: &str, text: &str, err: &toml::de::Error) -> ConfigError {
+    let (line, col) = err.span().map_or((1, 1), |s| line_col(text, s.start));
+    ConfigError::Syntax {
+        file: file.to_owned(),
+        line,
+        col,
+        message: describe(err),
+    }
+}
+
+fn model_of(table: &toml::Table) -> ModelKind {
+    match table.get("model") {
+        Some(toml::Value::String(s)) if s == "hexapod" => ModelKind::Hexapod,
+        _ => ModelKind::Planar,
+    }
+}
+
+fn from_table(table: &toml::Table) -> Result<Config, toml::de::Error> {
+    Ok(match model_of(table) {
+        ModelKind::Hexapod => Config::Hexapod(Box::new(table.clone().try_into()?)),
+        ModelKind::Planar => Config::Planar(Box::new(table.clone().try_into()?)),
+    })
+}
+
+/// Parses configuration `text` (named `file` in errors), applies
+/// `overrides` in order, fills defaults ([`Config::resolve`]) and validates
+/// every key ([`Config::validate`]). An empty `text` is the built-in
+/// default experiment (plus the overrides).
+pub fn parse_str(text: &str, file: &str, overrides: &[Override]) -> Result<Config, ConfigError> {
+    let mut table: toml::Table = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
+    // Deserialize the text itself so that errors carry its line and column.
+    let mut config = match model_of(&table) {
+        ModelKind::Hexapod => toml::from_str(text).map(|h| Config::Hexapod(Box::new(h))),
+        ModelKind::Planar => toml::from_str(text).map(|p| Config::Planar(Box::new(p))),
+    }
+    .map_err(|e| syntax_error(file, text, &e))?;
+    for o in overrides {
+        let fail = |message: String| ConfigError::Override {
+            file: file.to_owned(),
+            key: o.key.clone(),
+            message,
+        };
+        apply_override(&mut table, &o.key, o.value.clone()).map_err(fail)?;
+        config = from_table(&table).map_err(|e| fail(describe(&e)))?;
+    }
+    config.resolve();
+    config.validate(file)?;
+    Ok(config)
+}
+
+/// Reads and parses the configuration file at `path` ([`parse_str`]).
+pub fn load(path: &Path) -> Result<Config, ConfigError> {
+    load_with_overrides(path, &[])
+}
+
+/// Reads the file at `path`, applies `overrides` (dotted keys, e.g. from a
+/// sweep) and parses it ([`parse_str`]).
+pub fn load_with_overrides(path: &Path, overrides: &[Override]) -> Result<Config, ConfigError> {
+    let file = path.display().to_string();
+    let unreadable = |what: &str| ConfigError::Unreadable {
+        file: file.clone(),
+        what: what.to_owned(),
+    };
+    match std::fs::metadata(path) {
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(unreadable("no such file"));
+        }
+        Err(e) => {
+            return Err(ConfigError::Io {
+                file,
+                what: e.to_string(),
+            });
+        }
+        Ok(m) if m.is_dir() => {
+            return Err(unreadable(
+                "is a directory, expected a TOML configuration file",
+            ));
+        }
+        Ok(_) => {}
+    }
+    let bytes = std::fs::read(path).map_err(|e| ConfigError::Io {
+        file: file.clone(),
+        what: e.to_string(),
+    })?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        unreadable(&format!(
+            "is not UTF-8 text (invalid byte at offset {})",
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    if text.trim().is_empty() {
+        return Err(unreadable(
+            "the file is empty (expected a TOML configuration, e.g. `model = \"planar\"`)",
+        ));
+    }
+    parse_str(&text, &file, overrides)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Config, ConfigError> {
+        parse_str(text, "c.toml", &[])
+    }
+
+    #[test]
+    fn default_config_is_the_default_experiment() {
+        let Config::Planar(c) = Config::default() else {
+            unreachable!()
+        };
+        assert_eq!(c.params(), PlanarParams::default());
+        let Config::Planar(c) = parse("model = \"planar\"\n").unwrap() else {
+            unreachable!()
+        };
+        assert_eq!(c.params(), PlanarParams::default());
+    }
+
+    #[test]
+    fn complete_config_round_trips() {
+        let text = "[leg]\nupper_mass = 0.7\n[initial]\nphi_z_deg = 0.1\n[initial.leg4]\ntheta_deg = [1.3, 250.7]\n[contact]\npoints = [\"knees\", \"tips\"]\n";
+        let c = parse(text).unwrap();
+        let full = c.to_toml();
+        let again = parse_str(&full, "full.toml", &[]).unwrap();
+        assert_eq!(c, again);
+        assert_eq!(full, again.to_toml());
+        let Config::Planar(p) = again else {
+            unreachable!()
+        };
+        assert_eq!(p.leg.upper_inertia, Some(0.7 * 0.2 * 0.2 / 12.0));
+        assert_eq!(p.initial.leg3.theta_deg, Some([0.0, 245.0]));
+        assert_eq!(p.contact.points, vec![PointKind::Tips, PointKind::Knees]);
+    }
+
+    #[test]
+    fn unknown_key_has_line_column_and_key() {
+        let e = parse("[time]\ndt = 0.01\n\n[body]\nmass = 6.0\nmas = 3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.toml:6:1: "), "{e}");
+        assert!(e.contains("mas"), "{e}");
+        let e = parse("[time]\ndt = \"fast\"\n").unwrap_err().to_string();
+        assert!(e.starts_with("c.toml:2:6: time.dt: invalid type"), "{e}");
+    }
+
+    #[test]
+    fn semantic_errors_name_table_key() {
+        let e = parse("[leg]\nupper_mass = -1.0\n").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "c.toml: leg.upper_mass: must be positive and finite (got -1, expected a finite value > 0)"
+        );
+        let e = parse("[initial]\nphi_z_deg = inf\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("initial.phi_z_deg") && e.contains("got inf"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn overrides_apply_and_name_the_key() {
+        let o = [
+            Override::parse("terrain.mu_static=0.5").unwrap(),
+            Override::parse("initial.position = [0.1, 0.7]").unwrap(),
+        ];
+        let Config::Planar(c) = parse_str("", "x", &o).unwrap() else {
+            unreachable!()
+        };
+        assert_eq!(c.terrain.mu_static, 0.5);
+        // Integers are accepted where floats are expected, in files and
+        // overrides alike.
+        let o = [Override::parse("time.duration=1").unwrap()];
+        let Config::Planar(i) =
+            parse_str("[body]\nmass = 6\n[initial]\nposition = [0, 1]\n", "x", &o).unwrap()
+        else {
+            unreachable!()
+        };
+        assert_eq!(
+            (i.time.duration, i.body.mass, i.initial.position),
+            (1.0, 6.0, [0.0, 1.0])
+        );
+        assert_eq!(c.initial.position, [0.1, 0.7]);
+        let e = parse_str(
+            "model = \"planar\"",
+            "x.toml",
+            &[Override::parse("terrain.mu_statc=0.5").unwrap()],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.starts_with("x.toml: override `terrain.mu_statc`:") && e.contains("unknown field"),
+            "{e}"
+        );
+        let e = parse_str(
+            "model = \"planar\"",
+            "x.toml",
+            &[Override::parse("terrain.mu_dynamic=0.9").unwrap()],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("terrain.mu_dynamic"), "{e}");
+    }
+
+    #[test]
+    fn hexapod_parses() {
+        let c =
+            parse("model = \"hexapod\"\n[initial.leg2]\ntheta_deg = [10.0, 5.0, 250.0]\n").unwrap();
+        let Config::Hexapod(h) = c else { panic!() };
+        assert_eq!(h.initial.leg2.theta_deg, [10.0, 5.0, 250.0]);
+        let c = Config::Hexapod(h);
+        let again = parse_str(&c.to_toml(), "full.toml", &[]).unwrap();
+        assert_eq!(c, again);
+        assert!(parse("model = \"hexapod\"\n[initial]\nphi_z_deg = 1.0\n").is_err());
+    }
+}

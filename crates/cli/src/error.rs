@@ -1,0 +1,62 @@
+//! The top-level error of a command and its exit status.
+
+use crate::config::ConfigError;
+
+/// Why a command failed. Displays as one line (without the `error: `
+/// prefix the binary adds).
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// A configuration file is unreadable or invalid (exit 2, or 4 for an
+    /// operating-system read failure).
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// The request cannot be served (exit 2), e.g. `fbd run` of a hexapod.
+    #[error("{0}")]
+    Usage(String),
+    /// The simulation stopped with an error; what was computed is written
+    /// (exit 3).
+    #[error("{0}")]
+    Simulation(String),
+    /// Reading or writing a file failed (exit 4).
+    #[error("{0}")]
+    Io(String),
+    /// Writing to stdout failed because the reader went away (exit 4,
+    /// nothing printed).
+    #[error("broken pipe")]
+    BrokenPipe,
+}
+
+impl CliError {
+    /// Exit status for an internal error (a caught panic).
+    pub const INTERNAL: u8 = 70;
+
+    /// The process exit status of this error (SPEC §5): 2 usage or
+    /// configuration, 3 simulation, 4 input/output.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Config(e) if e.is_io() => 4,
+            CliError::Config(_) | CliError::Usage(_) => 2,
+            CliError::Simulation(_) => 3,
+            CliError::Io(_) | CliError::BrokenPipe => 4,
+        }
+    }
+
+    /// `true` when stdout was closed by its reader (no message is printed).
+    pub fn is_broken_pipe(&self) -> bool {
+        matches!(self, CliError::BrokenPipe)
+    }
+
+    /// Wraps an I/O error on `what` (a path or "stdout").
+    pub fn io(what: impl std::fmt::Display, e: &std::io::Error) -> Self {
+        CliError::Io(format!("{what}: {e}"))
+    }
+
+    /// Maps a failed write to stdout.
+    pub fn stdout(e: std::io::Error) -> Self {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            CliError::BrokenPipe
+        } else {
+            CliError::io("stdout", &e)
+        }
+    }
+}

@@ -1,0 +1,121 @@
+//! `fbd kinematics CONFIG`: hip, knee and tip of every leg at the initial
+//! state, inertial frame, as JSON (SPEC §5).
+
+use std::io::Write;
+use std::path::Path;
+
+use fbd_kinematics::hexapod::{HexapodData, HexapodModel, forward};
+use fbd_kinematics::leg::LegGeometry;
+use fbd_kinematics::planar::{PlanarChains, PlanarGeometry};
+use fbd_kinematics::pose::BodyPose;
+use serde::Serialize;
+
+use crate::CliError;
+use crate::config::{self, Config, HexapodConfig, PlanarConfig};
+
+/// The points of one leg (m, inertial frame).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LegPoints {
+    /// Hexapod leg number (1–6).
+    pub leg: usize,
+    /// Hip.
+    pub hip: [f64; 3],
+    /// Knee.
+    pub knee: [f64; 3],
+    /// Tip (foot).
+    pub tip: [f64; 3],
+}
+
+/// The JSON document `{"legs": [...]}`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Kinematics {
+    /// One entry per leg of the model.
+    pub legs: Vec<LegPoints>,
+}
+
+/// Planar geometry of a configuration.
+pub fn planar_geometry(c: &PlanarConfig) -> PlanarGeometry {
+    PlanarGeometry {
+        d: c.body.side * (std::f64::consts::PI / 6.0).cos(),
+        a: c.leg.upper_length,
+        c: c.leg.lower_length,
+        upper_com: c.leg.upper_com,
+        lower_com: c.leg.lower_com,
+    }
+}
+
+/// Hip, knee and tip of legs 3 and 4 for planar coordinates `q` (z = 0).
+pub fn planar_points(geometry: &PlanarGeometry, q: &[f64; 7]) -> Vec<LegPoints> {
+    let (chains, ix) = PlanarChains::two_leg(geometry);
+    let mut data = chains.new_data();
+    chains.eval_positions(q, &mut data);
+    let p = |i: usize| [data.pos[i][0], data.pos[i][1], 0.0];
+    (0..2)
+        .map(|leg| LegPoints {
+            leg: fbd_kinematics::planar::hexapod_leg_number(leg),
+            hip: p(ix.hip[leg]),
+            knee: p(ix.knee[leg]),
+            tip: p(ix.tip[leg]),
+        })
+        .collect()
+}
+
+/// Hip, knee and tip of the six legs of a hexapod configuration.
+pub fn hexapod_points(c: &HexapodConfig) -> Vec<LegPoints> {
+    let model = HexapodModel::new(
+        c.body.side,
+        LegGeometry {
+            a: c.leg.upper_length,
+            c: c.leg.lower_length,
+        },
+        c.leg.upper_com,
+        c.leg.lower_com,
+    );
+    let cfg = fbd_kinematics::hexapod::HexapodConfig {
+        pose: BodyPose::new(c.initial.position, c.phi_rad()),
+        joints: c.joints_rad(),
+    };
+    let mut data = HexapodData::new();
+    forward(&model, &cfg, &mut data);
+    data.legs
+        .iter()
+        .enumerate()
+        .map(|(i, l)| LegPoints {
+            leg: i + 1,
+            hip: l.hip.into(),
+            knee: l.knee.into(),
+            tip: l.tip.into(),
+        })
+        .collect()
+}
+
+/// The initial kinematics of a (validated) configuration.
+pub fn initial_kinematics(config: &Config) -> Kinematics {
+    let legs = match config {
+        Config::Planar(c) => planar_points(&planar_geometry(c), &c.params().q0),
+        Config::Hexapod(h) => hexapod_points(h),
+    };
+    Kinematics { legs }
+}
+
+impl Kinematics {
+    /// The JSON text: `{"legs": [` then one leg object per line, then
+    /// `]}`; numbers with full round-trip precision.
+    pub fn to_json(&self) -> String {
+        let legs: Vec<String> = self
+            .legs
+            .iter()
+            .map(|l| serde_json::to_string(l).unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}")))
+            .collect();
+        format!("{{\"legs\": [\n  {}\n]}}\n", legs.join(",\n  "))
+    }
+}
+
+/// `fbd kinematics CONFIG`.
+pub fn kinematics_command(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
+    let config = config::load(path)?;
+    let json = initial_kinematics(&config).to_json();
+    out.write_all(json.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(CliError::stdout)
+}

@@ -1,0 +1,352 @@
+//! The files of `fbd run` (SPEC §6): every file is written to a temporary
+//! file in the output directory and renamed into place, so that it appears
+//! completely or not at all.
+//!
+//! Numbers are written with [`ryu`]: the shortest decimal that reads back
+//! bit-identical, deterministic across runs and platforms.
+
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use fbd_sim::{Event, StepRecord};
+use serde::Serialize;
+use tempfile::NamedTempFile;
+
+use crate::CliError;
+
+/// Names of the files `fbd run` writes, in the order they are written.
+pub const FILES: [&str; 7] = [
+    "trajectory.csv",
+    "events.csv",
+    "summary.json",
+    "config.toml",
+    "tips.svg",
+    "forces.svg",
+    "stance.svg",
+];
+
+/// The columns of SPEC §6, in order; extras follow (see
+/// [`trajectory_columns`]).
+pub const SPEC_COLUMNS: [&str; 26] = [
+    "t", "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4", "tip3_x", "tip3_y",
+    "tip4_x", "tip4_y", "state3", "state4", "fa3", "n3", "fa4", "n4", "hip3_fx", "hip3_fy",
+    "knee3_fx", "knee3_fy", "hip4_fx", "hip4_fy", "knee4_fx", "knee4_fy",
+];
+
+/// Columns after the contact-point triples.
+pub const TAIL_COLUMNS: [&str; 8] = [
+    "tau_hip3",
+    "tau_knee3",
+    "tau_hip4",
+    "tau_knee4",
+    "kinetic",
+    "potential",
+    "energy",
+    "newton_iterations",
+];
+
+/// A new temporary file in `dir`, readable like an ordinary file once
+/// renamed.
+fn temp_in(dir: &Path, name: &str) -> Result<NamedTempFile, CliError> {
+    let prefix = format!(".{name}.");
+    let mut b = tempfile::Builder::new();
+    b.prefix(&prefix).suffix(".tmp");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    b.tempfile_in(dir)
+        .map_err(|e| CliError::io(format!("{}: cannot create a file", dir.display()), &e))
+}
+
+fn persist(tmp: NamedTempFile, dest: &Path) -> Result<(), CliError> {
+    tmp.persist(dest)
+        .map_err(|e| CliError::io(dest.display(), &e.error))?;
+    Ok(())
+}
+
+/// Writes `bytes` to `dir/name` all-or-nothing; returns the path.
+pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliError> {
+    let dest = dir.join(name);
+    let mut tmp = temp_in(dir, name)?;
+    tmp.write_all(bytes)
+        .and_then(|()| tmp.flush())
+        .map_err(|e| CliError::io(dest.display(), &e))?;
+    persist(tmp, &dest)?;
+    Ok(dest)
+}
+
+/// Creates `dir` if needed and checks that files can be created in it.
+pub fn prepare_dir(dir: &Path) -> Result<(), CliError> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(CliError::Io(format!(
+            "{}: exists and is not a directory",
+            dir.display()
+        )));
+    }
+    std::fs::create_dir_all(dir).map_err(|e| {
+        CliError::io(
+            format!("{}: cannot create the output directory", dir.display()),
+            &e,
+        )
+    })?;
+    // Probe: creating (and dropping) a temporary file proves writability.
+    temp_in(dir, "probe").map(drop)
+}
+
+/// The trajectory columns for a model whose contact points are named
+/// `contacts` (e.g. `["tip3", "tip4", "knee3", "knee4"]`): SPEC §6's list,
+/// then `<name>_state, <name>_fa, <name>_n` for every contact point that is
+/// not a tip, then [`TAIL_COLUMNS`].
+pub fn trajectory_columns(contacts: &[String]) -> Vec<String> {
+    let mut c: Vec<String> = SPEC_COLUMNS.iter().map(|s| (*s).to_owned()).collect();
+    for name in contacts.iter().filter(|n| !is_tip(n)) {
+        for suffix in ["state", "fa", "n"] {
+            c.push(format!("{name}_{suffix}"));
+        }
+    }
+    c.extend(TAIL_COLUMNS.iter().map(|s| (*s).to_owned()));
+    c
+}
+
+fn is_tip(name: &str) -> bool {
+    name == "tip3" || name == "tip4"
+}
+
+/// `tip`, `knee` or `hip` of a contact-point name such as `knee3`.
+pub fn point_kind(name: &str) -> &str {
+    name.trim_end_matches(|c: char| c.is_ascii_digit())
+}
+
+/// Streams `trajectory.csv` through a buffer into a temporary file; no
+/// allocation per row.
+pub struct TrajectoryWriter {
+    out: BufWriter<NamedTempFile>,
+    dest: PathBuf,
+    num: ryu::Buffer,
+    tips: [Option<usize>; 2],
+    extras: Vec<usize>,
+    error: Option<io::Error>,
+    rows: usize,
+}
+
+impl TrajectoryWriter {
+    /// Opens the temporary file in `dir` and writes the header.
+    pub fn create(dir: &Path, contacts: &[String]) -> Result<Self, CliError> {
+        let dest = dir.join("trajectory.csv");
+        let tmp = temp_in(dir, "trajectory.csv")?;
+        let mut w = Self {
+            out: BufWriter::with_capacity(1 << 16, tmp),
+            dest,
+            num: ryu::Buffer::new(),
+            tips: [
+                contacts.iter().position(|n| n == "tip3"),
+                contacts.iter().position(|n| n == "tip4"),
+            ],
+            extras: (0..contacts.len())
+                .filter(|&i| !is_tip(&contacts[i]))
+                .collect(),
+            error: None,
+            rows: 0,
+        };
+        let header = trajectory_columns(contacts).join(",");
+        if let Err(e) = writeln!(w.out, "{header}") {
+            return Err(CliError::io(w.dest.display(), &e));
+        }
+        Ok(w)
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Appends the row of `r`. An I/O error is kept and reported by
+    /// [`TrajectoryWriter::finish`]; later rows are skipped.
+    pub fn write(&mut self, r: &StepRecord) {
+        if self.error.is_some() {
+            return;
+        }
+        match self.write_row(r) {
+            Ok(()) => self.rows += 1,
+            Err(e) => self.error = Some(e),
+        }
+    }
+
+    fn f(&mut self, x: f64) -> io::Result<()> {
+        self.out.write_all(b",")?;
+        self.out.write_all(self.num.format(x).as_bytes())
+    }
+
+    fn s(&mut self, s: &str) -> io::Result<()> {
+        self.out.write_all(b",")?;
+        self.out.write_all(s.as_bytes())
+    }
+
+    fn write_row(&mut self, r: &StepRecord) -> io::Result<()> {
+        self.out.write_all(self.num.format(r.t).as_bytes())?;
+        for &x in &r.q {
+            self.f(x)?;
+        }
+        let tips = self.tips;
+        for c in tips {
+            let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
+            self.f(p[0])?;
+            self.f(p[1])?;
+        }
+        for c in tips {
+            self.s(c.map_or("ST1", |c| r.state[c].as_str()))?;
+        }
+        for c in tips {
+            let (fa, n) = c.map_or((0.0, 0.0), |c| (r.fa[c], r.n[c]));
+            self.f(fa)?;
+            self.f(n)?;
+        }
+        for j in &r.joint_force {
+            self.f(j[0])?;
+            self.f(j[1])?;
+        }
+        for k in 0..self.extras.len() {
+            let c = self.extras[k];
+            self.s(r.state[c].as_str())?;
+            self.f(r.fa[c])?;
+            self.f(r.n[c])?;
+        }
+        for &t in &r.torque {
+            self.f(t)?;
+        }
+        self.f(r.kinetic)?;
+        self.f(r.potential)?;
+        self.f(r.kinetic + r.potential)?;
+        write!(self.out, ",{}", r.newton_iterations)?;
+        self.out.write_all(b"\n")
+    }
+
+    /// Flushes and renames the file into place.
+    pub fn finish(self) -> Result<PathBuf, CliError> {
+        let dest = self.dest;
+        if let Some(e) = self.error {
+            return Err(CliError::io(dest.display(), &e));
+        }
+        let tmp = self
+            .out
+            .into_inner()
+            .map_err(|e| CliError::io(dest.display(), e.error()))?;
+        persist(tmp, &dest)?;
+        Ok(dest)
+    }
+}
+
+/// `events.csv`: header `t,leg,from,to,point`, one row per event.
+pub fn events_csv(events: &[Event]) -> String {
+    let mut s = String::from("t,leg,from,to,point\n");
+    let mut num = ryu::Buffer::new();
+    for e in events {
+        s.push_str(num.format(e.t));
+        s.push_str(&format!(
+            ",{},{},{},{}\n",
+            e.leg,
+            e.from.as_str(),
+            e.to.as_str(),
+            point_kind(&e.name)
+        ));
+    }
+    s
+}
+
+/// An event as written to `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EventJson {
+    /// Start of the first step solved in the new state (s).
+    pub t: f64,
+    /// Hexapod leg number.
+    pub leg: usize,
+    /// `tip`, `knee` or `hip`.
+    pub point: String,
+    /// Previous state.
+    pub from: &'static str,
+    /// New state.
+    pub to: &'static str,
+}
+
+impl From<&Event> for EventJson {
+    fn from(e: &Event) -> Self {
+        Self {
+            t: e.t,
+            leg: e.leg,
+            point: point_kind(&e.name).to_owned(),
+            from: e.from.as_str(),
+            to: e.to.as_str(),
+        }
+    }
+}
+
+/// Peak contact forces of one contact point over the run (N).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PeakForce {
+    /// Largest normal force.
+    pub n: f64,
+    /// Largest |tangential force|.
+    pub fa: f64,
+}
+
+/// Mechanical energy at the last solved step.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Energy {
+    /// Time of that step (s).
+    pub t: f64,
+    /// Kinetic energy (J).
+    pub kinetic: f64,
+    /// Gravitational potential energy (J).
+    pub potential: f64,
+    /// Their sum (J).
+    pub total: f64,
+}
+
+/// `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// `"ok"` or `"error"`.
+    pub status: &'static str,
+    /// The error message, or null.
+    pub error: Option<String>,
+    /// Steps solved.
+    pub steps: usize,
+    /// Newton iterations over the whole run.
+    pub newton_iterations: usize,
+    /// Time in the stepping loop alone (s).
+    pub wall_seconds: f64,
+    /// `steps / wall_seconds` (null when not measurable).
+    pub steps_per_second: Option<f64>,
+    /// Symbolic LU factorisations performed.
+    pub symbolic_factorizations: usize,
+    /// Contact events, as `events.csv`.
+    pub events: Vec<EventJson>,
+    /// `"planar"`.
+    pub model: &'static str,
+    /// Time step (s).
+    pub dt: f64,
+    /// Configured duration (s).
+    pub duration: f64,
+    /// Steps the run was to solve.
+    pub steps_planned: usize,
+    /// Every `stride`-th step is in `trajectory.csv`.
+    pub stride: usize,
+    /// Rows of `trajectory.csv`.
+    pub rows_written: usize,
+    /// Contact points of the model, e.g. `["tip3", "tip4"]`.
+    pub contact_points: Vec<String>,
+    /// First ST1 → contact change of each leg's tip (s), e.g. `"leg4"`.
+    pub first_touchdown: std::collections::BTreeMap<String, Option<f64>>,
+    /// First change of each leg's tip into ST3 (s).
+    pub first_slip: std::collections::BTreeMap<String, Option<f64>>,
+    /// Largest contact forces of each contact point.
+    pub peak_contact_force: std::collections::BTreeMap<String, PeakForce>,
+    /// Largest joint force magnitude of each joint (N).
+    pub peak_joint_force: std::collections::BTreeMap<String, f64>,
+    /// Largest joint force magnitude of all joints (N).
+    pub peak_joint_force_max: f64,
+    /// Energy at the last solved step (null if none).
+    pub final_energy: Option<Energy>,
+}

@@ -1,0 +1,324 @@
+//! Behavioural tests of `NewtonSolver`: convergence, pattern caching, and
+//! each error variant.
+
+mod common;
+
+use common::{Cubic, Small, TrigChain};
+use fbd_kinematics::fd::{FdTolerance, check_jacobian};
+use fbd_solver::{NewtonParams, NewtonSolver, NewtonSystem, SolverError};
+
+fn root10() -> Vec<f64> {
+    (0..10)
+        .map(|i| 0.8 * ((i as f64) * 0.7 + 0.3).sin())
+        .collect()
+}
+
+#[test]
+fn trig_chain_jacobian_matches_finite_differences() {
+    let mut sys = TrigChain::with_root(&root10(), 1);
+    let x: Vec<f64> = (0..10).map(|i| 0.3 * (i as f64) - 1.1).collect();
+    let mut r = vec![0.0; 10];
+    let dense = NewtonSolver::dense_jacobian(&mut sys, &x, &mut r);
+    let b = sys.b.clone();
+    check_jacobian(
+        &x,
+        10,
+        |x, out| {
+            TrigChain::f(x, out);
+            for (o, bi) in out.iter_mut().zip(&b) {
+                *o -= bi;
+            }
+        },
+        |i, j| dense[i * 10 + j],
+        FdTolerance::default(),
+    )
+    .unwrap_or_else(|m| panic!("{m}"));
+}
+
+#[test]
+fn trig_chain_converges_quadratically() {
+    let root = root10();
+    let mut sys = TrigChain::with_root(&root, 1);
+    let mut x = vec![0.0; 10];
+    let mut solver = NewtonSolver::default();
+    let report = solver.solve(&mut sys, &mut x).expect("converges");
+
+    assert!(report.residual <= 1e-9, "{report:?}");
+    assert!(report.iterations <= 6, "too many iterations: {report:?}");
+    assert_eq!(report.factorizations, report.iterations);
+    for (xi, ri) in x.iter().zip(&root) {
+        assert!((xi - ri).abs() < 1e-9, "x = {x:?}, root = {root:?}");
+    }
+
+    // Quadratic convergence: once in the asymptotic regime, the residual
+    // max-norm at iterate k+1 is bounded by C·(residual at k)².
+    let h = sys.history.as_slice();
+    assert_eq!(
+        h.len(),
+        report.iterations + 1,
+        "one Jacobian per iterate: {h:?}"
+    );
+    let tail: Vec<_> = h.windows(2).filter(|w| w[0] < 1e-2 && w[1] > 0.0).collect();
+    assert!(!tail.is_empty(), "history {h:?}");
+    for w in tail {
+        assert!(w[1] <= 10.0 * w[0] * w[0], "not quadratic: {h:?}");
+    }
+
+    // Solving again from the root takes no step at all.
+    let report = solver.solve(&mut sys, &mut x).expect("converged");
+    assert_eq!(report.iterations, 0);
+    assert_eq!(report.factorizations, 0);
+}
+
+#[test]
+fn two_pattern_keys_give_exactly_two_symbolic_factorizations() {
+    let root = root10();
+    let mut chain = TrigChain::with_root(&root, 0xC4A1);
+    let mut cubic = Cubic {
+        c: vec![1.0, -2.0, 0.5, 3.0, 0.0, -1.0, 2.0],
+        key: 0xC0B1C,
+    };
+    let mut solver = NewtonSolver::default();
+    let mut total_iterations = 0u64;
+    for k in 0..25 {
+        let shifted: Vec<f64> = root.iter().map(|r| r + 0.01 * k as f64).collect();
+        chain.retarget(&shifted);
+        let mut x = vec![0.0; 10];
+        let rep = solver.solve(&mut chain, &mut x).expect("chain converges");
+        total_iterations += rep.factorizations as u64;
+
+        cubic.c[0] = 1.0 + 0.1 * k as f64;
+        let mut y = vec![0.0; 7];
+        let rep = solver.solve(&mut cubic, &mut y).expect("cubic converges");
+        total_iterations += rep.factorizations as u64;
+        let mut r = vec![0.0; 7];
+        cubic.eval(&y, &mut r, None);
+        assert!(r.iter().all(|v| v.abs() <= 1e-9), "{r:?}");
+    }
+    assert_eq!(solver.symbolic_factorizations(), 2);
+    assert_eq!(solver.cached_patterns(), 2);
+    assert_eq!(solver.numeric_factorizations(), total_iterations);
+}
+
+#[test]
+fn structurally_singular_system_is_reported() {
+    // Unknown 2 appears in no equation: column 2 of J is structurally empty.
+    let mut sys = Small {
+        n: 3,
+        key: 7,
+        entries: vec![(0, 0), (0, 1), (1, 0), (1, 1), (2, 0)],
+        f: |x: &[f64], r: &mut [f64], j: &mut dyn FnMut(usize, usize, f64)| {
+            r[0] = x[0] + x[1] - 1.0;
+            r[1] = x[0] - x[1];
+            r[2] = x[0] * x[0] - 4.0;
+            j(0, 0, 1.0);
+            j(0, 1, 1.0);
+            j(1, 0, 1.0);
+            j(1, 1, -1.0);
+            j(2, 0, 2.0 * x[0]);
+        },
+    };
+    let mut x = vec![1.0; 3];
+    let err = NewtonSolver::default().solve(&mut sys, &mut x).unwrap_err();
+    assert_eq!(err, SolverError::Singular { equation: 2 }, "{err}");
+}
+
+#[test]
+fn numerically_singular_jacobian_is_reported() {
+    // Structurally fine, but the two rows are parallel: a zero pivot.
+    let mut sys = Small {
+        n: 2,
+        key: 8,
+        entries: vec![(0, 0), (0, 1), (1, 0), (1, 1)],
+        f: |x: &[f64], r: &mut [f64], j: &mut dyn FnMut(usize, usize, f64)| {
+            r[0] = x[0] + x[1] - 1.0;
+            r[1] = 2.0 * x[0] + 2.0 * x[1] - 3.0;
+            j(0, 0, 1.0);
+            j(0, 1, 1.0);
+            j(1, 0, 2.0);
+            j(1, 1, 2.0);
+        },
+    };
+    let mut x = vec![0.0; 2];
+    let err = NewtonSolver::default().solve(&mut sys, &mut x).unwrap_err();
+    assert!(
+        matches!(err, SolverError::Singular { equation } if equation < 2),
+        "{err}"
+    );
+}
+
+#[test]
+fn system_without_real_root_diverges() {
+    // Row 1 is x1² + 1 = 0: no real root. Row 0 is fine.
+    let mut sys = Small {
+        n: 2,
+        key: 9,
+        entries: vec![(0, 0), (1, 1)],
+        f: |x: &[f64], r: &mut [f64], j: &mut dyn FnMut(usize, usize, f64)| {
+            r[0] = x[0] - 1.0;
+            r[1] = x[1] * x[1] + 1.0;
+            j(0, 0, 1.0);
+            j(1, 1, 2.0 * x[1]);
+        },
+    };
+    let mut x = vec![0.0, 0.5];
+    let err = NewtonSolver::default().solve(&mut sys, &mut x).unwrap_err();
+    let SolverError::Diverged { iter, residual } = err else {
+        panic!("expected Diverged, got {err:?}");
+    };
+    assert!(residual >= 1.0, "{err}");
+    assert!(iter <= 20);
+    let msg = err.to_string();
+    assert!(msg.contains(&format!("iteration {iter}")), "{msg}");
+    assert!(!msg.contains('\n'));
+    // x holds the last accepted iterate, whose residual is the reported one.
+    assert!(((x[1] * x[1] + 1.0) - residual).abs() <= 1e-12);
+
+    // With no line search budget and few iterations the same system hits
+    // the iteration limit or the line-search failure at once.
+    let mut solver = NewtonSolver::new(NewtonParams {
+        max_iterations: 3,
+        ..NewtonParams::default()
+    });
+    let mut x = vec![0.0, 0.5];
+    assert!(matches!(
+        solver.solve(&mut sys, &mut x),
+        Err(SolverError::Diverged { iter, .. }) if iter <= 3
+    ));
+}
+
+#[test]
+fn iteration_limit_reports_diverged_at_max_iterations() {
+    // Converges, but needs more than one step.
+    let mut sys = TrigChain::with_root(&root10(), 1);
+    let mut solver = NewtonSolver::new(NewtonParams {
+        max_iterations: 1,
+        ..NewtonParams::default()
+    });
+    let mut x = vec![0.0; 10];
+    let err = solver.solve(&mut sys, &mut x).unwrap_err();
+    assert!(
+        matches!(err, SolverError::Diverged { iter: 1, .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("iteration 1 "), "{err}");
+}
+
+#[test]
+fn nan_residual_is_non_finite() {
+    let mut sys = Small {
+        n: 1,
+        key: 10,
+        entries: vec![(0, 0)],
+        f: |x: &[f64], r: &mut [f64], j: &mut dyn FnMut(usize, usize, f64)| {
+            r[0] = x[0].sqrt() - 2.0;
+            j(0, 0, 0.5 / x[0].sqrt());
+        },
+    };
+    let mut x = vec![-1.0];
+    let err = NewtonSolver::default().solve(&mut sys, &mut x).unwrap_err();
+    assert_eq!(err, SolverError::NonFinite { iter: 0 });
+    assert!(!err.to_string().contains('\n'));
+}
+
+#[test]
+fn nan_in_every_trial_point_is_non_finite() {
+    // r = sqrt(x) + 1 is finite for x ≥ 0 only. From x = 1e-6 the Newton
+    // step is −0.002, and even after 8 halvings x + α·Δx < 0 (NaN).
+    let mut sys = Small {
+        n: 1,
+        key: 12,
+        entries: vec![(0, 0)],
+        f: |x: &[f64], r: &mut [f64], j: &mut dyn FnMut(usize, usize, f64)| {
+            r[0] = (x[0]).sqrt() + 1.0;
+            j(0, 0, 0.5 / x[0].sqrt());
+        },
+    };
+    let mut x = vec![1e-6];
+    let err = NewtonSolver::default().solve(&mut sys, &mut x).unwrap_err();
+    assert_eq!(err, SolverError::NonFinite { iter: 0 }, "{err}");
+}
+
+#[test]
+fn line_search_recovers_from_nan_full_step() {
+    // r = ln x: from x = 3 the full Newton step lands at x < 0 (NaN); one
+    // halving lands inside the domain and the solve converges.
+    let mut sys = Small {
+        n: 1,
+        key: 11,
+        entries: vec![(0, 0)],
+        f: |x: &[f64], r: &mut [f64], j: &mut dyn FnMut(usize, usize, f64)| {
+            r[0] = x[0].ln();
+            j(0, 0, 1.0 / x[0]);
+        },
+    };
+    let mut x = vec![3.0];
+    let rep = NewtonSolver::default()
+        .solve(&mut sys, &mut x)
+        .expect("converges");
+    assert!((x[0] - 1.0).abs() < 1e-9, "{x:?} {rep:?}");
+}
+
+#[test]
+fn residual_scale_is_honoured() {
+    // Row 0 is in units 1e6 times larger than row 1; with a scale of 1e6 the
+    // tolerance applies to both rows consistently.
+    struct Scaled;
+    impl NewtonSystem for Scaled {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn pattern_key(&self) -> u64 {
+            13
+        }
+        fn pattern(&self, e: &mut Vec<(usize, usize)>) {
+            e.extend([(0, 0), (0, 1), (1, 1)]);
+        }
+        fn eval(
+            &mut self,
+            x: &[f64],
+            r: &mut [f64],
+            jac: Option<&mut fbd_solver::JacobianSink<'_>>,
+        ) {
+            r[0] = 1e6 * (x[0] * x[0] - 2.0 + 0.0 * x[1]);
+            r[1] = x[1].exp() - 2.0;
+            if let Some(j) = jac {
+                j.add(0, 0, 2e6 * x[0]);
+                j.add(0, 1, 0.0);
+                j.add(1, 1, x[1].exp());
+            }
+        }
+        fn residual_scale(&self, row: usize) -> f64 {
+            if row == 0 { 1e6 } else { 1.0 }
+        }
+    }
+    let mut x = vec![1.0, 0.0];
+    let rep = NewtonSolver::default()
+        .solve(&mut Scaled, &mut x)
+        .expect("converges");
+    assert!(rep.residual <= 1e-9);
+    assert!((x[0] - 2f64.sqrt()).abs() < 1e-9 && (x[1] - 2f64.ln()).abs() < 1e-9);
+}
+
+#[test]
+fn error_messages_are_one_line() {
+    for e in [
+        SolverError::Singular { equation: 3 },
+        SolverError::Diverged {
+            iter: 20,
+            residual: 0.5,
+        },
+        SolverError::NonFinite { iter: 4 },
+    ] {
+        let m = e.to_string();
+        assert!(!m.is_empty() && !m.contains('\n'), "{m}");
+    }
+    assert!(
+        SolverError::Diverged {
+            iter: 20,
+            residual: 0.5
+        }
+        .to_string()
+        .contains("iteration 20")
+    );
+}

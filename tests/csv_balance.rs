@@ -1,0 +1,131 @@
+//! Every body's Newton–Euler equations balance with the forces written to
+//! `trajectory.csv`: the file is produced by `fbd run`, read back, and the
+//! translational and rotational balance of each body is recomputed from its
+//! columns alone (configurations → accelerations by central differences;
+//! joint forces, contact forces, torques and gravity → applied forces).
+
+mod common;
+
+use common::physics::worst_body_imbalance;
+use fbd_contact::StateCode;
+use fbd_sim::record::{MAX_CONTACTS, MAX_JOINTS};
+use fbd_sim::{Model, PlanarParams, StepRecord};
+use std::path::Path;
+
+fn run_cli(config: Option<&str>, dir: &Path) {
+    let mut args = vec!["fbd".to_string(), "run".to_string()];
+    if let Some(text) = config {
+        let path = dir.join("input.toml");
+        std::fs::write(&path, text).unwrap();
+        args.push(path.display().to_string());
+    }
+    args.extend(["--out".to_string(), dir.join("out").display().to_string()]);
+    let code = fbd_cli::main_with_args(args);
+    assert_eq!(format!("{code:?}"), format!("{:?}", std::process::ExitCode::SUCCESS));
+}
+
+/// Reads `trajectory.csv` into records, using only the SPEC columns and the
+/// torque columns.
+fn read_rows(path: &Path) -> Vec<StepRecord> {
+    let mut rd = csv::Reader::from_path(path).unwrap();
+    let head = rd.headers().unwrap().clone();
+    let col = |name: &str| head.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let f = |rec: &csv::StringRecord, name: &str| -> f64 { rec[col(name)].parse().unwrap() };
+    let state = |s: &str| match s {
+        "ST1" => StateCode::St1,
+        "ST2" => StateCode::St2,
+        "ST3" => StateCode::St3,
+        other => panic!("bad state {other}"),
+    };
+    let q_cols = ["rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4"];
+    let joints = ["hip3", "knee3", "hip4", "knee4"];
+    rd.records()
+        .enumerate()
+        .map(|(k, rec)| {
+            let rec = rec.unwrap();
+            let mut r = StepRecord {
+                step: k,
+                t: f(&rec, "t"),
+                q: [0.0; 7],
+                contacts: 2,
+                point: [[0.0; 2]; MAX_CONTACTS],
+                state: [StateCode::St1; MAX_CONTACTS],
+                fa: [0.0; MAX_CONTACTS],
+                n: [0.0; MAX_CONTACTS],
+                joint_force: [[0.0; 2]; MAX_JOINTS],
+                torque: [0.0; MAX_JOINTS],
+                kinetic: 0.0,
+                potential: 0.0,
+                newton_iterations: 0,
+                state_trials: 0,
+            };
+            for (i, c) in q_cols.iter().enumerate() {
+                r.q[i] = f(&rec, c);
+            }
+            for (c, leg) in [3, 4].iter().enumerate() {
+                r.point[c] = [f(&rec, &format!("tip{leg}_x")), f(&rec, &format!("tip{leg}_y"))];
+                r.state[c] = state(&rec[col(&format!("state{leg}"))]);
+                r.fa[c] = f(&rec, &format!("fa{leg}"));
+                r.n[c] = f(&rec, &format!("n{leg}"));
+            }
+            for (j, name) in joints.iter().enumerate() {
+                r.joint_force[j] = [f(&rec, &format!("{name}_fx")), f(&rec, &format!("{name}_fy"))];
+                r.torque[j] = f(&rec, &format!("tau_{name}"));
+            }
+            r
+        })
+        .collect()
+}
+
+#[test]
+fn default_run_balances_from_the_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    run_cli(None, dir.path());
+    let rows = read_rows(&dir.path().join("out/trajectory.csv"));
+    assert_eq!(rows.len(), 46);
+    let model = Model::planar(&PlanarParams::default()).unwrap();
+    let (worst, at) = worst_body_imbalance(&model, &rows);
+    assert!(worst < 1e-6, "{at}");
+    // The check has teeth: a 1 N error in one written force is caught.
+    let mut broken = rows.clone();
+    broken[25].joint_force[1][0] += 1.0;
+    assert!(worst_body_imbalance(&model, &broken).0 > 0.5);
+}
+
+#[test]
+fn tumbling_flight_balances_from_the_csv() {
+    let config = r#"
+model = "planar"
+[time]
+dt = 0.005
+duration = 0.5
+[terrain]
+kind = "none"
+[initial]
+position = [0.0, 0.6]
+velocity = [0.7, 1.5]
+phi_z_deg = 10.0
+omega_z_deg = 120.0
+[initial.leg3]
+theta_deg = [10.0, 245.0]
+rate_deg = [-170.0, 230.0]
+[initial.leg4]
+theta_deg = [-5.0, 255.0]
+rate_deg = [140.0, -60.0]
+"#;
+    let dir = tempfile::tempdir().unwrap();
+    run_cli(Some(config), dir.path());
+    let rows = read_rows(&dir.path().join("out/trajectory.csv"));
+    let mut p = PlanarParams {
+        dt: 0.005,
+        terrain: fbd_contact::Terrain::None,
+        ..PlanarParams::default()
+    };
+    p.q0 = rows[0].q;
+    let model = Model::planar(&p).unwrap();
+    // Joint forces are far from zero in a tumbling flight.
+    let peak = rows.iter().flat_map(|r| r.joint_force).map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+    assert!(peak > 1.0, "peak joint force {peak} N");
+    let (worst, at) = worst_body_imbalance(&model, &rows);
+    assert!(worst < 1e-6, "{at}");
+}

@@ -21,7 +21,10 @@ fn run_cli(config: Option<&str>, dir: &Path) {
     }
     args.extend(["--out".to_string(), dir.join("out").display().to_string()]);
     let code = fbd_cli::main_with_args(args);
-    assert_eq!(format!("{code:?}"), format!("{:?}", std::process::ExitCode::SUCCESS));
+    assert_eq!(
+        format!("{code:?}"),
+        format!("{:?}", std::process::ExitCode::SUCCESS)
+    );
 }
 
 /// Reads `trajectory.csv` into records, using only the SPEC columns and the
@@ -29,7 +32,11 @@ fn run_cli(config: Option<&str>, dir: &Path) {
 fn read_rows(path: &Path) -> Vec<StepRecord> {
     let mut rd = csv::Reader::from_path(path).unwrap();
     let head = rd.headers().unwrap().clone();
-    let col = |name: &str| head.iter().position(|h| h == name).unwrap_or_else(|| panic!("no column {name}"));
+    let col = |name: &str| {
+        head.iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name}"))
+    };
     let f = |rec: &csv::StringRecord, name: &str| -> f64 { rec[col(name)].parse().unwrap() };
     let state = |s: &str| match s {
         "ST1" => StateCode::St1,
@@ -37,7 +44,9 @@ fn read_rows(path: &Path) -> Vec<StepRecord> {
         "ST3" => StateCode::St3,
         other => panic!("bad state {other}"),
     };
-    let q_cols = ["rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4"];
+    let q_cols = [
+        "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4",
+    ];
     let joints = ["hip3", "knee3", "hip4", "knee4"];
     rd.records()
         .enumerate()
@@ -63,13 +72,19 @@ fn read_rows(path: &Path) -> Vec<StepRecord> {
                 r.q[i] = f(&rec, c);
             }
             for (c, leg) in [3, 4].iter().enumerate() {
-                r.point[c] = [f(&rec, &format!("tip{leg}_x")), f(&rec, &format!("tip{leg}_y"))];
+                r.point[c] = [
+                    f(&rec, &format!("tip{leg}_x")),
+                    f(&rec, &format!("tip{leg}_y")),
+                ];
                 r.state[c] = state(&rec[col(&format!("state{leg}"))]);
                 r.fa[c] = f(&rec, &format!("fa{leg}"));
                 r.n[c] = f(&rec, &format!("n{leg}"));
             }
             for (j, name) in joints.iter().enumerate() {
-                r.joint_force[j] = [f(&rec, &format!("{name}_fx")), f(&rec, &format!("{name}_fy"))];
+                r.joint_force[j] = [
+                    f(&rec, &format!("{name}_fx")),
+                    f(&rec, &format!("{name}_fy")),
+                ];
                 r.torque[j] = f(&rec, &format!("tau_{name}"));
             }
             r
@@ -124,7 +139,11 @@ rate_deg = [140.0, -60.0]
     p.q0 = rows[0].q;
     let model = Model::planar(&p).unwrap();
     // Joint forces are far from zero in a tumbling flight.
-    let peak = rows.iter().flat_map(|r| r.joint_force).map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+    let peak = rows
+        .iter()
+        .flat_map(|r| r.joint_force)
+        .map(|f| f[0].hypot(f[1]))
+        .fold(0.0, f64::max);
     assert!(peak > 1.0, "peak joint force {peak} N");
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");

@@ -16,18 +16,38 @@ fn check_rows(p: &PlanarParams) -> (usize, usize) {
             let (fa, n, name) = (r.fa[c], r.n[c], &model.mech.contacts[c].name);
             let tol = 1e-6 * (1.0 + n.abs());
             let depth = -model.params.terrain.clearance(r.point[c]);
-            assert!(depth < 1e-9, "t = {}: {name} is {depth} m below the terrain", r.t);
+            assert!(
+                depth < 1e-9,
+                "t = {}: {name} is {depth} m below the terrain",
+                r.t
+            );
             match r.state[c] {
-                StateCode::St1 => assert!(fa == 0.0 && n == 0.0, "t = {}: {name} in ST1 with fa = {fa}, n = {n}", r.t),
+                StateCode::St1 => assert!(
+                    fa == 0.0 && n == 0.0,
+                    "t = {}: {name} in ST1 with fa = {fa}, n = {n}",
+                    r.t
+                ),
                 StateCode::St2 => {
                     stick += 1;
                     assert!(n >= -1e-6, "t = {}: {name} sticking with n = {n}", r.t);
-                    assert!(fa.abs() <= mus * n + tol, "t = {}: {name} sticking with |fa| = {} > μS·n = {}", r.t, fa.abs(), mus * n);
+                    assert!(
+                        fa.abs() <= mus * n + tol,
+                        "t = {}: {name} sticking with |fa| = {} > μS·n = {}",
+                        r.t,
+                        fa.abs(),
+                        mus * n
+                    );
                 }
                 StateCode::St3 => {
                     slide += 1;
                     assert!(n >= -1e-6, "t = {}: {name} sliding with n = {n}", r.t);
-                    assert!((fa.abs() - mud * n).abs() <= tol, "t = {}: {name} sliding with |fa| = {} ≠ μD·n = {}", r.t, fa.abs(), mud * n);
+                    assert!(
+                        (fa.abs() - mud * n).abs() <= tol,
+                        "t = {}: {name} sliding with |fa| = {} ≠ μD·n = {}",
+                        r.t,
+                        fa.abs(),
+                        mud * n
+                    );
                 }
             }
         }
@@ -38,7 +58,10 @@ fn check_rows(p: &PlanarParams) -> (usize, usize) {
 #[test]
 fn default_run_obeys_coulomb_on_every_row() {
     let (stick, slide) = check_rows(&PlanarParams::default());
-    assert!(stick > 0 && slide > 0, "the run must exercise both laws ({stick} sticking rows, {slide} sliding rows)");
+    assert!(
+        stick > 0 && slide > 0,
+        "the run must exercise both laws ({stick} sticking rows, {slide} sliding rows)"
+    );
 }
 
 #[test]

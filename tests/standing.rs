@@ -16,19 +16,46 @@ fn high_friction_stance_sticks_and_supports_the_robot() {
     p.friction.mu_dynamic = 40.0;
     p.duration = 0.15;
     let (model, rows, summary) = run_ok(&p);
-    assert!(summary.events.is_empty(), "unexpected events {:?}", summary.events);
+    assert!(
+        summary.events.is_empty(),
+        "unexpected events {:?}",
+        summary.events
+    );
     let m = model.mech.total_mass();
     let dt = p.dt;
     for w in rows.windows(3) {
         let r = &w[1];
-        assert_eq!(&r.state[..2], &[StateCode::St2, StateCode::St2], "t = {}", r.t);
-        assert!(r.n[0] > 0.0 && r.n[1] > 0.0, "t = {}: n = {:?}", r.t, &r.n[..2]);
+        assert_eq!(
+            &r.state[..2],
+            &[StateCode::St2, StateCode::St2],
+            "t = {}",
+            r.t
+        );
+        assert!(
+            r.n[0] > 0.0 && r.n[1] > 0.0,
+            "t = {}: n = {:?}",
+            r.t,
+            &r.n[..2]
+        );
         let c: Vec<[f64; 2]> = w.iter().map(|x| system_com(&model, &x.q)).collect();
-        let a = [(c[2][0] - 2.0 * c[1][0] + c[0][0]) / (dt * dt), (c[2][1] - 2.0 * c[1][1] + c[0][1]) / (dt * dt)];
+        let a = [
+            (c[2][0] - 2.0 * c[1][0] + c[0][0]) / (dt * dt),
+            (c[2][1] - 2.0 * c[1][1] + c[0][1]) / (dt * dt),
+        ];
         let fy = r.n[0] + r.n[1];
         let fx = r.fa[0] + r.fa[1];
-        assert!((fy - m * (9.81 + a[1])).abs() < 1e-6 * m, "t = {}: Σn = {fy}, M(g + a) = {}", r.t, m * (9.81 + a[1]));
-        assert!((fx - m * a[0]).abs() < 1e-6 * m, "t = {}: Σfa = {fx}, M a_x = {}", r.t, m * a[0]);
+        assert!(
+            (fy - m * (9.81 + a[1])).abs() < 1e-6 * m,
+            "t = {}: Σn = {fy}, M(g + a) = {}",
+            r.t,
+            m * (9.81 + a[1])
+        );
+        assert!(
+            (fx - m * a[0]).abs() < 1e-6 * m,
+            "t = {}: Σfa = {fx}, M a_x = {}",
+            r.t,
+            m * a[0]
+        );
     }
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");

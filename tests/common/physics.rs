@@ -72,8 +72,21 @@ pub fn run_ok(p: &PlanarParams) -> (Model, Vec<StepRecord>, fbd_sim::RunSummary)
 /// `q[k]` of the paper's pose with `Ry` chosen so that both tips touch flat
 /// ground at `y = 0` (θ3₃ = θ3₄ = `theta3_deg`, θ2 = 0).
 pub fn standing_q(p: &PlanarParams, theta3_deg: f64) -> [f64; 7] {
-    let mut q = [0.0, 1.0, 0.0, 0.0, theta3_deg.to_radians(), 0.0, theta3_deg.to_radians()];
-    let model = Model::planar(&PlanarParams { q0: q, terrain: fbd_contact::Terrain::None, ..p.clone() }).unwrap();
+    let mut q = [
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        theta3_deg.to_radians(),
+        0.0,
+        theta3_deg.to_radians(),
+    ];
+    let model = Model::planar(&PlanarParams {
+        q0: q,
+        terrain: fbd_contact::Terrain::None,
+        ..p.clone()
+    })
+    .unwrap();
     let pts = points(&model, &q);
     q[1] -= pts[model.index.tip[0]][1];
     q
@@ -92,10 +105,18 @@ pub fn worst_body_imbalance(model: &Model, rows: &[StepRecord]) -> (f64, String)
     for w in rows.windows(3) {
         let (prev, cur, next) = (&w[0], &w[1], &w[2]);
         assert_eq!(cur.step, prev.step + 1, "force balance needs stride 1");
-        let (xp, xk, xn) = (body_coords(model, &prev.q), body_coords(model, &cur.q), body_coords(model, &next.q));
+        let (xp, xk, xn) = (
+            body_coords(model, &prev.q),
+            body_coords(model, &cur.q),
+            body_coords(model, &next.q),
+        );
         let pts = points(model, &cur.q);
         // Applied forces and moments about each centre of mass at k.
-        let mut acc: Vec<[f64; 3]> = mech.bodies.iter().map(|b| [0.0, -b.mass * mech.gravity, 0.0]).collect();
+        let mut acc: Vec<[f64; 3]> = mech
+            .bodies
+            .iter()
+            .map(|b| [0.0, -b.mass * mech.gravity, 0.0])
+            .collect();
         let mut apply = |b: usize, p: [f64; 2], f: [f64; 2], tz: f64| {
             let r = [p[0] - xk[b][0], p[1] - xk[b][1]];
             acc[b][0] += f[0];
@@ -112,12 +133,21 @@ pub fn worst_body_imbalance(model: &Model, rows: &[StepRecord]) -> (f64, String)
             let x = pts[spec.point][0];
             let (t, n) = model.params.terrain.frame(x);
             let _ = (t, n);
-            let (t, n) = if let fbd_contact::Terrain::None = model.params.terrain { ([1.0, 0.0], [0.0, 1.0]) } else { (t, n) };
-            let f = [cur.fa[c] * t[0] + cur.n[c] * n[0], cur.fa[c] * t[1] + cur.n[c] * n[1]];
+            let (t, n) = if let fbd_contact::Terrain::None = model.params.terrain {
+                ([1.0, 0.0], [0.0, 1.0])
+            } else {
+                (t, n)
+            };
+            let f = [
+                cur.fa[c] * t[0] + cur.n[c] * n[0],
+                cur.fa[c] * t[1] + cur.n[c] * n[1],
+            ];
             apply(spec.body, pts[spec.point], f, 0.0);
         }
         for (b, spec) in mech.bodies.iter().enumerate() {
-            let a: Vec<f64> = (0..3).map(|i| (xn[b][i] - 2.0 * xk[b][i] + xp[b][i]) / (dt * dt)).collect();
+            let a: Vec<f64> = (0..3)
+                .map(|i| (xn[b][i] - 2.0 * xk[b][i] + xp[b][i]) / (dt * dt))
+                .collect();
             let e = [
                 spec.mass * a[0] - acc[b][0],
                 spec.mass * a[1] - acc[b][1],
@@ -125,7 +155,15 @@ pub fn worst_body_imbalance(model: &Model, rows: &[StepRecord]) -> (f64, String)
             ];
             for (i, v) in e.iter().enumerate() {
                 if v.abs() > worst.0 {
-                    worst = (v.abs(), format!("t = {}, body {}, equation {}: imbalance {v:e}", cur.t, spec.name, ["x", "y", "rotation"][i]));
+                    worst = (
+                        v.abs(),
+                        format!(
+                            "t = {}, body {}, equation {}: imbalance {v:e}",
+                            cur.t,
+                            spec.name,
+                            ["x", "y", "rotation"][i]
+                        ),
+                    );
                 }
             }
         }

@@ -36,6 +36,10 @@ pub enum Command {
     /// Print the inertial hip, knee and tip of every leg at the
     /// configuration's initial state, as JSON.
     Kinematics(KinematicsArgs),
+    /// Run many variations of a configuration in parallel (see
+    /// docs/sweep.md): DIR/runs/<i>/, DIR/index.csv, DIR/sweep.svg;
+    /// `fbd sweep merge` joins shard directories.
+    Sweep(crate::sweep::SweepArgs),
 }
 
 /// Arguments of `fbd run`.
@@ -63,5 +67,6 @@ pub fn dispatch(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     match cli.command {
         Command::Run(a) => crate::run::run_command(a.config.as_deref(), &a.out, out),
         Command::Kinematics(a) => crate::kinematics::kinematics_command(&a.config, out),
+        Command::Sweep(a) => crate::sweep::sweep_command(a, out),
     }
 }

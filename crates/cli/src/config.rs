@@ -24,6 +24,9 @@ use fbd_dynamics::ContactPoints;
 use fbd_sim::{Model, PlanarParams, SimError};
 use serde::{Deserialize, Serialize};
 
+mod actuation;
+pub use actuation::{ControlConfig, ControlKind, ControlLegConfig, TargetDeg};
+
 /// Fixed-length arrays of numbers: serde's `[f64; N]` would silently
 /// ignore extra elements of a TOML array, so the length is checked here.
 mod fixed {
@@ -260,6 +263,15 @@ pub enum TerrainKind {
     Flat,
     /// No ground: every contact point stays in ST1.
     None,
+    /// Inclined plane `y = height + tan(angle_deg)·x`.
+    Slope,
+    /// Piecewise-linear `points` (or a CSV `file`), flat beyond the ends.
+    Profile,
+    /// `y = height + amplitude·sin(360°·x/wavelength + phase_deg)`.
+    Sine,
+    /// Staircase `y = height + step_height·floor(x/step_width)` (risers
+    /// smoothed over `fbd_contact::STEP_RAMP`).
+    Steps,
 }
 
 /// `[terrain]`.
@@ -268,8 +280,34 @@ pub enum TerrainKind {
 pub struct TerrainConfig {
     /// Ground kind.
     pub kind: TerrainKind,
-    /// Ground height for `kind = "flat"` (m).
+    /// Ground height for `kind = "flat"`, and the reference height of
+    /// `slope` (at x = 0), `sine` (mean) and `steps` (step at x = 0) (m).
     pub height: f64,
+    /// Slope inclination (degrees, positive rising towards +X).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<f64>,
+    /// Profile vertices `[[x, y], ...]` (m), x strictly increasing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<Vec<f64>>>,
+    /// Profile CSV file (`x,y` lines), relative to the configuration file;
+    /// replaced by `points` once loaded.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file: Option<String>,
+    /// Sine amplitude (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub amplitude: Option<f64>,
+    /// Sine wavelength (m), > 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wavelength: Option<f64>,
+    /// Sine phase (degrees), default 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub phase_deg: Option<f64>,
+    /// Step rise (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step_height: Option<f64>,
+    /// Step run (m), > 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step_width: Option<f64>,
     /// Static friction coefficient μS.
     pub mu_static: f64,
     /// Dynamic friction coefficient μD (`0 ≤ μD ≤ μS`).
@@ -286,6 +324,14 @@ impl Default for TerrainConfig {
         Self {
             kind,
             height,
+            angle_deg: None,
+            points: None,
+            file: None,
+            amplitude: None,
+            wavelength: None,
+            phase_deg: None,
+            step_height: None,
+            step_width: None,
             mu_static: p.friction.mu_static,
             mu_dynamic: p.friction.mu_dynamic,
         }
@@ -295,12 +341,7 @@ impl Default for TerrainConfig {
 impl TerrainConfig {
     /// The terrain of the simulator.
     pub fn terrain(&self) -> Terrain {
-        match self.kind {
-            TerrainKind::Flat => Terrain::Flat {
-                height: self.height,
-            },
-            TerrainKind::None => Terrain::None,
-        }
+        self.terrain_kind()
     }
 
     /// The friction coefficients of the simulator.
@@ -542,6 +583,9 @@ pub struct ConfigFile<I> {
     /// `[output]`.
     #[serde(default)]
     pub output: OutputConfig,
+    /// `[control]` (planar model).
+    #[serde(default)]
+    pub control: ControlConfig,
 }
 
 /// A planar configuration.
@@ -562,6 +606,7 @@ impl Default for PlanarConfig {
             terrain: TerrainConfig::default(),
             contact: ContactConfig::default(),
             output: OutputConfig::default(),
+            control: ControlConfig::default(),
         };
         c.resolve_common();
         c.resolve_initial();
@@ -577,6 +622,7 @@ impl<I> ConfigFile<I> {
         points.sort();
         points.dedup();
         self.contact.points = points;
+        self.terrain.resolve_kind();
     }
 
     /// Checks the keys every model shares; errors name `table.key`.
@@ -626,7 +672,9 @@ impl<I> ConfigFile<I> {
                 return err(key, "must lie on the link", &v, "a fraction in [0, 1]");
             }
         }
-        if self.terrain.kind == TerrainKind::Flat && !self.terrain.height.is_finite() {
+        // Checked for every kind: `nan`/`inf` are rejected everywhere, even
+        // where the value is unused (it is written back to config.toml).
+        if !self.terrain.height.is_finite() {
             return err(
                 "terrain.height",
                 "must be finite",
@@ -634,6 +682,7 @@ impl<I> ConfigFile<I> {
                 "a finite value",
             );
         }
+        self.terrain.validate_kind(file)?;
         let (ms, md) = (self.terrain.mu_static, self.terrain.mu_dynamic);
         if !(ms.is_finite() && ms >= 0.0) {
             return err(
@@ -719,6 +768,8 @@ impl PlanarConfig {
             l.theta_deg = Some(theta);
             l.rate_deg = Some(rate);
         }
+        let initial = [self.initial.theta_deg(0), self.initial.theta_deg(1)];
+        self.control.resolve(initial);
     }
 
     /// Checks every key, in the file's units (degrees for `*_deg` keys).
@@ -739,6 +790,7 @@ impl PlanarConfig {
             )?;
             check_finite(file, &format!("initial.{name}.rate_deg"), &i.rate_deg(leg))?;
         }
+        self.control.control(file)?;
         Ok(())
     }
 
@@ -784,6 +836,7 @@ impl PlanarConfig {
             friction: self.terrain.friction(),
             contact_points: self.contact.contact_points(),
             stride: self.output.stride,
+            control: self.control.control("").unwrap_or_default(),
         }
     }
 
@@ -1006,11 +1059,24 @@ fn describe(err: &toml::de::Error) -> String {
 
 fn syntax_error(file: &str, text: &str, err: &toml::de::Error) -> ConfigError {
     let (line, col) = err.span().map_or((1, 1), |s| line_col(text, s.start));
+    let mut message = describe(err);
+    // toml names no key for some errors (e.g. "duplicate key"): quote the
+    // offending text when it is a short single-line snippet.
+    if !message.contains('`')
+        && !message.contains(": ")
+        && let Some(snippet) = err
+            .span()
+            .and_then(|s| text.get(s))
+            .map(str::trim)
+            .filter(|s| !s.is_empty() && s.len() <= 60 && !s.contains('\n'))
+    {
+        message.push_str(&format!(" (at `{snippet}`)"));
+    }
     ConfigError::Syntax {
         file: file.to_owned(),
         line,
         col,
-        message: describe(err),
+        message,
     }
 }
 
@@ -1028,6 +1094,14 @@ fn from_table(table: &toml::Table) -> Result<Config, toml::de::Error> {
     })
 }
 
+/// Loads a `[terrain] file` profile into `points` ([`TerrainConfig::load_profile_file`]).
+fn load_profile(config: &mut Config, file: &str) -> Result<(), ConfigError> {
+    match config {
+        Config::Planar(c) => c.terrain.load_profile_file(file),
+        Config::Hexapod(c) => c.terrain.load_profile_file(file),
+    }
+}
+
 /// Parses configuration `text` (named `file` in errors), applies
 /// `overrides` in order, fills defaults ([`Config::resolve`]) and validates
 /// every key ([`Config::validate`]). An empty `text` is the built-in
@@ -1040,6 +1114,7 @@ pub fn parse_str(text: &str, file: &str, overrides: &[Override]) -> Result<Confi
         ModelKind::Planar => toml::from_str(text).map(|p| Config::Planar(Box::new(p))),
     }
     .map_err(|e| syntax_error(file, text, &e))?;
+    load_profile(&mut config, file)?;
     for o in overrides {
         let fail = |message: String| ConfigError::Override {
             file: file.to_owned(),
@@ -1048,6 +1123,7 @@ pub fn parse_str(text: &str, file: &str, overrides: &[Override]) -> Result<Confi
         };
         apply_override(&mut table, &o.key, o.value.clone()).map_err(fail)?;
         config = from_table(&table).map_err(|e| fail(describe(&e)))?;
+        load_profile(&mut config, file)?;
     }
     config.resolve();
     config.validate(file)?;

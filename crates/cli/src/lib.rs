@@ -17,6 +17,8 @@ pub mod kinematics;
 pub mod output;
 pub mod plot;
 pub mod run;
+pub mod sweep;
+pub mod sweep_plot;
 
 pub use config::{Config, ConfigError, Override};
 pub use error::CliError;

@@ -317,7 +317,7 @@ pub fn run_command(
     }
     if let Some(e) = &run.error {
         return Err(CliError::Simulation(format!(
-            "{source}: {e} (the steps computed so far are in {})",
+            "{e} ({source}; the steps computed so far are in {})",
             out_dir.display()
         )));
     }

@@ -4,7 +4,9 @@
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ContactError {
     /// Friction coefficients out of order.
-    #[error("friction coefficients must satisfy 0 ≤ mu_dynamic ≤ mu_static (got mu_static = {mu_static}, mu_dynamic = {mu_dynamic})")]
+    #[error(
+        "friction coefficients must satisfy 0 ≤ mu_dynamic ≤ mu_static (got mu_static = {mu_static}, mu_dynamic = {mu_dynamic})"
+    )]
     Friction {
         /// Static coefficient μS.
         mu_static: f64,

@@ -16,4 +16,4 @@ pub mod terrain;
 
 pub use error::ContactError;
 pub use mode::{ContactParams, ContactState, Friction, StateCode, Trial, transition};
-pub use terrain::Terrain;
+pub use terrain::{STEP_RAMP, Terrain, TerrainIssue};

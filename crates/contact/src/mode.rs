@@ -262,9 +262,23 @@ mod tests {
 
     #[test]
     fn touchdown_anchors_at_the_crossing() {
-        let s = tr(ContactState::Free, trial([0.0, 0.01], [0.02, -0.01], 0.0, 0.0));
-        assert_eq!(s, Some(ContactState::Stick { anchor: [0.01, 0.0] }));
-        assert_eq!(tr(ContactState::Free, trial([0.0, 0.01], [0.0, 0.001], 0.0, 0.0)), None);
+        let s = tr(
+            ContactState::Free,
+            trial([0.0, 0.01], [0.02, -0.01], 0.0, 0.0),
+        );
+        assert_eq!(
+            s,
+            Some(ContactState::Stick {
+                anchor: [0.01, 0.0]
+            })
+        );
+        assert_eq!(
+            tr(
+                ContactState::Free,
+                trial([0.0, 0.01], [0.0, 0.001], 0.0, 0.0)
+            ),
+            None
+        );
     }
 
     #[test]
@@ -272,8 +286,14 @@ mod tests {
         let st = ContactState::Stick { anchor: [0.0, 0.0] };
         assert_eq!(tr(st, trial([0.0; 2], [0.0; 2], 3.9, 10.0)), None);
         // Friction needed +4.1 N > 0.4·10 N: slides towards −x, friction stays +.
-        assert_eq!(tr(st, trial([0.0; 2], [0.0; 2], 4.1, 10.0)), Some(ContactState::Slide { dir: -1.0 }));
-        assert_eq!(tr(st, trial([0.0; 2], [0.0; 2], 0.0, -1.0)), Some(ContactState::Free));
+        assert_eq!(
+            tr(st, trial([0.0; 2], [0.0; 2], 4.1, 10.0)),
+            Some(ContactState::Slide { dir: -1.0 })
+        );
+        assert_eq!(
+            tr(st, trial([0.0; 2], [0.0; 2], 0.0, -1.0)),
+            Some(ContactState::Free)
+        );
     }
 
     #[test]
@@ -284,12 +304,18 @@ mod tests {
             tr(sl, trial([0.2, 0.0], [0.199, 0.0], -3.0, 10.0)),
             Some(ContactState::Stick { anchor: [0.2, 0.0] })
         );
-        assert_eq!(tr(sl, trial([0.0; 2], [0.001, 0.0], 0.0, -1.0)), Some(ContactState::Free));
+        assert_eq!(
+            tr(sl, trial([0.0; 2], [0.001, 0.0], 0.0, -1.0)),
+            Some(ContactState::Free)
+        );
     }
 
     #[test]
     fn initial_states() {
-        assert_eq!(ContactState::initial([0.0, 0.5], &G, 1e-9), Ok(ContactState::Free));
+        assert_eq!(
+            ContactState::initial([0.0, 0.5], &G, 1e-9),
+            Ok(ContactState::Free)
+        );
         assert_eq!(
             ContactState::initial([0.3, 5e-10], &G, 1e-9),
             Ok(ContactState::Stick { anchor: [0.3, 0.0] })
@@ -299,8 +325,22 @@ mod tests {
 
     #[test]
     fn friction_validation() {
-        assert!(Friction { mu_static: 0.3, mu_dynamic: 0.4 }.validate().is_err());
-        assert!(Friction { mu_static: 0.4, mu_dynamic: f64::NAN }.validate().is_err());
+        assert!(
+            Friction {
+                mu_static: 0.3,
+                mu_dynamic: 0.4
+            }
+            .validate()
+            .is_err()
+        );
+        assert!(
+            Friction {
+                mu_static: 0.4,
+                mu_dynamic: f64::NAN
+            }
+            .validate()
+            .is_err()
+        );
         assert!(Friction::default().validate().is_ok());
     }
 }

@@ -140,7 +140,9 @@ pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, 
     for b in 0..mech.bodies.len() {
         let x_k = FbdData::body_coords(mech, &data.kin, b);
         data.body[b] = match history {
-            History::Previous => BodyStep::from_history(x_k, FbdData::body_coords(mech, &data.kin_prev, b)),
+            History::Previous => {
+                BodyStep::from_history(x_k, FbdData::body_coords(mech, &data.kin_prev, b))
+            }
             History::Initial { qdot } => {
                 let spec = &mech.bodies[b];
                 let v = mech.chains.point_velocity(&data.kin, spec.com, qdot);
@@ -176,7 +178,14 @@ pub fn pattern(mech: &Mechanism, data: &FbdData, entries: &mut Vec<(usize, usize
 }
 
 /// Residual `r(z)` and, through `jac`, the analytic Jacobian.
-pub fn eval<S: JacobianSink>(mech: &Mechanism, terrain: &Terrain, data: &mut FbdData, z: &[f64], r: &mut [f64], jac: &mut S) {
+pub fn eval<S: JacobianSink>(
+    mech: &Mechanism,
+    terrain: &Terrain,
+    data: &mut FbdData,
+    z: &[f64],
+    r: &mut [f64],
+    jac: &mut S,
+) {
     let lay = mech.layout();
     assert_eq!(z.len(), lay.dim(), "unknown vector has the wrong length");
     assert_eq!(r.len(), lay.dim(), "residual vector has the wrong length");
@@ -205,7 +214,10 @@ pub fn eval<S: JacobianSink>(mech: &Mechanism, terrain: &Terrain, data: &mut Fbd
     for (ci, spec) in mech.contacts.iter().enumerate() {
         let eq = &data.contact[ci];
         let (fa, n) = (z[lay.contact_fa(ci)], z[lay.contact_n(ci)]);
-        let f = [fa * eq.tangent[0] + n * eq.normal[0], fa * eq.tangent[1] + n * eq.normal[1]];
+        let f = [
+            fa * eq.tangent[0] + n * eq.normal[0],
+            fa * eq.tangent[1] + n * eq.normal[1],
+        ];
         let p = data.kin.pos[spec.point];
         let c = data.body[spec.body].com_k;
         let a = &mut data.acc[spec.body];
@@ -298,7 +310,12 @@ fn force_entries<S: JacobianSink>(mech: &Mechanism, data: &FbdData, jac: &mut S)
 
 /// Entries in the `q[k+1]` columns: `∂(second difference)/∂q` of every body
 /// and the contact position rows, at the iterate `data.kin_next`.
-fn position_entries<S: JacobianSink>(mech: &Mechanism, terrain: &Terrain, data: &FbdData, jac: &mut S) {
+fn position_entries<S: JacobianSink>(
+    mech: &Mechanism,
+    terrain: &Terrain,
+    data: &FbdData,
+    jac: &mut S,
+) {
     let lay = mech.layout();
     let kin_next = &data.kin_next;
     let dt2 = data.dt * data.dt;
@@ -328,7 +345,12 @@ fn position_entries<S: JacobianSink>(mech: &Mechanism, terrain: &Terrain, data: 
             ContactState::Slide { .. } => {
                 let s = terrain.slope(kin_next.pos[spec.point][0]);
                 for &i in mech.point_columns(spec.point) {
-                    jac.add(row + 1, i, k * (kin_next.jac_at(spec.point, 1, i) - s * kin_next.jac_at(spec.point, 0, i)));
+                    jac.add(
+                        row + 1,
+                        i,
+                        k * (kin_next.jac_at(spec.point, 1, i)
+                            - s * kin_next.jac_at(spec.point, 0, i)),
+                    );
                 }
             }
         }

@@ -41,5 +41,10 @@ pub mod assemble;
 pub mod body;
 pub mod mechanism;
 
-pub use assemble::{ContactEquation, FbdData, History, JacobianSink, NoJacobian, advance, eval, pattern, pattern_key, prepare_step, set_configuration};
-pub use mechanism::{BodySpec, ContactPoints, ContactSpec, JointSpec, Layout, Mechanism, TwoLegInertia};
+pub use assemble::{
+    ContactEquation, FbdData, History, JacobianSink, NoJacobian, advance, eval, pattern,
+    pattern_key, prepare_step, set_configuration,
+};
+pub use mechanism::{
+    BodySpec, ContactPoints, ContactSpec, JointSpec, Layout, Mechanism, TwoLegInertia,
+};

@@ -160,10 +160,20 @@ impl Mechanism {
         contacts: Vec<ContactSpec>,
         gravity: f64,
     ) -> Self {
-        assert_eq!(bodies.len(), joints.len() + 1, "a planar tree has one body more than joints");
-        assert_eq!(chains.nq, 3 + joints.len(), "nq must be 3 + number of joints");
+        assert_eq!(
+            bodies.len(),
+            joints.len() + 1,
+            "a planar tree has one body more than joints"
+        );
+        assert_eq!(
+            chains.nq,
+            3 + joints.len(),
+            "nq must be 3 + number of joints"
+        );
         for j in &joints {
-            assert!(j.parent < bodies.len() && j.child < bodies.len() && j.point < chains.points.len());
+            assert!(
+                j.parent < bodies.len() && j.child < bodies.len() && j.point < chains.points.len()
+            );
         }
         for c in &contacts {
             assert!(c.body < bodies.len() && c.point < chains.points.len());
@@ -195,7 +205,12 @@ impl Mechanism {
     /// Bodies `[body, upper3, lower3, upper4, lower4]`; joints
     /// `[hip3, knee3, hip4, knee4]`; contacts in the order tips (3, 4), knees
     /// (3, 4), hips (3, 4) for those enabled.
-    pub fn two_leg(geometry: &PlanarGeometry, inertia: &TwoLegInertia, gravity: f64, points: ContactPoints) -> (Self, TwoLegIndex) {
+    pub fn two_leg(
+        geometry: &PlanarGeometry,
+        inertia: &TwoLegInertia,
+        gravity: f64,
+        points: ContactPoints,
+    ) -> (Self, TwoLegIndex) {
         use fbd_kinematics::planar::{hexapod_leg_number, side_sign, theta2_index, theta3_index};
         let (chains, ix) = PlanarChains::two_leg(geometry);
         let mut bodies = vec![BodySpec {

@@ -3,7 +3,10 @@
 
 use fbd_contact::{ContactState, Terrain};
 use fbd_dynamics::mechanism::ContactPoints;
-use fbd_dynamics::{ContactEquation, FbdData, History, JacobianSink, Mechanism, NoJacobian, TwoLegInertia, eval, pattern, prepare_step, set_configuration};
+use fbd_dynamics::{
+    ContactEquation, FbdData, History, JacobianSink, Mechanism, NoJacobian, TwoLegInertia, eval,
+    pattern, prepare_step, set_configuration,
+};
 use fbd_kinematics::fd::{FdTolerance, check_jacobian};
 use fbd_kinematics::planar::PlanarGeometry;
 
@@ -60,22 +63,42 @@ fn check(states: [ContactState; 6], history_first: bool) {
             normal: [-s * k, k],
             mu_dynamic: 0.3,
         };
-        data.torque.iter_mut().enumerate().for_each(|(j, t)| *t = 0.5 * j as f64 - 0.7);
+        data.torque
+            .iter_mut()
+            .enumerate()
+            .for_each(|(j, t)| *t = 0.5 * j as f64 - 0.7);
     }
     let terrain = Terrain::Flat { height: 0.01 };
     let z: Vec<f64> = (0..n)
-        .map(|i| if i < 7 { q1[i] + 0.003 * (i as f64).sin() } else { 3.0 * ((i * 7) as f64).cos() })
+        .map(|i| {
+            if i < 7 {
+                q1[i] + 0.003 * (i as f64).sin()
+            } else {
+                3.0 * ((i * 7) as f64).cos()
+            }
+        })
         .collect();
     let mut r = vec![0.0; n];
     let mut jm = vec![0.0; n * n];
-    eval(&mech, &terrain, &mut data, &z, &mut r, &mut Dense { n, m: &mut jm });
+    eval(
+        &mech,
+        &terrain,
+        &mut data,
+        &z,
+        &mut r,
+        &mut Dense { n, m: &mut jm },
+    );
     // Every entry written must be in the declared pattern.
     let mut entries = Vec::new();
     pattern(&mech, &data, &mut entries);
     for i in 0..n {
         for j in 0..n {
             if jm[i * n + j] != 0.0 {
-                assert!(entries.contains(&(i, j)), "entry ({i}, {j}) = {} is outside the pattern", jm[i * n + j]);
+                assert!(
+                    entries.contains(&(i, j)),
+                    "entry ({i}, {j}) = {} is outside the pattern",
+                    jm[i * n + j]
+                );
             }
         }
     }
@@ -102,8 +125,20 @@ fn jacobian_in_flight() {
 
 #[test]
 fn jacobian_sticking_and_sliding() {
-    let st = ContactState::Stick { anchor: [0.5, 0.01] };
+    let st = ContactState::Stick {
+        anchor: [0.5, 0.01],
+    };
     let sl = ContactState::Slide { dir: -1.0 };
-    check([st, sl, ContactState::Free, st, sl, ContactState::Slide { dir: 1.0 }], false);
+    check(
+        [
+            st,
+            sl,
+            ContactState::Free,
+            st,
+            sl,
+            ContactState::Slide { dir: 1.0 },
+        ],
+        false,
+    );
     check([sl, st, st, sl, ContactState::Free, st], true);
 }

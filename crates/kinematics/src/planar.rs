@@ -281,7 +281,9 @@ impl PlanarChains {
     pub fn point_velocity(&self, data: &PlanarData, p: usize, qdot: &[f64]) -> [f64; 2] {
         let mut v = [0.0; 2];
         for (axis, vk) in v.iter_mut().enumerate() {
-            *vk = (0..self.nq).map(|i| data.jac_at(p, axis, i) * qdot[i]).sum();
+            *vk = (0..self.nq)
+                .map(|i| data.jac_at(p, axis, i) * qdot[i])
+                .sum();
         }
         v
     }
@@ -337,7 +339,15 @@ mod tests {
     use crate::fd::{FdTolerance, check_jacobian};
 
     fn paper_q() -> [f64; NQ] {
-        [0.0, 0.6, 0.0, 0.0, 245f64.to_radians(), 0.0, 255f64.to_radians()]
+        [
+            0.0,
+            0.6,
+            0.0,
+            0.0,
+            245f64.to_radians(),
+            0.0,
+            255f64.to_radians(),
+        ]
     }
 
     #[test]
@@ -347,8 +357,14 @@ mod tests {
         ch.eval_positions(&paper_q(), &mut d);
         let t3 = d.pos[ix.tip[0]];
         let t4 = d.pos[ix.tip[1]];
-        assert!((t3[0] + 0.594006).abs() < 1e-6 && (t3[1] - 0.219351).abs() < 1e-6, "{t3:?}");
-        assert!((t4[0] - 0.525210).abs() < 1e-6 && (t4[1] - 0.194311).abs() < 1e-6, "{t4:?}");
+        assert!(
+            (t3[0] + 0.594006).abs() < 1e-6 && (t3[1] - 0.219351).abs() < 1e-6,
+            "{t3:?}"
+        );
+        assert!(
+            (t4[0] - 0.525210).abs() < 1e-6 && (t4[1] - 0.194311).abs() < 1e-6,
+            "{t4:?}"
+        );
     }
 
     #[test]
@@ -364,9 +380,13 @@ mod tests {
             let (t2, t3) = (q[theta2_index(leg)], q[theta3_index(leg)]);
             let hip = [s * g.d, 0.0];
             let knee = [hip[0] + s * g.a * t2.cos(), hip[1] - g.a * t2.sin()];
-            let tip = [knee[0] - s * g.c * (t2 + t3).cos(), knee[1] + g.c * (t2 + t3).sin()];
+            let tip = [
+                knee[0] - s * g.c * (t2 + t3).cos(),
+                knee[1] + g.c * (t2 + t3).sin(),
+            ];
             let (sp, cp) = q[PHI_Z].sin_cos();
-            let to_world = |p: [f64; 2]| [q[0] + cp * p[0] - sp * p[1], q[1] + sp * p[0] + cp * p[1]];
+            let to_world =
+                |p: [f64; 2]| [q[0] + cp * p[0] - sp * p[1], q[1] + sp * p[0] + cp * p[1]];
             for (want, got) in [(hip, ix.hip[leg]), (knee, ix.knee[leg]), (tip, ix.tip[leg])] {
                 let w = to_world(want);
                 let p = d.pos[got];
@@ -420,7 +440,11 @@ mod tests {
             let b = ch.point_bias_acceleration(&d, p, &qd);
             for k in 0..2 {
                 let fd = (pp[p][k] - 2.0 * p0[p][k] + pm[p][k]) / (h * h);
-                assert!((fd - b[k]).abs() < 1e-5 * (1.0 + b[k].abs()), "point {p} axis {k}: {fd} vs {}", b[k]);
+                assert!(
+                    (fd - b[k]).abs() < 1e-5 * (1.0 + b[k].abs()),
+                    "point {p} axis {k}: {fd} vs {}",
+                    b[k]
+                );
             }
         }
     }

@@ -14,6 +14,8 @@ pub struct Data {
     pub k: usize,
     /// `q[k−1]` (meaningful for `k ≥ 1`).
     pub q_prev: Vec<f64>,
+    /// `q[k−2]` (meaningful for `k ≥ 2`; the predictor's third point).
+    pub q_prev2: Vec<f64>,
     /// `q[k]`.
     pub q: Vec<f64>,
     /// Unknowns of the step: `[q[k+1] | joint forces | contact forces]`; the
@@ -54,6 +56,7 @@ impl Data {
         Self {
             k: 0,
             q_prev: model.params.q0.to_vec(),
+            q_prev2: model.params.q0.to_vec(),
             q: model.params.q0.to_vec(),
             z,
             states: model.initial_states.clone(),

@@ -10,7 +10,11 @@ pub fn kinetic_central(mech: &Mechanism, prev: &PlanarData, next: &PlanarData, d
         .map(|b| {
             let a = FbdData::body_coords(mech, prev, b);
             let c = FbdData::body_coords(mech, next, b);
-            let v = [(c[0] - a[0]) / (2.0 * dt), (c[1] - a[1]) / (2.0 * dt), (c[2] - a[2]) / (2.0 * dt)];
+            let v = [
+                (c[0] - a[0]) / (2.0 * dt),
+                (c[1] - a[1]) / (2.0 * dt),
+                (c[2] - a[2]) / (2.0 * dt),
+            ];
             body_kinetic(mech, b, v)
         })
         .sum()

@@ -19,7 +19,9 @@ pub enum SimError {
         expected: String,
     },
     /// A contact point starts below the terrain.
-    #[error("initial.{leg}: {point} starts {depth:.6} m below the terrain (got depth {depth:.6} m, expected ≤ 1e-9 m)")]
+    #[error(
+        "initial.{leg}: {point} starts {depth:.6} m below the terrain (got depth {depth:.6} m, expected ≤ 1e-9 m)"
+    )]
     InitialPenetration {
         /// The leg table, e.g. `leg3`.
         leg: String,
@@ -39,7 +41,9 @@ pub enum SimError {
         source: SolverError,
     },
     /// The contact-state search revisited a state combination.
-    #[error("step {step} (t = {t:.6} s): the contact-state search cycles at [{states}] (residual {residual:.3e})")]
+    #[error(
+        "step {step} (t = {t:.6} s): the contact-state search cycles at [{states}] (residual {residual:.3e})"
+    )]
     Cycling {
         /// Step index k.
         step: usize,
@@ -67,7 +71,9 @@ impl SimError {
     /// errors).
     pub fn step(&self) -> Option<usize> {
         match self {
-            SimError::Newton { step, .. } | SimError::Cycling { step, .. } | SimError::NonFinite { step, .. } => Some(*step),
+            SimError::Newton { step, .. }
+            | SimError::Cycling { step, .. }
+            | SimError::NonFinite { step, .. } => Some(*step),
             _ => None,
         }
     }

@@ -19,6 +19,7 @@
 //! assert_eq!(rows.len(), 6);
 //! ```
 
+pub mod control;
 mod data;
 pub mod energy;
 mod error;
@@ -29,6 +30,7 @@ mod run;
 pub mod step;
 mod system;
 
+pub use control::{Control, LegTrajectory};
 pub use data::Data;
 pub use error::SimError;
 pub use model::Model;

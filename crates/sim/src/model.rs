@@ -27,7 +27,13 @@ pub struct Model {
     pub initial_states: Vec<ContactState>,
 }
 
-fn check(ok: bool, key: &str, what: &str, got: impl std::fmt::Display, expected: &str) -> Result<(), SimError> {
+fn check(
+    ok: bool,
+    key: &str,
+    what: &str,
+    got: impl std::fmt::Display,
+    expected: &str,
+) -> Result<(), SimError> {
     if ok {
         Ok(())
     } else {
@@ -41,7 +47,13 @@ fn check(ok: bool, key: &str, what: &str, got: impl std::fmt::Display, expected:
 }
 
 fn positive(key: &str, v: f64) -> Result<(), SimError> {
-    check(v.is_finite() && v > 0.0, key, "must be positive and finite", v, "a finite value > 0")
+    check(
+        v.is_finite() && v > 0.0,
+        key,
+        "must be positive and finite",
+        v,
+        "a finite value > 0",
+    )
 }
 
 impl Model {
@@ -51,10 +63,28 @@ impl Model {
         let p = params;
         positive("time.dt", p.dt)?;
         positive("time.duration", p.duration)?;
-        check(p.dt <= p.duration, "time.dt", "must not exceed time.duration", p.dt, "dt ≤ duration")?;
+        check(
+            p.dt <= p.duration,
+            "time.dt",
+            "must not exceed time.duration",
+            p.dt,
+            "dt ≤ duration",
+        )?;
         let steps_f = (p.duration / p.dt).round();
-        check(steps_f <= 1e9, "time.duration", "needs too many steps", steps_f, "duration/dt ≤ 1e9")?;
-        check(p.gravity.is_finite(), "world.gravity", "must be finite", p.gravity, "a finite value")?;
+        check(
+            steps_f <= 1e9,
+            "time.duration",
+            "needs too many steps",
+            steps_f,
+            "duration/dt ≤ 1e9",
+        )?;
+        check(
+            p.gravity.is_finite(),
+            "world.gravity",
+            "must be finite",
+            p.gravity,
+            "a finite value",
+        )?;
         positive("body.mass", p.body_mass)?;
         positive("body.inertia", p.body_inertia)?;
         positive("body.side", p.side)?;
@@ -64,27 +94,87 @@ impl Model {
         positive("leg.lower_length", p.lower_length)?;
         positive("leg.lower_mass", p.lower_mass)?;
         positive("leg.lower_inertia", p.lower_inertia)?;
-        for (key, v) in [("leg.upper_com", p.upper_com), ("leg.lower_com", p.lower_com)] {
-            check(v.is_finite() && (0.0..=1.0).contains(&v), key, "must lie on the link", v, "a fraction in [0, 1]")?;
+        for (key, v) in [
+            ("leg.upper_com", p.upper_com),
+            ("leg.lower_com", p.lower_com),
+        ] {
+            check(
+                v.is_finite() && (0.0..=1.0).contains(&v),
+                key,
+                "must lie on the link",
+                v,
+                "a fraction in [0, 1]",
+            )?;
         }
-        let names = ["initial.position", "initial.position", "initial.phi_z_deg", "initial.leg3.theta_deg", "initial.leg3.theta_deg", "initial.leg4.theta_deg", "initial.leg4.theta_deg"];
-        let rates = ["initial.velocity", "initial.velocity", "initial.omega_z_deg", "initial.leg3.rate_deg", "initial.leg3.rate_deg", "initial.leg4.rate_deg", "initial.leg4.rate_deg"];
+        let names = [
+            "initial.position",
+            "initial.position",
+            "initial.phi_z_deg",
+            "initial.leg3.theta_deg",
+            "initial.leg3.theta_deg",
+            "initial.leg4.theta_deg",
+            "initial.leg4.theta_deg",
+        ];
+        let rates = [
+            "initial.velocity",
+            "initial.velocity",
+            "initial.omega_z_deg",
+            "initial.leg3.rate_deg",
+            "initial.leg3.rate_deg",
+            "initial.leg4.rate_deg",
+            "initial.leg4.rate_deg",
+        ];
         for i in 0..7 {
-            check(p.q0[i].is_finite(), names[i], "must be finite", p.q0[i], "a finite value")?;
-            check(p.qdot0[i].is_finite(), rates[i], "must be finite", p.qdot0[i], "a finite value")?;
+            check(
+                p.q0[i].is_finite(),
+                names[i],
+                "must be finite",
+                p.q0[i],
+                "a finite value",
+            )?;
+            check(
+                p.qdot0[i].is_finite(),
+                rates[i],
+                "must be finite",
+                p.qdot0[i],
+                "a finite value",
+            )?;
         }
-        if let fbd_contact::Terrain::Flat { height } = p.terrain {
-            check(height.is_finite(), "terrain.height", "must be finite", height, "a finite value")?;
+        if let Err(e) = p.terrain.validate() {
+            check(
+                false,
+                &format!("terrain.{}", e.key),
+                e.what,
+                e.got,
+                e.expected,
+            )?;
         }
-        check(p.friction.mu_static.is_finite() && p.friction.mu_static >= 0.0, "terrain.mu_static", "must be finite and ≥ 0", p.friction.mu_static, "0 ≤ mu_static")?;
+        if let Err((key, what, got)) = p.control.validate() {
+            check(false, &key, what, got, "see the [control] documentation")?;
+        }
         check(
-            p.friction.mu_dynamic.is_finite() && p.friction.mu_dynamic >= 0.0 && p.friction.mu_dynamic <= p.friction.mu_static,
+            p.friction.mu_static.is_finite() && p.friction.mu_static >= 0.0,
+            "terrain.mu_static",
+            "must be finite and ≥ 0",
+            p.friction.mu_static,
+            "0 ≤ mu_static",
+        )?;
+        check(
+            p.friction.mu_dynamic.is_finite()
+                && p.friction.mu_dynamic >= 0.0
+                && p.friction.mu_dynamic <= p.friction.mu_static,
             "terrain.mu_dynamic",
             "must satisfy 0 ≤ mu_dynamic ≤ mu_static",
             p.friction.mu_dynamic,
             &format!("0 ≤ mu_dynamic ≤ {}", p.friction.mu_static),
         )?;
-        check(p.stride >= 1, "output.stride", "must be at least 1", p.stride, "an integer ≥ 1")?;
+        check(
+            p.stride >= 1,
+            "output.stride",
+            "must be at least 1",
+            p.stride,
+            "an integer ≥ 1",
+        )?;
 
         let geometry = PlanarGeometry {
             d: p.side * (std::f64::consts::PI / 6.0).cos(),
@@ -112,11 +202,12 @@ impl Model {
         mech.chains.eval_positions(&p.q0, &mut kin);
         let mut initial_states = Vec::with_capacity(mech.contacts.len());
         for (ci, c) in mech.contacts.iter().enumerate() {
-            let state = ContactState::initial(kin.pos[c.point], &p.terrain, contact.initial_tol).map_err(|depth| SimError::InitialPenetration {
-                leg: format!("leg{}", contact_leg[ci]),
-                point: c.name.clone(),
-                depth,
-            })?;
+            let state = ContactState::initial(kin.pos[c.point], &p.terrain, contact.initial_tol)
+                .map_err(|depth| SimError::InitialPenetration {
+                    leg: format!("leg{}", contact_leg[ci]),
+                    point: c.name.clone(),
+                    depth,
+                })?;
             initial_states.push(state);
         }
         Ok(Self {
@@ -124,7 +215,14 @@ impl Model {
             mech,
             index,
             contact,
-            newton: NewtonParams::default(),
+            newton: NewtonParams {
+                // At the small steps of a simulation the previous
+                // factorisation is an excellent approximate Jacobian; a chord
+                // step that does not contract falls back to full Newton, so
+                // the tolerances are unchanged.
+                chord_steps: 6,
+                ..NewtonParams::default()
+            },
             steps: steps_f as usize + 1,
             contact_leg,
             initial_states,

@@ -1,6 +1,7 @@
 //! Physical and numerical parameters of a planar run, in SI units and
 //! radians. The CLI fills them from a TOML configuration (degrees there).
 
+use crate::control::Control;
 use fbd_contact::{Friction, Terrain};
 use fbd_dynamics::mechanism::ContactPoints;
 
@@ -55,6 +56,8 @@ pub struct PlanarParams {
     pub contact_points: ContactPoints,
     /// Write every `stride`-th step. Default 1.
     pub stride: usize,
+    /// Joint controller. Default [`Control::None`] (passive joints).
+    pub control: Control,
 }
 
 impl Default for PlanarParams {
@@ -78,12 +81,21 @@ impl Default for PlanarParams {
             lower_mass,
             lower_inertia: lower_mass * lower_length * lower_length / 12.0,
             lower_com: 0.75,
-            q0: [0.0, 0.6, 0.0, 0.0, 245f64.to_radians(), 0.0, 255f64.to_radians()],
+            q0: [
+                0.0,
+                0.6,
+                0.0,
+                0.0,
+                245f64.to_radians(),
+                0.0,
+                255f64.to_radians(),
+            ],
             qdot0: [0.0; 7],
             terrain: Terrain::Flat { height: 0.0 },
             friction: Friction::default(),
             contact_points: ContactPoints::default(),
             stride: 1,
+            control: Control::None,
         }
     }
 }

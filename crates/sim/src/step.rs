@@ -1,6 +1,8 @@
 //! One time step, in stages:
 //!
 //! 1. **kinematics at k**: the per-body constants of the second differences;
+//! 2. **joint torques at k**: the controller's torques from `q[k]`, `q[k−1]`
+//!    ([`crate::control`]);
 //! 2. **predictor**: a starting guess for `q[k+1]` (forces from the last step);
 //! 3. **solve**: Newton on the FBD equations with the current contact states;
 //! 4. **contact check**: every point's switching rule on the trial solution;
@@ -37,7 +39,9 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     loop {
         trials += 1;
         let (mut sys, solver, z) = system(model, data);
-        let report = solver.solve(&mut sys, z).map_err(|source| SimError::Newton { step: k, t, source })?;
+        let report = solver
+            .solve(&mut sys, z)
+            .map_err(|source| SimError::Newton { step: k, t, source })?;
         newton_iterations += report.iterations;
         if data.z.iter().any(|v| !v.is_finite()) {
             return Err(SimError::NonFinite {
@@ -46,7 +50,8 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
                 residual: report.residual,
             });
         }
-        mech.chains.eval_positions(&data.z[..nq], &mut data.fbd.kin_next);
+        mech.chains
+            .eval_positions(&data.z[..nq], &mut data.fbd.kin_next);
         if !check_contacts(model, data) {
             break;
         }
@@ -55,8 +60,12 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
             fallback_used = true;
             let mut forced = false;
             for c in 0..mech.contacts.len() {
-                if data.seen[c] & 0b11 == 0b11 && !matches!(data.trial[c], ContactState::Slide { .. }) {
-                    data.trial[c] = ContactState::Slide { dir: -data.stick_fa[c].signum() };
+                if data.seen[c] & 0b11 == 0b11
+                    && !matches!(data.trial[c], ContactState::Slide { .. })
+                {
+                    data.trial[c] = ContactState::Slide {
+                        dir: -data.stick_fa[c].signum(),
+                    };
                     forced = true;
                 }
             }
@@ -94,6 +103,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
         }
     }
     data.states.copy_from_slice(&data.trial);
+    std::mem::swap(&mut data.q_prev2, &mut data.q_prev);
     data.q_prev.copy_from_slice(&data.q);
     data.q.copy_from_slice(&data.z[..nq]);
     advance(mech, &mut data.fbd, &data.z[..nq]);
@@ -111,18 +121,25 @@ pub fn prepare(model: &Model, data: &mut Data) {
     let k = data.k;
     let nq = mech.layout().nq;
     let history = if k == 0 {
-        History::Initial { qdot: &model.params.qdot0 }
+        History::Initial {
+            qdot: &model.params.qdot0,
+        }
     } else {
         History::Previous
     };
     prepare_step(mech, &mut data.fbd, history, dt);
 
-    // Predictor: constant-velocity extrapolation of q.
+    // 2. Joint torques at k (explicit, from q[k] and q[k−1]).
+    crate::control::joint_torques(model, data);
+
+    // Predictor: quadratic extrapolation of q through the last three
+    // configurations (exact for the discrete free fall), linear at k = 1,
+    // the initial velocity at k = 0.
     for i in 0..nq {
-        data.z[i] = if k == 0 {
-            data.q[i] + dt * model.params.qdot0[i]
-        } else {
-            2.0 * data.q[i] - data.q_prev[i]
+        data.z[i] = match k {
+            0 => data.q[i] + dt * model.params.qdot0[i],
+            1 => 2.0 * data.q[i] - data.q_prev[i],
+            _ => 3.0 * (data.q[i] - data.q_prev[i]) + data.q_prev2[i],
         };
     }
     data.trial.copy_from_slice(&data.states);
@@ -134,9 +151,17 @@ pub fn prepare(model: &Model, data: &mut Data) {
 /// Stage 3's inputs for the current trial states (contact equations, row
 /// scales), split from `data`: the step's [`NewtonSystem`](fbd_solver::NewtonSystem),
 /// the solver and the unknowns `z`. Public for benchmarks.
-pub fn system<'a>(model: &'a Model, data: &'a mut Data) -> (StepSystem<'a>, &'a mut NewtonSolver, &'a mut [f64]) {
+pub fn system<'a>(
+    model: &'a Model,
+    data: &'a mut Data,
+) -> (StepSystem<'a>, &'a mut NewtonSolver, &'a mut [f64]) {
     set_contact_equations(model, data);
-    row_scales(&model.mech, &data.fbd, &mut data.scales);
+    row_scales(
+        &model.mech,
+        &data.fbd,
+        data.q[0].abs().max(data.q[1].abs()),
+        &mut data.scales,
+    );
     let sys = StepSystem {
         mech: &model.mech,
         terrain: &model.params.terrain,
@@ -185,7 +210,13 @@ fn check_contacts(model: &Model, data: &mut Data) -> bool {
         if matches!(data.trial[c], ContactState::Stick { .. }) {
             data.stick_fa[c] = trial.fa;
         }
-        if let Some(next) = transition(&data.trial[c], &trial, &model.params.terrain, &model.params.friction, &model.contact) {
+        if let Some(next) = transition(
+            &data.trial[c],
+            &trial,
+            &model.params.terrain,
+            &model.params.friction,
+            &model.contact,
+        ) {
             data.trial[c] = next;
             changed = true;
         }
@@ -208,7 +239,12 @@ fn describe_states(model: &Model, states: &[ContactState]) -> String {
         .join(" ")
 }
 
-fn make_record(model: &Model, data: &Data, newton_iterations: usize, state_trials: usize) -> StepRecord {
+fn make_record(
+    model: &Model,
+    data: &Data,
+    newton_iterations: usize,
+    state_trials: usize,
+) -> StepRecord {
     let mech = &model.mech;
     let lay = mech.layout();
     let nc = mech.contacts.len().min(MAX_CONTACTS);

@@ -46,12 +46,14 @@ impl NewtonSystem for StepSystem<'_> {
 }
 
 /// Convergence scales of every row for the current contact states: forces
-/// to `1e-9 ×` the weight (with a round-off floor that grows as `M/Δt²`),
-/// moments to that times the length scale, contact positions to `1e-12` m.
-pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, scales: &mut [f64]) {
+/// to `1e-9 ×` the weight, with a round-off floor `1e-6·(M/Δt²)·(1 m + |R|)`
+/// (a body row is `m·x/Δt²` minus forces, so its round-off grows with the
+/// coordinates' magnitude `|R|` and with `1/Δt²`); moments to that times the
+/// length scale; contact positions to `1e-12·(1 m + |R|)`.
+pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, extent: f64, scales: &mut [f64]) {
     let lay = mech.layout();
     let k = fbd.position_gain;
-    let force = mech.total_mass() * mech.gravity.abs().max(1.0) + 1e-6 * k;
+    let force = mech.total_mass() * mech.gravity.abs().max(1.0) + 1e-6 * k * (1.0 + extent);
     let moment = force * mech.length_scale();
     for b in 0..lay.bodies {
         let row = lay.body_row(b);
@@ -61,7 +63,7 @@ pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, scales: &mut [f64]) {
     }
     for (c, eq) in fbd.contact.iter().enumerate() {
         let row = lay.contact_row(c);
-        let position = 1e-3 * k;
+        let position = 1e-3 * k * (1.0 + extent);
         let (s0, s1) = match eq.state {
             ContactState::Free => (force, force),
             ContactState::Stick { .. } => (position, position),

@@ -31,7 +31,9 @@
 //!   faer's simplicial one cannot be reused for a smaller dimension.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::sparse::linalg::lu::{LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::linalg::lu::{
+    LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu,
+};
 use faer::sparse::linalg::{LuError, SupernodalThreshold};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par};
@@ -396,7 +398,12 @@ impl NewtonSolver {
     /// If `x.len() != sys.dim()` (and as [`Self::solve`]).
     pub fn load_jacobian<S: NewtonSystem>(&mut self, sys: &mut S, x: &[f64]) {
         let n = sys.dim();
-        assert_eq!(x.len(), n, "x has length {} but the system has dimension {n}", x.len());
+        assert_eq!(
+            x.len(),
+            n,
+            "x has length {} but the system has dimension {n}",
+            x.len()
+        );
         let index = self.register(sys);
         let pattern = &self.patterns[index].1;
         set_len(&mut self.ws.values, pattern.row_idx.len());
@@ -417,15 +424,17 @@ impl NewtonSolver {
     /// # Panics
     /// If nothing was loaded, or `dx` does not have the system's dimension.
     pub fn factorize_loaded(&mut self, dx: Option<&mut [f64]>) -> Result<(), SolverError> {
-        let index = self.loaded.expect("factorize_loaded: call load_jacobian first");
+        let index = self
+            .loaded
+            .expect("factorize_loaded: call load_jacobian first");
         let pattern = &mut self.patterns[index].1;
-        let dx = dx.map(|dx| {
+        let mut dx = dx;
+        if let Some(dx) = dx.as_deref_mut() {
             assert_eq!(dx.len(), pattern.n, "dx has the wrong length");
             for (d, &ri) in dx.iter_mut().zip(&self.ws.r) {
                 *d = -ri;
             }
-            dx
-        });
+        }
         factor_and_solve(pattern, &self.ws.values, &mut self.ws.mem, dx)
     }
 }
@@ -605,12 +614,13 @@ impl Workspace {
                     }
                     // `numeric` is the output of `factorize_numeric_lu` for
                     // this pattern's `symbolic` (`factored`), as required.
-                    LuRef::new_unchecked(&pattern.symbolic, &pattern.numeric).solve_in_place_with_conj(
-                        Conj::No,
-                        MatMut::from_column_major_slice_mut(&mut self.dx, n, 1),
-                        Par::Seq,
-                        MemStack::new(&mut self.mem),
-                    );
+                    LuRef::new_unchecked(&pattern.symbolic, &pattern.numeric)
+                        .solve_in_place_with_conj(
+                            Conj::No,
+                            MatMut::from_column_major_slice_mut(&mut self.dx, n, 1),
+                            Par::Seq,
+                            MemStack::new(&mut self.mem),
+                        );
                     for ((xt, &xi), &d) in self.x_trial.iter_mut().zip(x.iter()).zip(&self.dx) {
                         *xt = xi + d;
                     }
@@ -620,8 +630,21 @@ impl Workspace {
                         Some(t) if t <= params.chord_contraction * rnorm => {
                             x.copy_from_slice(&self.x_trial);
                             std::mem::swap(&mut self.r, &mut self.r_trial);
-                            rnorm = t;
                             chord += 1;
+                            // At the observed contraction, would the chord
+                            // reach the tolerance within its budget? If not,
+                            // refactor now rather than spend the steps.
+                            let rate = t / rnorm;
+                            rnorm = t;
+                            if rnorm > params.residual_tol {
+                                let needed = (params.residual_tol / rnorm).ln() / rate.ln();
+                                // Negated so that a NaN estimate also stops.
+                                #[allow(clippy::neg_cmp_op_on_partial_ord)]
+                                let hopeless = !(needed <= (params.chord_steps - chord) as f64);
+                                if hopeless {
+                                    break;
+                                }
+                            }
                         }
                         _ => break,
                     }

@@ -43,7 +43,10 @@ impl JacobianSink<'_> {
     #[inline]
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
         let s = self.slot[row * self.n + col];
-        assert!(s != u32::MAX, "Jacobian entry ({row}, {col}) is not in the declared pattern");
+        assert!(
+            s != u32::MAX,
+            "Jacobian entry ({row}, {col}) is not in the declared pattern"
+        );
         self.values[s as usize] += v;
     }
 }

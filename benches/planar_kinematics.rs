@@ -1,0 +1,46 @@
+//! Stage "kinematics": positions and analytic point Jacobians of the planar
+//! two-leg model (7 angles' `sin_cos`, 11 points), as evaluated at every
+//! Newton iterate.
+//!
+//! `cargo bench -p fbd-suite --bench planar_kinematics`
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use fbd_kinematics::planar::{PlanarChains, PlanarGeometry};
+
+fn bench(c: &mut Criterion) {
+    let (chains, _) = PlanarChains::two_leg(&PlanarGeometry::default());
+    let mut data = chains.new_data();
+    let q = [
+        0.01,
+        0.6,
+        0.02,
+        0.05,
+        245f64.to_radians(),
+        -0.03,
+        255f64.to_radians(),
+    ];
+
+    c.bench_function("planar_eval_positions", |b| {
+        b.iter(|| chains.eval_positions(black_box(&q), &mut data))
+    });
+    chains.eval_positions(&q, &mut data);
+    c.bench_function("planar_eval_jacobians", |b| {
+        b.iter(|| chains.eval_jacobians(black_box(&mut data)))
+    });
+    c.bench_function("planar_positions_and_jacobians", |b| {
+        b.iter(|| {
+            chains.eval_positions(black_box(&q), &mut data);
+            chains.eval_jacobians(&mut data);
+        })
+    });
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().measurement_time(Duration::from_secs(2)).warm_up_time(Duration::from_secs(1));
+    targets = bench
+}
+criterion_main!(benches);

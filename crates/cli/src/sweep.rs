@@ -1,0 +1,966 @@
+//! `fbd sweep SWEEP.toml`: many runs of one base configuration with some
+//! dotted keys varied, on every core, with progress, resumable and
+//! shardable across the machines of a cluster; `fbd sweep merge` joins the
+//! shards. See `docs/sweep.md`.
+//!
+//! Layout of the output directory:
+//! * `runs/<index>/` — exactly the files of `fbd run runs/<index>/config.toml`
+//!   (only `wall_seconds`/`steps_per_second` of `summary.json` differ from
+//!   run to run), plus an empty `.done` marker written after every other
+//!   file, so that `--resume` never takes a half-written run for a finished
+//!   one.
+//! * `index.csv` — one row per finished run, sorted by index ([`COLUMNS`]).
+//! * `sweep.json` — the sweep definition, the total number of runs, the
+//!   shard and the varied values of every run (what `merge` checks).
+//! * `sweep.svg` — a column of `index.csv` against the varied keys.
+//!
+//! Random mode uses splitmix64 (Steele, Lea & Flood 2014) seeded with
+//! `seed`: for run 0, 1, … and, within a run, for each varied key in the
+//! order of the file, one 64-bit draw `u` gives
+//! `min + (max − min)·(u >> 11)/2⁵³`, uniform in `[min, max)`. The
+//! sequence depends only on the seed, so every shard draws the same runs.
+
+use std::collections::BTreeMap;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Mutex, OnceLock};
+use std::time::{Duration, Instant};
+
+use clap::{Args, Subcommand};
+use serde::{Deserialize, Serialize};
+
+use crate::CliError;
+use crate::config::{self, Config, Override};
+
+/// The fixed columns of `index.csv` after `run, status` and the varied
+/// keys.
+pub const COLUMNS: [&str; 12] = [
+    "touchdown3",
+    "touchdown4",
+    "slip3",
+    "slip4",
+    "peak_n3",
+    "peak_n4",
+    "peak_fa3",
+    "peak_fa4",
+    "peak_joint_force",
+    "steps",
+    "wall_seconds",
+    "error",
+];
+
+/// Columns `--plot` accepts: the numeric columns of `index.csv` and
+/// `touchdown`, the first touchdown of either tip (the default).
+pub const PLOT_COLUMNS: [&str; 12] = [
+    "touchdown",
+    "touchdown3",
+    "touchdown4",
+    "slip3",
+    "slip4",
+    "peak_n3",
+    "peak_n4",
+    "peak_fa3",
+    "peak_fa4",
+    "peak_joint_force",
+    "steps",
+    "wall_seconds",
+];
+
+/// Marker written in a run directory after all its files.
+const DONE: &str = ".done";
+
+/// Arguments of `fbd sweep`.
+#[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct SweepArgs {
+    /// `fbd sweep merge DIR... --out DIR`.
+    #[command(subcommand)]
+    pub command: Option<SweepCommand>,
+    /// The sweep file (TOML: base, mode, samples, seed, [vary]).
+    #[arg(value_name = "SWEEP", required = true)]
+    pub sweep: Option<PathBuf>,
+    /// Output directory, created if needed.
+    #[arg(short, long, value_name = "DIR", default_value = "sweep")]
+    pub out: PathBuf,
+    /// Runs at a time (default: every core).
+    #[arg(short, long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// Run only the indices with `index % N == I` (0 ≤ I < N).
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+    /// Skip runs whose directory holds a finished run with status ok.
+    #[arg(long)]
+    pub resume: bool,
+    /// Column of index.csv plotted in sweep.svg (default: touchdown, the
+    /// first touchdown of either tip).
+    #[arg(long, value_name = "COLUMN", default_value = "touchdown")]
+    pub plot: String,
+}
+
+/// Subcommands of `fbd sweep`.
+#[derive(Debug, Subcommand)]
+pub enum SweepCommand {
+    /// Combine shard directories into one (runs/<i>, one index.csv) and
+    /// report missing runs.
+    Merge(MergeArgs),
+}
+
+/// Arguments of `fbd sweep merge`.
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// Shard output directories.
+    #[arg(value_name = "DIR", required = true)]
+    pub dirs: Vec<PathBuf>,
+    /// The merged directory, created if needed.
+    #[arg(short, long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Column plotted in the merged sweep.svg.
+    #[arg(long, value_name = "COLUMN", default_value = "touchdown")]
+    pub plot: String,
+}
+
+/// How the varied values combine into runs.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// Cartesian product, the first key varying slowest.
+    #[default]
+    Grid,
+    /// The i-th value of every list (equal lengths).
+    Zip,
+    /// `samples` draws, uniform in each key's `{ min, max }`.
+    Random,
+}
+
+/// A `[vary]` table in the order of the file.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Vary(pub Vec<(String, toml::Value)>);
+
+impl<'de> Deserialize<'de> for Vary {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Vary;
+            fn expecting(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str("a table of dotted configuration keys")
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, mut m: A) -> Result<Vary, A::Error> {
+                // The deserializer may visit keys sorted: restore the
+                // order of the file from the spans.
+                let mut v = Vec::new();
+                while let Some((k, val)) = m.next_entry::<String, toml::Spanned<toml::Value>>()? {
+                    v.push((val.span().start, k, val.into_inner()));
+                }
+                v.sort_by_key(|e| e.0);
+                let v = v.into_iter().map(|(_, k, val)| (k, val)).collect();
+                Ok(Vary(v))
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
+/// The sweep file.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepFile {
+    /// Base configuration, relative to the sweep file; none = built-in
+    /// default.
+    pub base: Option<String>,
+    /// grid | zip | random.
+    #[serde(default)]
+    pub mode: Mode,
+    /// Number of runs (random only).
+    pub samples: Option<usize>,
+    /// PRNG seed (random only, default 0).
+    pub seed: Option<u64>,
+    /// Dotted keys and their values.
+    #[serde(default)]
+    pub vary: Vary,
+}
+
+/// splitmix64: a tiny deterministic PRNG.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+fn as_f64(v: &toml::Value) -> Option<f64> {
+    match v {
+        toml::Value::Float(f) => Some(*f),
+        toml::Value::Integer(i) => Some(*i as f64),
+        _ => None,
+    }
+}
+
+/// A varied value as written in `index.csv`: floats always with a decimal
+/// point, arrays as `[0.0, 0.5]`.
+pub fn format_value(v: &toml::Value) -> String {
+    match v {
+        toml::Value::Float(f) => format!("{f:?}"),
+        toml::Value::Integer(i) => i.to_string(),
+        toml::Value::String(s) => s.clone(),
+        toml::Value::Boolean(b) => b.to_string(),
+        toml::Value::Array(a) => {
+            let items: Vec<String> = a.iter().map(format_value).collect();
+            format!("[{}]", items.join(", "))
+        }
+        other => other.to_string(),
+    }
+}
+
+/// Expands the sweep into the varied values of every run.
+pub fn expand(s: &SweepFile, file: &str) -> Result<Vec<Vec<toml::Value>>, String> {
+    let keys = &s.vary.0;
+    let bad = |msg: String| format!("{file}: {msg}");
+    if keys.is_empty() {
+        return Err(bad("[vary] names no key".into()));
+    }
+    if s.mode != Mode::Random && (s.samples.is_some() || s.seed.is_some()) {
+        return Err(bad(
+            "`samples` and `seed` apply to mode = \"random\" only".into()
+        ));
+    }
+    let lists = || -> Result<Vec<&Vec<toml::Value>>, String> {
+        keys.iter()
+            .map(|(k, v)| match v {
+                toml::Value::Array(a) if !a.is_empty() => Ok(a),
+                _ => Err(bad(format!(
+                    "vary.\"{k}\": expected a non-empty list of values (mode = \"{}\")",
+                    mode_str(s.mode)
+                ))),
+            })
+            .collect()
+    };
+    match s.mode {
+        Mode::Grid => {
+            let lists = lists()?;
+            let total: usize = lists.iter().map(|l| l.len()).product();
+            Ok((0..total)
+                .map(|mut i| {
+                    let mut row = vec![toml::Value::Boolean(false); lists.len()];
+                    for (slot, l) in row.iter_mut().zip(&lists).rev() {
+                        *slot = l[i % l.len()].clone();
+                        i /= l.len();
+                    }
+                    row
+                })
+                .collect())
+        }
+        Mode::Zip => {
+            let lists = lists()?;
+            let n = lists[0].len();
+            if let Some((k, l)) = keys.iter().zip(&lists).find(|(_, l)| l.len() != n) {
+                return Err(bad(format!(
+                    "vary.\"{}\": {} values, but vary.\"{}\" has {n} (mode = \"zip\" needs equal lengths)",
+                    k.0,
+                    l.len(),
+                    keys[0].0
+                )));
+            }
+            Ok((0..n)
+                .map(|i| lists.iter().map(|l| l[i].clone()).collect())
+                .collect())
+        }
+        Mode::Random => {
+            let samples = s
+                .samples
+                .ok_or_else(|| bad("mode = \"random\" needs `samples`".into()))?;
+            let mut ranges = Vec::new();
+            for (k, v) in keys {
+                let range = v.as_table().and_then(|t| {
+                    (t.len() == 2)
+                        .then(|| Some((as_f64(t.get("min")?)?, as_f64(t.get("max")?)?)))
+                        .flatten()
+                });
+                match range {
+                    Some((lo, hi)) if lo.is_finite() && hi.is_finite() && lo <= hi => {
+                        ranges.push((lo, hi));
+                    }
+                    _ => {
+                        return Err(bad(format!(
+                            "vary.\"{k}\": expected {{ min = X, max = Y }} with finite X <= Y (mode = \"random\")"
+                        )));
+                    }
+                }
+            }
+            let mut rng = SplitMix64(s.seed.unwrap_or(0));
+            Ok((0..samples)
+                .map(|_| {
+                    ranges
+                        .iter()
+                        .map(|(lo, hi)| toml::Value::Float(lo + (hi - lo) * rng.unit()))
+                        .collect()
+                })
+                .collect())
+        }
+    }
+}
+
+fn mode_str(m: Mode) -> &'static str {
+    match m {
+        Mode::Grid => "grid",
+        Mode::Zip => "zip",
+        Mode::Random => "random",
+    }
+}
+
+/// `DIR/sweep.json`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SweepJson {
+    /// The sweep file as given.
+    pub sweep_file: String,
+    /// The definition (base resolved relative to the sweep file).
+    pub definition: serde_json::Value,
+    /// The varied keys, in order.
+    pub keys: Vec<String>,
+    /// Number of runs of the whole sweep (all shards).
+    pub total_runs: usize,
+    /// `[I, N]` of this directory's shard; `null` for a whole sweep or a
+    /// merge.
+    pub shard: Option<[usize; 2]>,
+    /// The varied values of every run (as in index.csv), by index.
+    pub runs: Vec<Vec<String>>,
+}
+
+/// One row of `index.csv`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Row {
+    /// Global run index.
+    pub run: usize,
+    /// "ok" or "error".
+    pub status: String,
+    /// The varied values, formatted ([`format_value`]).
+    pub values: Vec<String>,
+    /// [`COLUMNS`] `touchdown3` … `wall_seconds`, `None` = empty.
+    pub numbers: [Option<f64>; 11],
+    /// The error message ("" when ok).
+    pub error: String,
+}
+
+impl Row {
+    /// A plotted column of this row (see [`PLOT_COLUMNS`]).
+    pub fn column(&self, name: &str) -> Option<f64> {
+        if name == "touchdown" {
+            return match (self.numbers[0], self.numbers[1]) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
+        }
+        COLUMNS[..11]
+            .iter()
+            .position(|c| *c == name)
+            .and_then(|i| self.numbers[i])
+    }
+}
+
+fn fmt_num(v: Option<f64>) -> String {
+    v.map(|x| x.to_string()).unwrap_or_default()
+}
+
+/// Writes `index.csv` (rows sorted by run).
+pub fn write_index(dir: &Path, keys: &[String], rows: &[Row]) -> Result<(), CliError> {
+    let mut rows: Vec<&Row> = rows.iter().collect();
+    rows.sort_by_key(|r| r.run);
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let io = |e: csv::Error| CliError::Io(format!("index.csv: {e}"));
+    let mut header = vec!["run".to_owned(), "status".to_owned()];
+    header.extend(keys.iter().cloned());
+    header.extend(COLUMNS.iter().map(|s| (*s).to_owned()));
+    w.write_record(&header).map_err(io)?;
+    for r in rows {
+        let mut rec = vec![r.run.to_string(), r.status.clone()];
+        rec.extend(r.values.iter().cloned());
+        rec.extend(r.numbers.iter().enumerate().map(|(i, v)| {
+            if i == 9 {
+                v.map(|s| (s as u64).to_string()).unwrap_or_default()
+            } else {
+                fmt_num(*v)
+            }
+        }));
+        rec.push(r.error.clone());
+        w.write_record(&rec).map_err(io)?;
+    }
+    let bytes = w
+        .into_inner()
+        .map_err(|e| CliError::Io(format!("index.csv: {e}")))?;
+    crate::output::write_file(dir, "index.csv", &bytes).map(drop)
+}
+
+/// Reads `index.csv` back (for `merge`).
+pub fn read_index(path: &Path, nkeys: usize) -> Result<Vec<Row>, CliError> {
+    let mut r = csv::Reader::from_path(path)
+        .map_err(|e| CliError::Io(format!("{}: {e}", path.display())))?;
+    let mut rows = Vec::new();
+    for rec in r.records() {
+        let rec = rec.map_err(|e| CliError::Io(format!("{}: {e}", path.display())))?;
+        let bad = || CliError::Io(format!("{}: malformed row", path.display()));
+        if rec.len() != 2 + nkeys + 12 {
+            return Err(bad());
+        }
+        let mut numbers = [None; 11];
+        for (i, n) in numbers.iter_mut().enumerate() {
+            let s = &rec[2 + nkeys + i];
+            *n = if s.is_empty() {
+                None
+            } else {
+                Some(s.parse().map_err(|_| bad())?)
+            };
+        }
+        rows.push(Row {
+            run: rec[0].parse().map_err(|_| bad())?,
+            status: rec[1].to_owned(),
+            values: (0..nkeys).map(|i| rec[2 + i].to_owned()).collect(),
+            numbers,
+            error: rec[2 + nkeys + 11].to_owned(),
+        });
+    }
+    Ok(rows)
+}
+
+/// The row of a finished run, from its `summary.json`.
+fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> {
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let s: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let num = |v: &serde_json::Value| v.as_f64();
+    let numbers = [
+        num(&s["first_touchdown"]["leg3"]),
+        num(&s["first_touchdown"]["leg4"]),
+        num(&s["first_slip"]["leg3"]),
+        num(&s["first_slip"]["leg4"]),
+        num(&s["peak_contact_force"]["tip3"]["n"]),
+        num(&s["peak_contact_force"]["tip4"]["n"]),
+        num(&s["peak_contact_force"]["tip3"]["fa"]),
+        num(&s["peak_contact_force"]["tip4"]["fa"]),
+        num(&s["peak_joint_force_max"]),
+        num(&s["steps"]),
+        num(&s["wall_seconds"]),
+    ];
+    Some(Row {
+        run,
+        status: s["status"].as_str().unwrap_or("error").to_owned(),
+        values,
+        numbers,
+        error: s["error"].as_str().unwrap_or("").replace('\n', " "),
+    })
+}
+
+/// A finished run with status ok whose config.toml is the one planned
+/// (so `--resume` after editing the sweep file reruns what changed).
+fn is_done_ok(dir: &Path, run: usize, config: &Config) -> Option<Row> {
+    if !dir.join(DONE).is_file()
+        || std::fs::read(dir.join("config.toml")).ok()? != config.to_toml().as_bytes()
+    {
+        return None;
+    }
+    row_from_summary(dir, run, Vec::new()).filter(|r| r.status == "ok")
+}
+
+fn parse_shard(s: &str) -> Result<(usize, usize), CliError> {
+    let bad = || {
+        CliError::Usage(format!(
+            "--shard {s}: expected I/N with 0 <= I < N, e.g. 0/8"
+        ))
+    };
+    let (i, n) = s.split_once('/').ok_or_else(bad)?;
+    let (i, n): (usize, usize) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
+    if n == 0 || i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+/// A loaded, validated sweep: the configuration of every run.
+pub struct Plan {
+    /// The sweep file's definition.
+    pub file: SweepFile,
+    /// Varied keys in order.
+    pub keys: Vec<String>,
+    /// Per run: the varied values.
+    pub values: Vec<Vec<toml::Value>>,
+    /// Per run: the complete configuration.
+    pub configs: Vec<Config>,
+}
+
+/// Reads the sweep file, expands it and validates every run's
+/// configuration (errors name the run and the key).
+pub fn plan(path: &Path) -> Result<Plan, CliError> {
+    let name = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        CliError::Config(config::ConfigError::Unreadable {
+            file: name.clone(),
+            what: e.to_string(),
+        })
+    })?;
+    let mut file: SweepFile = toml::from_str(&text).map_err(|e| {
+        let at = e.span().map_or(String::new(), |sp| {
+            let before = &text[..sp.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
+            format!(":{line}:{col}")
+        });
+        CliError::Usage(format!(
+            "{name}{at}: {}",
+            e.message().trim().replace('\n', "; ")
+        ))
+    })?;
+    let values = expand(&file, &name).map_err(CliError::Usage)?;
+    let keys: Vec<String> = file.vary.0.iter().map(|(k, _)| k.clone()).collect();
+    let (base_text, base_name) = match &file.base {
+        Some(b) => {
+            let p = path.parent().unwrap_or(Path::new("")).join(b);
+            let t = std::fs::read_to_string(&p).map_err(|e| {
+                CliError::Config(config::ConfigError::Unreadable {
+                    file: p.display().to_string(),
+                    what: format!("base of {name}: {e}"),
+                })
+            })?;
+            // Record the resolved base so sweep.json is self-describing.
+            file.base = Some(p.display().to_string());
+            (t, p.display().to_string())
+        }
+        None => (String::new(), "the built-in default".to_owned()),
+    };
+    let mut configs = Vec::with_capacity(values.len());
+    for (i, vals) in values.iter().enumerate() {
+        let overrides: Vec<Override> = keys
+            .iter()
+            .zip(vals)
+            .map(|(k, v)| Override::new(k.clone(), v.clone()))
+            .collect();
+        let what = || {
+            keys.iter()
+                .zip(vals)
+                .map(|(k, v)| format!("{k} = {}", format_value(v)))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let fail = |e: String| CliError::Usage(format!("{name}: run {i} ({}): {e}", what()));
+        let c = config::parse_str(&base_text, &base_name, &overrides)
+            .map_err(|e| fail(e.to_string()))?;
+        match &c {
+            Config::Planar(p) => {
+                p.model(&base_name).map_err(|e| fail(e.to_string()))?;
+            }
+            Config::Hexapod(_) => {
+                return Err(fail(
+                    "model = \"hexapod\": `fbd run` does not simulate hexapods yet".into(),
+                ));
+            }
+        }
+        configs.push(c);
+    }
+    Ok(Plan {
+        file,
+        keys,
+        values,
+        configs,
+    })
+}
+
+/// Set by Ctrl-C: workers take no new run.
+fn stop_flag() -> &'static AtomicBool {
+    static STOP: OnceLock<AtomicBool> = OnceLock::new();
+    STOP.get_or_init(|| {
+        // Install once; a second Ctrl-C while stopping exits at once.
+        let _ = ctrlc::set_handler(|| {
+            let stop = STOP.get().expect("initialised before the handler");
+            if stop.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+            eprintln!("\ninterrupted: finishing the runs in progress (Ctrl-C again to quit now)");
+        });
+        AtomicBool::new(false)
+    })
+}
+
+/// Progress on stderr: an indicatif bar on a terminal, otherwise a line
+/// every 10 % or every 5 s.
+struct Progress {
+    bar: Option<indicatif::ProgressBar>,
+    total: usize,
+    done: usize,
+    failed: usize,
+    start: Instant,
+    last_line: Instant,
+    last_decile: usize,
+}
+
+impl Progress {
+    fn new(total: usize) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let b = indicatif::ProgressBar::new(total as u64);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{bar:40} {pos}/{len} runs  {msg}  elapsed {elapsed}  ETA {eta}",
+            ) {
+                b.set_style(style);
+            }
+            b.set_message("0 failed");
+            b
+        });
+        Self {
+            bar,
+            total,
+            done: 0,
+            failed: 0,
+            start: Instant::now(),
+            last_line: Instant::now(),
+            last_decile: 0,
+        }
+    }
+
+    fn tick(&mut self, ok: bool) {
+        self.done += 1;
+        self.failed += usize::from(!ok);
+        if let Some(b) = &self.bar {
+            b.set_message(format!("{} failed", self.failed));
+            b.inc(1);
+            return;
+        }
+        let decile = self.done * 10 / self.total.max(1);
+        let now = Instant::now();
+        if decile > self.last_decile
+            || now.duration_since(self.last_line) >= Duration::from_secs(5)
+            || self.done == self.total
+        {
+            self.last_decile = decile;
+            self.last_line = now;
+            let el = now.duration_since(self.start).as_secs_f64();
+            let eta = el / self.done as f64 * (self.total - self.done) as f64;
+            eprintln!(
+                "sweep: {}/{} runs, {} failed, {el:.1} s elapsed, ETA {eta:.0} s",
+                self.done, self.total, self.failed
+            );
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish();
+        }
+    }
+}
+
+/// Runs one sweep entry into `dir`: config.toml first, then `fbd run` of
+/// it (so the files are those of `fbd run dir/config.toml`), then `.done`.
+fn run_one(dir: &Path, config: &Config, run: usize, values: Vec<String>) -> Row {
+    let fail = |msg: String| Row {
+        run,
+        status: "error".into(),
+        values: values.clone(),
+        error: msg.replace('\n', " "),
+        ..Row::default()
+    };
+    if dir.exists()
+        && let Err(e) = std::fs::remove_dir_all(dir)
+    {
+        return fail(format!("{}: cannot clear: {e}", dir.display()));
+    }
+    if let Err(e) = crate::output::prepare_dir(dir)
+        .and_then(|()| crate::output::write_file(dir, "config.toml", config.to_toml().as_bytes()))
+    {
+        return fail(e.to_string());
+    }
+    let cfg = dir.join("config.toml");
+    let result =
+        std::panic::catch_unwind(|| crate::run::run_command(Some(&cfg), dir, &mut std::io::sink()));
+    let err = match result {
+        Ok(Ok(())) => None,
+        Ok(Err(e)) => Some(e.to_string()),
+        Err(_) => Some("internal error (panic)".to_owned()),
+    };
+    let row = match row_from_summary(dir, run, values.clone()) {
+        Some(mut r) => {
+            if let Some(e) = err {
+                r.status = "error".into();
+                if r.error.is_empty() {
+                    r.error = e.replace('\n', " ");
+                }
+            }
+            r
+        }
+        None => fail(err.unwrap_or_else(|| "summary.json missing".into())),
+    };
+    if let Err(e) = std::fs::write(dir.join(DONE), b"") {
+        return fail(format!("{}: {e}", dir.join(DONE).display()));
+    }
+    row
+}
+
+fn write_json(dir: &Path, name: &str, v: &impl Serialize) -> Result<(), CliError> {
+    let j = serde_json::to_string_pretty(v).map_err(|e| CliError::Io(format!("{name}: {e}")))?;
+    crate::output::write_file(dir, name, format!("{j}\n").as_bytes()).map(drop)
+}
+
+/// Writes `sweep.svg`, or says why not on `out`.
+fn write_plot(
+    dir: &Path,
+    keys: &[String],
+    rows: &[Row],
+    column: &str,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    match crate::sweep_plot::sweep_svg(keys, rows, column) {
+        Ok(svg) => crate::output::write_file(dir, "sweep.svg", svg.as_bytes()).map(drop),
+        Err(why) => writeln!(out, "sweep.svg not written: {why}").map_err(CliError::stdout),
+    }
+}
+
+fn check_plot_column(c: &str) -> Result<(), CliError> {
+    if PLOT_COLUMNS.contains(&c) {
+        Ok(())
+    } else {
+        Err(CliError::Usage(format!(
+            "--plot {c}: unknown column (expected one of {})",
+            PLOT_COLUMNS.join(", ")
+        )))
+    }
+}
+
+/// `fbd sweep …` and `fbd sweep merge …`.
+pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    if let Some(SweepCommand::Merge(m)) = a.command {
+        return merge_command(&m, out);
+    }
+    let Some(path) = a.sweep.as_deref() else {
+        return Err(CliError::Usage("fbd sweep: missing the SWEEP file".into()));
+    };
+    check_plot_column(&a.plot)?;
+    let (shard_i, shard_n) = a.shard.as_deref().map_or(Ok((0, 1)), parse_shard)?;
+    let jobs = match a.jobs {
+        Some(0) => return Err(CliError::Usage("--jobs 0: expected at least 1".into())),
+        Some(j) => j,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    let plan = plan(path)?;
+    let total = plan.configs.len();
+    let dir = &a.out;
+    crate::output::prepare_dir(&dir.join("runs"))?;
+    let formatted: Vec<Vec<String>> = plan
+        .values
+        .iter()
+        .map(|v| v.iter().map(format_value).collect())
+        .collect();
+    write_json(
+        dir,
+        "sweep.json",
+        &SweepJson {
+            sweep_file: path.display().to_string(),
+            definition: serde_json::to_value(&plan.file)
+                .map_err(|e| CliError::Io(format!("sweep.json: {e}")))?,
+            keys: plan.keys.clone(),
+            total_runs: total,
+            shard: a.shard.as_ref().map(|_| [shard_i, shard_n]),
+            runs: formatted.clone(),
+        },
+    )?;
+
+    let mine: Vec<usize> = (0..total).filter(|i| i % shard_n == shard_i).collect();
+    let mut rows: Vec<Row> = Vec::new();
+    let mut todo = Vec::new();
+    for &i in &mine {
+        let rd = dir.join("runs").join(i.to_string());
+        match a
+            .resume
+            .then(|| is_done_ok(&rd, i, &plan.configs[i]))
+            .flatten()
+        {
+            Some(mut r) => {
+                r.values = formatted[i].clone();
+                rows.push(r);
+            }
+            None => todo.push(i),
+        }
+    }
+    let skipped = rows.len();
+    let stop = stop_flag();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.min(todo.len().max(1)))
+        .build()
+        .map_err(|e| CliError::Io(format!("thread pool: {e}")))?;
+    let next = AtomicUsize::new(0);
+    let results = Mutex::new(Vec::with_capacity(todo.len()));
+    let progress = Mutex::new(Progress::new(todo.len()));
+    pool.scope(|s| {
+        for _ in 0..pool.current_num_threads() {
+            s.spawn(|_| {
+                loop {
+                    if stop.load(Ordering::SeqCst) {
+                        break;
+                    }
+                    let k = next.fetch_add(1, Ordering::SeqCst);
+                    let Some(&i) = todo.get(k) else { break };
+                    let rd = dir.join("runs").join(i.to_string());
+                    let row = run_one(&rd, &plan.configs[i], i, formatted[i].clone());
+                    let ok = row.status == "ok";
+                    if let Ok(mut r) = results.lock() {
+                        r.push(row);
+                    }
+                    if let Ok(mut p) = progress.lock() {
+                        p.tick(ok);
+                    }
+                }
+            });
+        }
+    });
+    if let Ok(p) = progress.lock() {
+        p.finish();
+    }
+    let ran = results.into_inner().unwrap_or_default();
+    let ran_n = ran.len();
+    rows.extend(ran);
+    rows.sort_by_key(|r| r.run);
+    write_index(dir, &plan.keys, &rows)?;
+    write_plot(dir, &plan.keys, &rows, &a.plot, out)?;
+
+    let failed: Vec<usize> = rows
+        .iter()
+        .filter(|r| r.status != "ok")
+        .map(|r| r.run)
+        .collect();
+    let shard_txt = if shard_n > 1 {
+        format!(", shard {shard_i}/{shard_n}: {} runs", mine.len())
+    } else {
+        String::new()
+    };
+    writeln!(
+        out,
+        "sweep: {total} runs{shard_txt}; ran {ran_n}, skipped {skipped} finished; {} ok, {} failed\nfiles in {}: index.csv sweep.json sweep.svg runs/",
+        rows.len() - failed.len(),
+        failed.len(),
+        dir.display()
+    )
+    .map_err(CliError::stdout)?;
+    let interrupted = stop.load(Ordering::SeqCst);
+    if interrupted {
+        return Err(CliError::Simulation(format!(
+            "interrupted: {} of {} runs finished (index.csv lists them); `--resume` continues",
+            rows.len(),
+            mine.len()
+        )));
+    }
+    if !failed.is_empty() {
+        let list: Vec<String> = failed.iter().take(10).map(ToString::to_string).collect();
+        return Err(CliError::Simulation(format!(
+            "{} of {} runs failed (runs {}{}); see the error column of {}",
+            failed.len(),
+            rows.len(),
+            list.join(", "),
+            if failed.len() > 10 { ", …" } else { "" },
+            dir.join("index.csv").display()
+        )));
+    }
+    Ok(())
+}
+
+fn copy_dir(from: &Path, to: &Path) -> std::io::Result<()> {
+    std::fs::create_dir_all(to)?;
+    for e in std::fs::read_dir(from)? {
+        let e = e?;
+        let dest = to.join(e.file_name());
+        if e.file_type()?.is_dir() {
+            copy_dir(&e.path(), &dest)?;
+        } else {
+            std::fs::copy(e.path(), dest)?;
+        }
+    }
+    Ok(())
+}
+
+/// `fbd sweep merge DIR... --out DIR`.
+pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError> {
+    check_plot_column(&m.plot)?;
+    let mut first: Option<SweepJson> = None;
+    let mut rows: BTreeMap<usize, Row> = BTreeMap::new();
+    let mut sources: BTreeMap<usize, PathBuf> = BTreeMap::new();
+    for d in &m.dirs {
+        let p = d.join("sweep.json");
+        let text = std::fs::read_to_string(&p).map_err(|e| CliError::io(p.display(), &e))?;
+        let j: SweepJson = serde_json::from_str(&text)
+            .map_err(|e| CliError::Io(format!("{}: {e}", p.display())))?;
+        match &first {
+            None => first = Some(j.clone()),
+            Some(f) => {
+                if f.total_runs != j.total_runs || f.keys != j.keys || f.runs != j.runs {
+                    return Err(CliError::Usage(format!(
+                        "{}: not a shard of the same sweep as {}",
+                        d.display(),
+                        m.dirs[0].display()
+                    )));
+                }
+            }
+        }
+        let idx = d.join("index.csv");
+        if !idx.exists() {
+            continue;
+        }
+        for r in read_index(&idx, j.keys.len())? {
+            sources.insert(r.run, d.clone());
+            rows.insert(r.run, r);
+        }
+    }
+    let Some(mut j) = first else {
+        return Err(CliError::Usage("merge: no directory given".into()));
+    };
+    crate::output::prepare_dir(&m.out.join("runs"))?;
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(x), Ok(y)) => x == y,
+        _ => false,
+    };
+    for (run, src) in &sources {
+        if same(src, &m.out) {
+            continue;
+        }
+        let from = src.join("runs").join(run.to_string());
+        let to = m.out.join("runs").join(run.to_string());
+        if to.exists() {
+            std::fs::remove_dir_all(&to).map_err(|e| CliError::io(to.display(), &e))?;
+        }
+        copy_dir(&from, &to).map_err(|e| CliError::io(from.display(), &e))?;
+    }
+    let rows: Vec<Row> = rows.into_values().collect();
+    j.shard = None;
+    write_json(&m.out, "sweep.json", &j)?;
+    write_index(&m.out, &j.keys, &rows)?;
+    write_plot(&m.out, &j.keys, &rows, &m.plot, out)?;
+    let missing: Vec<usize> = (0..j.total_runs)
+        .filter(|i| rows.binary_search_by_key(i, |r| r.run).is_err())
+        .collect();
+    let failed = rows.iter().filter(|r| r.status != "ok").count();
+    writeln!(
+        out,
+        "merged {} of {} runs from {} directories into {} ({failed} failed, {} missing)",
+        rows.len(),
+        j.total_runs,
+        m.dirs.len(),
+        m.out.display(),
+        missing.len()
+    )
+    .map_err(CliError::stdout)?;
+    if !missing.is_empty() {
+        let list: Vec<String> = missing.iter().take(20).map(ToString::to_string).collect();
+        return Err(CliError::Simulation(format!(
+            "{} of {} runs missing: {}{} (run their shards again with --resume)",
+            missing.len(),
+            j.total_runs,
+            list.join(", "),
+            if missing.len() > 20 { ", …" } else { "" }
+        )));
+    }
+    Ok(())
+}

@@ -1,0 +1,181 @@
+//! `sweep.svg`: one column of `index.csv` against the varied keys.
+//!
+//! The x axis is the first varied key with numeric values: a number, or an
+//! array in which exactly one component varies across the runs (e.g.
+//! `initial.position = [0.0, h]` plots against `h`, labelled
+//! `initial.position[1]`). Every combination of the other keys is one
+//! line (for two keys: one line per value of the other key). Runs with an
+//! empty cell in the column are left out.
+
+use plotters::prelude::*;
+
+use crate::sweep::Row;
+
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+fn err<E: std::fmt::Debug>(e: E) -> String {
+    format!("plotting failed: {e:?}")
+}
+
+/// Numbers of a formatted value: `0.4` → `[0.4]`, `[0.0, 0.5]` →
+/// `[0.0, 0.5]`; `None` when anything is not a number.
+fn numbers(v: &str) -> Option<Vec<f64>> {
+    let inner = v
+        .trim()
+        .strip_prefix('[')
+        .and_then(|s| s.strip_suffix(']'))
+        .unwrap_or(v);
+    inner
+        .split(',')
+        .map(|s| s.trim().parse::<f64>().ok().filter(|x| x.is_finite()))
+        .collect()
+}
+
+/// The x values of key `k` and its axis label, when numeric.
+fn numeric_view(key: &str, k: usize, rows: &[Row]) -> Option<(String, Vec<f64>)> {
+    let nums: Vec<Vec<f64>> = rows
+        .iter()
+        .map(|r| numbers(r.values.get(k)?))
+        .collect::<Option<_>>()?;
+    let len = nums.first()?.len();
+    if nums.iter().any(|n| n.len() != len) {
+        return None;
+    }
+    let scalar = !rows[0].values[k].trim_start().starts_with('[');
+    if scalar {
+        return Some((key.to_owned(), nums.iter().map(|n| n[0]).collect()));
+    }
+    let varying: Vec<usize> = (0..len)
+        .filter(|&c| nums.iter().any(|n| n[c] != nums[0][c]))
+        .collect();
+    match varying.as_slice() {
+        [c] => Some((format!("{key}[{c}]"), nums.iter().map(|n| n[*c]).collect())),
+        [] if len == 1 => Some((format!("{key}[0]"), nums.iter().map(|n| n[0]).collect())),
+        _ => None,
+    }
+}
+
+fn tick(v: &f64) -> String {
+    let v = if v.abs() < 1e-12 { 0.0 } else { *v };
+    let s = format!("{v:.6}");
+    s.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > hi {
+        return (0.0, 1.0);
+    }
+    let pad = if hi > lo {
+        0.05 * (hi - lo)
+    } else {
+        0.5 * lo.abs().max(1e-3)
+    };
+    (lo - pad, hi + pad)
+}
+
+/// The SVG, or why there is none (no numeric key, no value to plot).
+pub fn sweep_svg(keys: &[String], rows: &[Row], column: &str) -> Result<String, String> {
+    if rows.is_empty() {
+        return Err("no finished run".into());
+    }
+    let Some((xk, (x_label, xs))) = keys
+        .iter()
+        .enumerate()
+        .find_map(|(k, key)| numeric_view(key, k, rows).map(|v| (k, v)))
+    else {
+        return Err("no varied key has numeric values".into());
+    };
+    // Group by the other keys, in order of first appearance.
+    let mut groups: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for (r, &x) in rows.iter().zip(&xs) {
+        let label: Vec<String> = keys
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| *k != xk)
+            .map(|(k, key)| format!("{key} = {}", r.values.get(k).map_or("", String::as_str)))
+            .collect();
+        let label = label.join(", ");
+        let Some(y) = r.column(column) else { continue };
+        match groups.iter_mut().find(|g| g.0 == label) {
+            Some(g) => g.1.push((x, y)),
+            None => groups.push((label, vec![(x, y)])),
+        }
+    }
+    if groups.is_empty() {
+        return Err(format!("column {column} is empty in every run"));
+    }
+    for g in &mut groups {
+        g.1.sort_by(|a, b| a.0.total_cmp(&b.0));
+    }
+    let (x0, x1) = range(groups.iter().flat_map(|g| g.1.iter().map(|p| p.0)));
+    let (y0, y1) = range(groups.iter().flat_map(|g| g.1.iter().map(|p| p.1)));
+    let y_desc = match column {
+        "touchdown" => "first touchdown (s)".to_owned(),
+        c if c.starts_with("touchdown") || c.starts_with("slip") || c == "wall_seconds" => {
+            format!("{c} (s)")
+        }
+        c if c.starts_with("peak") => format!("{c} (N)"),
+        c => c.to_owned(),
+    };
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, (960, 540)).into_drawing_area();
+        root.fill(&WHITE).map_err(err)?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(format!("{y_desc} vs {x_label}"), ("sans-serif", 22))
+            .margin(14)
+            .x_label_area_size(48)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label.as_str())
+            .y_desc(y_desc.as_str())
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .light_line_style(WHITE.mix(0.0))
+            .draw()
+            .map_err(err)?;
+        let labelled = groups.len() > 1 || !groups[0].0.is_empty();
+        for (i, (label, pts)) in groups.iter().enumerate() {
+            let color = PALETTE[i % PALETTE.len()];
+            let s = chart
+                .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
+                .map_err(err)?;
+            if labelled {
+                s.label(label.as_str()).legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+            }
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+                .map_err(err)?;
+        }
+        if labelled {
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::UpperRight)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(err)?;
+        }
+        root.present().map_err(err)?;
+    }
+    Ok(buf)
+}

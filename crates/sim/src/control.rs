@@ -1,0 +1,197 @@
+//! Joint controllers: the torques `FbdData::torque` applied at step `k`,
+//! computed explicitly from the state of step `k`.
+//!
+//! `τ = kp·(θ* − θ[k]) − kd·θ̇[k]`, with the backward-difference rate
+//! `θ̇[k] = (θ[k] − θ[k−1])/Δt` (the initial rate at `k = 0`), clamped to
+//! `±torque_limit`. A positive torque drives its joint angle towards larger
+//! values (see [`fbd_dynamics::JointSpec::axis_z`]). Joint order of the
+//! two-leg model: `[hip3, knee3, hip4, knee4]`, targets per leg `(θ2, θ3)`.
+
+use crate::{Data, Model};
+
+/// A joint-space target trajectory of one leg: `(θ2, θ3)` (rad) at `times`
+/// (s), linear in between, held before the first and after the last point.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LegTrajectory {
+    /// Strictly increasing times (s), at least one.
+    pub times: Vec<f64>,
+    /// `(θ2, θ3)` (rad) at each time.
+    pub targets: Vec<[f64; 2]>,
+}
+
+impl LegTrajectory {
+    /// The target at time `t`.
+    pub fn at(&self, t: f64) -> [f64; 2] {
+        let (ts, xs) = (&self.times, &self.targets);
+        let n = ts.len().min(xs.len());
+        if n == 0 {
+            return [0.0; 2];
+        }
+        if t <= ts[0] {
+            return xs[0];
+        }
+        if t >= ts[n - 1] {
+            return xs[n - 1];
+        }
+        let i = ts[..n].partition_point(|&s| s <= t) - 1;
+        let u = (t - ts[i]) / (ts[i + 1] - ts[i]);
+        [
+            xs[i][0] + u * (xs[i + 1][0] - xs[i][0]),
+            xs[i][1] + u * (xs[i + 1][1] - xs[i][1]),
+        ]
+    }
+}
+
+/// The joint controller of a planar run.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum Control {
+    /// Passive joints: no torque.
+    #[default]
+    None,
+    /// PD regulation to fixed joint angles.
+    Pd {
+        /// Stiffness (N·m/rad), ≥ 0.
+        kp: f64,
+        /// Damping (N·m·s/rad), ≥ 0.
+        kd: f64,
+        /// Saturation `|τ| ≤ limit` (N·m), > 0; `None` for no limit.
+        torque_limit: Option<f64>,
+        /// `(θ2, θ3)` targets (rad) of leg 3 and leg 4.
+        target: [[f64; 2]; 2],
+    },
+    /// PD tracking of a piecewise-linear joint trajectory per leg.
+    Trajectory {
+        /// Stiffness (N·m/rad), ≥ 0.
+        kp: f64,
+        /// Damping (N·m·s/rad), ≥ 0.
+        kd: f64,
+        /// Saturation `|τ| ≤ limit` (N·m), > 0; `None` for no limit.
+        torque_limit: Option<f64>,
+        /// Trajectories of leg 3 and leg 4.
+        legs: [LegTrajectory; 2],
+    },
+}
+
+impl Control {
+    /// `(kp, kd, limit)`, `None` for passive joints.
+    fn gains(&self) -> Option<(f64, f64, Option<f64>)> {
+        match self {
+            Control::None => None,
+            Control::Pd {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            }
+            | Control::Trajectory {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            } => Some((*kp, *kd, *torque_limit)),
+        }
+    }
+
+    /// `(θ2, θ3)` target (rad) of leg `leg` (0 = leg 3, 1 = leg 4) at `t`.
+    pub fn target(&self, leg: usize, t: f64) -> Option<[f64; 2]> {
+        match self {
+            Control::None => None,
+            Control::Pd { target, .. } => Some(target[leg]),
+            Control::Trajectory { legs, .. } => Some(legs[leg].at(t)),
+        }
+    }
+
+    /// Checks the parameters; `Err((key, what, got))` names the
+    /// configuration key at fault.
+    pub fn validate(&self) -> Result<(), (String, &'static str, String)> {
+        let Some((kp, kd, limit)) = self.gains() else {
+            return Ok(());
+        };
+        for (key, v) in [("control.kp", kp), ("control.kd", kd)] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err((key.into(), "must be finite and ≥ 0", v.to_string()));
+            }
+        }
+        if let Some(l) = limit
+            && !(l.is_finite() && l > 0.0)
+        {
+            return Err((
+                "control.torque_limit".into(),
+                "must be positive and finite",
+                l.to_string(),
+            ));
+        }
+        for (leg, name) in [(0, "leg3"), (1, "leg4")] {
+            match self {
+                Control::Pd { target, .. } => {
+                    if !target[leg].iter().all(|v| v.is_finite()) {
+                        return Err((
+                            format!("control.{name}.target_deg"),
+                            "must be finite",
+                            format!("{:?}", target[leg]),
+                        ));
+                    }
+                }
+                Control::Trajectory { legs, .. } => {
+                    let l = &legs[leg];
+                    if l.times.is_empty() || l.times.len() != l.targets.len() {
+                        return Err((
+                            format!("control.{name}.times"),
+                            "must be non-empty and as long as target_deg",
+                            format!("{} times, {} targets", l.times.len(), l.targets.len()),
+                        ));
+                    }
+                    if !l.times.iter().all(|v| v.is_finite())
+                        || l.times.windows(2).any(|w| w[1] <= w[0])
+                    {
+                        return Err((
+                            format!("control.{name}.times"),
+                            "must be finite and strictly increasing",
+                            format!("{:?}", l.times),
+                        ));
+                    }
+                    if !l.targets.iter().flatten().all(|v| v.is_finite()) {
+                        return Err((
+                            format!("control.{name}.target_deg"),
+                            "must be finite",
+                            format!("{:?}", l.targets),
+                        ));
+                    }
+                }
+                Control::None => {}
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Stage 2 of [`crate::step()`]: the joint torques of step `data.k` into
+/// `data.fbd.torque`, from `q[k]` and `q[k−1]` (explicit). No allocation.
+pub fn joint_torques(model: &Model, data: &mut Data) {
+    let control = &model.params.control;
+    let Some((kp, kd, limit)) = control.gains() else {
+        data.fbd.torque.fill(0.0);
+        return;
+    };
+    let dt = model.dt();
+    let t = data.k as f64 * dt;
+    let targets = [
+        control.target(0, t).unwrap_or_default(),
+        control.target(1, t).unwrap_or_default(),
+    ];
+    for (j, spec) in model.mech.joints.iter().enumerate() {
+        let i = spec.q_index;
+        // q = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄).
+        let target = targets[((i - 3) / 2).min(1)][(i - 3) % 2];
+        let rate = if data.k == 0 {
+            model.params.qdot0[i]
+        } else {
+            (data.q[i] - data.q_prev[i]) / dt
+        };
+        let mut tau = kp * (target - data.q[i]) - kd * rate;
+        if let Some(l) = limit {
+            tau = tau.clamp(-l, l);
+        }
+        data.fbd.torque[j] = tau;
+    }
+}

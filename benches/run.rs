@@ -29,6 +29,17 @@ fn bench(c: &mut Criterion) {
             black_box(s.steps)
         })
     });
+    // The whole default experiment (the paper's §6 fall), no output.
+    let paper = fbd_sim::Model::planar(&fbd_sim::PlanarParams::default()).unwrap();
+    c.bench_function("run/default_experiment", |b| {
+        b.iter(|| {
+            let s = fbd_sim::run(black_box(&paper), |r| {
+                black_box(r);
+            });
+            assert!(s.error.is_none());
+            black_box(s.steps)
+        })
+    });
 }
 
 criterion_group! {

@@ -10,7 +10,7 @@ mod common;
 use std::hint::black_box;
 use std::time::Duration;
 
-use common::{Case, warm_data};
+use common::{Case, prepared};
 use criterion::{Criterion, criterion_group, criterion_main};
 use fbd_dynamics::{JacobianSink, NoJacobian, eval, pattern};
 
@@ -31,9 +31,7 @@ impl JacobianSink for SlotSink<'_> {
 
 fn bench(c: &mut Criterion) {
     for case in Case::ALL {
-        let model = case.model();
-        let mut data = warm_data(&model, case);
-        fbd_sim::step::prepare(&model, &mut data);
+        let (model, mut data) = prepared(case);
         // Building the system sets the contact equations.
         let _ = fbd_sim::step::system(&model, &mut data);
         let mech = &model.mech;

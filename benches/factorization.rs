@@ -11,14 +11,12 @@ mod common;
 use std::hint::black_box;
 use std::time::Duration;
 
-use common::{Case, warm_data};
+use common::{Case, prepared};
 use criterion::{Criterion, criterion_group, criterion_main};
 
 fn bench(c: &mut Criterion) {
     for case in Case::ALL {
-        let model = case.model();
-        let mut data = warm_data(&model, case);
-        fbd_sim::step::prepare(&model, &mut data);
+        let (model, mut data) = prepared(case);
         let (mut sys, solver, z) = fbd_sim::step::system(&model, &mut data);
         let z = z.to_vec();
         solver.load_jacobian(&mut sys, &z);

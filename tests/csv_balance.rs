@@ -8,7 +8,6 @@ mod common;
 
 use common::physics::worst_body_imbalance;
 use fbd_contact::StateCode;
-use fbd_sim::record::{MAX_CONTACTS, MAX_JOINTS};
 use fbd_sim::{Model, PlanarParams, StepRecord};
 use std::path::Path;
 
@@ -52,22 +51,7 @@ fn read_rows(path: &Path) -> Vec<StepRecord> {
         .enumerate()
         .map(|(k, rec)| {
             let rec = rec.unwrap();
-            let mut r = StepRecord {
-                step: k,
-                t: f(&rec, "t"),
-                q: [0.0; 7],
-                contacts: 2,
-                point: [[0.0; 2]; MAX_CONTACTS],
-                state: [StateCode::St1; MAX_CONTACTS],
-                fa: [0.0; MAX_CONTACTS],
-                n: [0.0; MAX_CONTACTS],
-                joint_force: [[0.0; 2]; MAX_JOINTS],
-                torque: [0.0; MAX_JOINTS],
-                kinetic: 0.0,
-                potential: 0.0,
-                newton_iterations: 0,
-                state_trials: 0,
-            };
+            let mut r = StepRecord::zeroed(k, f(&rec, "t"), 2);
             for (i, c) in q_cols.iter().enumerate() {
                 r.q[i] = f(&rec, c);
             }

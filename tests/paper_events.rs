@@ -15,7 +15,7 @@ fn default_run_reproduces_the_papers_events() {
         summary
             .events
             .iter()
-            .find(|e| e.name == name && e.to == to)
+            .find(|e| format!("{}{}", e.point, e.leg) == name && e.to == to)
             .map(|e| (e.t, e.from))
     };
     let near = |a: f64, b: f64| (a - b).abs() < 1e-9;

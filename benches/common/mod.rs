@@ -116,6 +116,15 @@ pub fn warm_data(model: &Model, case: Case) -> Data {
     data
 }
 
+/// The case's model and a warm workspace whose next step is prepared
+/// (kinematics at k, torques, predictor): what the per-stage benches time.
+pub fn prepared(case: Case) -> (Model, Data) {
+    let model = case.model();
+    let mut data = warm_data(&model, case);
+    fbd_sim::step::prepare(&model, &mut data);
+    (model, data)
+}
+
 /// `iters` calls of [`step`], restarting from a fresh warm state every
 /// [`CHUNK`] steps (the restart is not timed). For `iter_custom`.
 pub fn time_steps(model: &Model, case: Case, iters: u64) -> Duration {

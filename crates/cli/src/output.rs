@@ -249,7 +249,7 @@ pub fn events_csv(events: &[Event]) -> String {
             e.leg,
             e.from.as_str(),
             e.to.as_str(),
-            point_kind(&e.name)
+            e.point
         ));
     }
     s
@@ -275,7 +275,7 @@ impl From<&Event> for EventJson {
         Self {
             t: e.t,
             leg: e.leg,
-            point: point_kind(&e.name).to_owned(),
+            point: e.point.to_owned(),
             from: e.from.as_str(),
             to: e.to.as_str(),
         }

@@ -4,6 +4,7 @@
 //! instants (`stance.svg`).
 
 use fbd_contact::Terrain;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 
 /// The structure at one instant (inertial x, y in metres).
@@ -41,7 +42,7 @@ pub struct PlotData {
 
 type PlotResult<T> = Result<T, String>;
 
-fn err<E: std::fmt::Debug>(e: E) -> String {
+pub(crate) fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("plotting failed: {e:?}")
 }
 
@@ -52,17 +53,38 @@ const LEG4_LIGHT: RGBColor = RGBColor(245, 140, 60);
 const EVENT: RGBColor = RGBColor(150, 150, 150);
 const GROUND: RGBColor = RGBColor(120, 85, 45);
 
-/// Finite min/max of `values`, widened when degenerate; `(0, 1)` when
-/// nothing is finite.
+/// The legend box every chart draws, upper right.
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
+/// A legend marker: a short horizontal line in `color`.
+pub(crate) fn legend_line(
+    color: RGBColor,
+    width: u32,
+) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(width))
+}
+
 /// Tick label without `-0` and with no more digits than needed.
-fn tick(v: &f64) -> String {
+pub(crate) fn tick(v: &f64) -> String {
     let v = if v.abs() < 1e-12 { 0.0 } else { *v };
     let s = format!("{v:.6}");
     let s = s.trim_end_matches('0').trim_end_matches('.');
     s.to_owned()
 }
 
-fn range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
+/// Finite min/max of `values`, widened when degenerate; `(0, 1)` when
+/// nothing is finite.
+pub(crate) fn range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for &v in values {
         if v.is_finite() {
@@ -149,17 +171,9 @@ fn time_chart(
                     .draw_series(LineSeries::new(points, style))
                     .map_err(err)?
             };
-            drawn.label(s.label).legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-            });
+            drawn.label(s.label).legend(legend_line(color, 2));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart)?;
         root.present().map_err(err)?;
     }
     Ok(buf)
@@ -350,17 +364,9 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
                 .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
                 .map_err(err)?
                 .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
+                .legend(legend_line(color, 2));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart)?;
         root.present().map_err(err)?;
     }
     Ok(buf)

@@ -133,7 +133,7 @@ impl Collector {
 fn first_time(run: &RunSummary, leg: usize, pred: impl Fn(&fbd_sim::Event) -> bool) -> Option<f64> {
     run.events
         .iter()
-        .find(|e| e.leg == leg && output::point_kind(&e.name) == "tip" && pred(e))
+        .find(|e| e.leg == leg && e.point == "tip" && pred(e))
         .map(|e| e.t)
 }
 
@@ -192,7 +192,7 @@ fn summary(
 /// One line per event: `t=0.190 s  leg 4  ST1 -> ST2` (the point is named
 /// when it is not the tip).
 pub fn event_line(e: &fbd_sim::Event) -> String {
-    let kind = output::point_kind(&e.name);
+    let kind = e.point;
     let point = if kind == "tip" {
         String::new()
     } else {

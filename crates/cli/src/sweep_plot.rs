@@ -9,6 +9,7 @@
 
 use plotters::prelude::*;
 
+use crate::plot::{draw_legend, err, legend_line, range, tick};
 use crate::sweep::Row;
 
 const PALETTE: [RGBColor; 8] = [
@@ -21,10 +22,6 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(227, 119, 194),
     RGBColor(127, 127, 127),
 ];
-
-fn err<E: std::fmt::Debug>(e: E) -> String {
-    format!("plotting failed: {e:?}")
-}
 
 /// Numbers of a formatted value: `0.4` → `[0.4]`, `[0.0, 0.5]` →
 /// `[0.0, 0.5]`; `None` when anything is not a number.
@@ -64,29 +61,6 @@ fn numeric_view(key: &str, k: usize, rows: &[Row]) -> Option<(String, Vec<f64>)>
     }
 }
 
-fn tick(v: &f64) -> String {
-    let v = if v.abs() < 1e-12 { 0.0 } else { *v };
-    let s = format!("{v:.6}");
-    s.trim_end_matches('0').trim_end_matches('.').to_owned()
-}
-
-fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values.filter(|v| v.is_finite()) {
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
-    if lo > hi {
-        return (0.0, 1.0);
-    }
-    let pad = if hi > lo {
-        0.05 * (hi - lo)
-    } else {
-        0.5 * lo.abs().max(1e-3)
-    };
-    (lo - pad, hi + pad)
-}
-
 /// The SVG, or why there is none (no numeric key, no value to plot).
 pub fn sweep_svg(keys: &[String], rows: &[Row], column: &str) -> Result<String, String> {
     if rows.is_empty() {
@@ -121,8 +95,8 @@ pub fn sweep_svg(keys: &[String], rows: &[Row], column: &str) -> Result<String, 
     for g in &mut groups {
         g.1.sort_by(|a, b| a.0.total_cmp(&b.0));
     }
-    let (x0, x1) = range(groups.iter().flat_map(|g| g.1.iter().map(|p| p.0)));
-    let (y0, y1) = range(groups.iter().flat_map(|g| g.1.iter().map(|p| p.1)));
+    let (x0, x1) = range(groups.iter().flat_map(|g| g.1.iter().map(|p| &p.0)));
+    let (y0, y1) = range(groups.iter().flat_map(|g| g.1.iter().map(|p| &p.1)));
     let y_desc = match column {
         "touchdown" => "first touchdown (s)".to_owned(),
         c if c.starts_with("touchdown") || c.starts_with("slip") || c == "wall_seconds" => {
@@ -158,22 +132,14 @@ pub fn sweep_svg(keys: &[String], rows: &[Row], column: &str) -> Result<String, 
                 .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
                 .map_err(err)?;
             if labelled {
-                s.label(label.as_str()).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
+                s.label(label.as_str()).legend(legend_line(color, 2));
             }
             chart
                 .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 .map_err(err)?;
         }
         if labelled {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            draw_legend(&mut chart)?;
         }
         root.present().map_err(err)?;
     }

@@ -1,5 +1,8 @@
 //! The analytic Jacobian of the FBD residual against central differences,
-//! in every contact state, through the shared checker.
+//! through the shared checker, in every contact state, at the first step
+//! (history from the initial velocity) and later ones, on flat and curved
+//! terrains (sliding rows use the terrain height and slope at the iterate,
+//! and the contact frames tilt with the ground).
 
 use fbd_contact::{ContactState, Terrain};
 use fbd_dynamics::mechanism::ContactPoints;
@@ -38,7 +41,10 @@ fn mechanism() -> Mechanism {
     Mechanism::two_leg(&PlanarGeometry::default(), &inertia, 9.81, all).0
 }
 
-fn check(states: [ContactState; 6], history_first: bool) {
+/// Assembles at a generic state with contact points in `states` (tips,
+/// knees, hips), frames taken from `terrain` under each point as the
+/// simulator sets them, and compares the Jacobian with central differences.
+fn check(terrain: &Terrain, states: [ContactState; 6], first_step: bool) {
     let mech = mechanism();
     let lay = mech.layout();
     let n = lay.dim();
@@ -48,27 +54,33 @@ fn check(states: [ContactState; 6], history_first: bool) {
     let q1 = [0.051, 0.549, 0.102, 0.21, 4.19, -0.14, 4.41];
     let qdot = [0.3, -0.5, 0.2, 1.0, -1.0, 0.5, 0.7];
     set_configuration(&mech, &mut data, &q0);
-    if history_first {
+    if first_step {
         prepare_step(&mech, &mut data, History::Initial { qdot: &qdot }, 0.01);
     } else {
         fbd_dynamics::advance(&mech, &mut data, &q1);
         prepare_step(&mech, &mut data, History::Previous, 0.01);
     }
-    let s = 0.3f64;
-    let k = 1.0 / (1.0 + s * s).sqrt();
+    let curved = !matches!(terrain, Terrain::Flat { .. } | Terrain::None);
     for (c, st) in states.iter().enumerate() {
+        let x = match st {
+            ContactState::Stick { anchor } => anchor[0],
+            _ => data.kin.pos[mech.contacts[c].point][0],
+        };
+        let (tangent, normal) = terrain.frame(x);
+        if curved {
+            assert!(tangent[1] != 0.0, "the frame should be tilted at x = {x}");
+        }
         data.contact[c] = ContactEquation {
             state: *st,
-            tangent: [k, s * k],
-            normal: [-s * k, k],
+            tangent,
+            normal,
             mu_dynamic: 0.3,
         };
-        data.torque
-            .iter_mut()
-            .enumerate()
-            .for_each(|(j, t)| *t = 0.5 * j as f64 - 0.7);
     }
-    let terrain = Terrain::Flat { height: 0.01 };
+    data.torque
+        .iter_mut()
+        .enumerate()
+        .for_each(|(j, t)| *t = 0.5 * j as f64 - 0.7);
     let z: Vec<f64> = (0..n)
         .map(|i| {
             if i < 7 {
@@ -82,7 +94,7 @@ fn check(states: [ContactState; 6], history_first: bool) {
     let mut jm = vec![0.0; n * n];
     eval(
         &mech,
-        &terrain,
+        terrain,
         &mut data,
         &z,
         &mut r,
@@ -106,7 +118,7 @@ fn check(states: [ContactState; 6], history_first: bool) {
     check_jacobian(
         &z,
         n,
-        |x, out| eval(&mech, &terrain, &mut work, x, out, &mut NoJacobian),
+        |x, out| eval(&mech, terrain, &mut work, x, out, &mut NoJacobian),
         |i, j| jm[i * n + j],
         FdTolerance {
             rel: 1e-6,
@@ -114,31 +126,66 @@ fn check(states: [ContactState; 6], history_first: bool) {
             ..Default::default()
         },
     )
-    .unwrap_or_else(|e| panic!("states {states:?}: {e}"));
+    .unwrap_or_else(|e| panic!("{terrain:?}, states {states:?}: {e}"));
 }
+
+const SL: ContactState = ContactState::Slide { dir: -1.0 };
+const SR: ContactState = ContactState::Slide { dir: 1.0 };
+const FREE: ContactState = ContactState::Free;
 
 #[test]
 fn jacobian_in_flight() {
-    check([ContactState::Free; 6], true);
-    check([ContactState::Free; 6], false);
+    check(&Terrain::Flat { height: 0.01 }, [FREE; 6], true);
+    check(&Terrain::Flat { height: 0.01 }, [FREE; 6], false);
 }
 
 #[test]
 fn jacobian_sticking_and_sliding() {
+    let flat = Terrain::Flat { height: 0.01 };
     let st = ContactState::Stick {
         anchor: [0.5, 0.01],
     };
-    let sl = ContactState::Slide { dir: -1.0 };
+    check(&flat, [st, SL, FREE, st, SL, SR], false);
+    check(&flat, [SL, st, st, SL, FREE, st], true);
+    let slope = Terrain::slope_deg(16.7, 0.01);
+    let st = ContactState::Stick {
+        anchor: [0.5, slope.height(0.5)],
+    };
+    check(&slope, [st, SL, FREE, st, SL, SR], false);
+    check(&slope, [SL, st, st, SL, FREE, st], true);
+}
+
+#[test]
+fn jacobian_on_a_sine_terrain() {
+    let sine = Terrain::Sine {
+        amplitude: 0.03,
+        wavelength: 0.37,
+        phase: 0.4,
+        height: 0.01,
+    };
+    let st = ContactState::Stick {
+        anchor: [0.5, sine.height(0.5)],
+    };
+    check(&sine, [SL, SR, SL, SR, SL, SR], false);
+    check(&sine, [st, SL, FREE, st, SR, SL], false);
+}
+
+#[test]
+fn jacobian_on_a_slope_and_a_profile() {
     check(
-        [
-            st,
-            sl,
-            ContactState::Free,
-            st,
-            sl,
-            ContactState::Slide { dir: 1.0 },
-        ],
+        &Terrain::slope_deg(10.0, 0.0),
+        [SL, SR, SL, SR, SL, SR],
         false,
     );
-    check([sl, st, st, sl, ContactState::Free, st], true);
+    let profile = Terrain::Profile {
+        points: vec![
+            [-2.0, 0.0],
+            [-0.3, 0.1],
+            [-0.07, 0.05],
+            [0.02, 0.12],
+            [0.31, -0.1],
+            [2.0, 0.3],
+        ],
+    };
+    check(&profile, [SL, SR, SL, SR, SL, SR], false);
 }

@@ -23,6 +23,8 @@ pub struct Model {
     pub steps: usize,
     /// Hexapod leg number (3 or 4) of each contact point.
     pub contact_leg: Vec<usize>,
+    /// Kind of each contact point: `"tip"`, `"knee"` or `"hip"`.
+    pub contact_point: Vec<&'static str>,
     /// Contact state of each point at `t = 0` (SPEC §3).
     pub initial_states: Vec<ContactState>,
 }
@@ -198,6 +200,16 @@ impl Model {
             .iter()
             .map(|c| if c.name.ends_with('3') { 3 } else { 4 })
             .collect();
+        let contact_point = mech
+            .contacts
+            .iter()
+            .map(|c| {
+                ["tip", "knee", "hip"]
+                    .into_iter()
+                    .find(|k| c.name.starts_with(k))
+                    .expect("two-leg contact points are tips, knees or hips")
+            })
+            .collect();
         let mut kin = mech.chains.new_data();
         mech.chains.eval_positions(&p.q0, &mut kin);
         let mut initial_states = Vec::with_capacity(mech.contacts.len());
@@ -225,6 +237,7 @@ impl Model {
             },
             steps: steps_f as usize + 1,
             contact_leg,
+            contact_point,
             initial_states,
         })
     }

@@ -43,6 +43,29 @@ pub struct StepRecord {
     pub state_trials: usize,
 }
 
+impl StepRecord {
+    /// A record of step `step` at time `t` with `contacts` points in use and
+    /// every other field zero (states ST1).
+    pub fn zeroed(step: usize, t: f64, contacts: usize) -> Self {
+        Self {
+            step,
+            t,
+            q: [0.0; 7],
+            contacts,
+            point: [[0.0; 2]; MAX_CONTACTS],
+            state: [StateCode::St1; MAX_CONTACTS],
+            fa: [0.0; MAX_CONTACTS],
+            n: [0.0; MAX_CONTACTS],
+            joint_force: [[0.0; 2]; MAX_JOINTS],
+            torque: [0.0; MAX_JOINTS],
+            kinetic: 0.0,
+            potential: 0.0,
+            newton_iterations: 0,
+            state_trials: 0,
+        }
+    }
+}
+
 /// A change of a contact point's state (a row of `events.csv`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Event {
@@ -52,8 +75,9 @@ pub struct Event {
     pub step: usize,
     /// Index of the contact point in the mechanism.
     pub contact: usize,
-    /// Contact point name, e.g. `tip4`.
-    pub name: String,
+    /// Kind of contact point: `"tip"`, `"knee"` or `"hip"` (with `leg`, the
+    /// mechanism's contact name, e.g. `tip4`).
+    pub point: &'static str,
     /// Hexapod leg number (3 or 4).
     pub leg: usize,
     /// Previous state.

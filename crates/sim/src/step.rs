@@ -3,23 +3,23 @@
 //! 1. **kinematics at k**: the per-body constants of the second differences;
 //! 2. **joint torques at k**: the controller's torques from `q[k]`, `q[k−1]`
 //!    ([`crate::control`]);
-//! 2. **predictor**: a starting guess for `q[k+1]` (forces from the last step);
-//! 3. **solve**: Newton on the FBD equations with the current contact states;
-//! 4. **contact check**: every point's switching rule on the trial solution;
-//!    any switch → back to 3. A repeated state combination means no
+//! 3. **predictor**: a starting guess for `q[k+1]` (forces from the last step);
+//! 4. **solve**: Newton on the FBD equations with the current contact states;
+//! 5. **contact check**: every point's switching rule on the trial solution;
+//!    any switch → back to 4. A repeated state combination means no
 //!    combination the rules reach is consistent; before giving up, a point
 //!    that flip-flopped between ST1 (it penetrates when free) and ST2 (it
 //!    would pull on the ground when stuck) is tried in ST3, sliding opposite
 //!    to the friction sticking needed — the remaining candidate of Coulomb's
-//!    law. A cycle after that is an error;
-//! 5. **accept**: record, events, and `q[k+1]` becomes the current state.
+//!    law ([`slide_flip_flops`]). A cycle after that is an error;
+//! 6. **accept**: record, events, and `q[k+1]` becomes the current state.
 
 use crate::energy;
 use crate::record::{Event, MAX_CONTACTS, MAX_JOINTS, StepRecord};
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
-use fbd_contact::{ContactState, StateCode, Trial, transition};
+use fbd_contact::{ContactState, Trial, transition};
 use fbd_dynamics::{ContactEquation, History, advance, prepare_step};
 use fbd_solver::NewtonSolver;
 
@@ -31,7 +31,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     let t = k as f64 * dt;
     let nq = mech.layout().nq;
 
-    // 1–2. Kinematics at k, predictor.
+    // 1–3. Kinematics and torques at k, predictor.
     prepare(model, data);
     let mut fallback_used = false;
     let mut newton_iterations = 0;
@@ -58,18 +58,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
         let mut key = states_key(&data.trial);
         if data.visited.contains(&key) && !fallback_used {
             fallback_used = true;
-            let mut forced = false;
-            for c in 0..mech.contacts.len() {
-                if data.seen[c] & 0b11 == 0b11
-                    && !matches!(data.trial[c], ContactState::Slide { .. })
-                {
-                    data.trial[c] = ContactState::Slide {
-                        dir: -data.stick_fa[c].signum(),
-                    };
-                    forced = true;
-                }
-            }
-            if forced {
+            if slide_flip_flops(data) {
                 data.visited.clear();
                 key = states_key(&data.trial);
             }
@@ -86,7 +75,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     }
     data.newton_iterations += newton_iterations;
 
-    // 5. Accept.
+    // 6. Accept.
     let record = make_record(model, data, newton_iterations, trials);
     for c in 0..mech.contacts.len() {
         let (from, to) = (data.states[c].code(), data.trial[c].code());
@@ -95,7 +84,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
                 t,
                 step: k,
                 contact: c,
-                name: mech.contacts[c].name.clone(),
+                point: model.contact_point[c],
                 leg: model.contact_leg[c],
                 from,
                 to,
@@ -111,7 +100,24 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     Ok(record)
 }
 
-/// Stages 1–2 of [`step`]: the per-body constants of step `data.k` and the
+/// The cycle fallback of stage 5: every point that was solved in both ST1
+/// and ST2 during this step's search (and is not sliding) is set to ST3,
+/// sliding opposite to the friction its last sticking trial needed. `true`
+/// if any point was changed.
+fn slide_flip_flops(data: &mut Data) -> bool {
+    let mut forced = false;
+    for (c, state) in data.trial.iter_mut().enumerate() {
+        if data.seen[c] & 0b11 == 0b11 && !matches!(state, ContactState::Slide { .. }) {
+            *state = ContactState::Slide {
+                dir: -data.stick_fa[c].signum(),
+            };
+            forced = true;
+        }
+    }
+    forced
+}
+
+/// Stages 1–3 of [`step`]: the per-body constants of step `data.k` and the
 /// predictor of `q[k+1]` in `data.z` (the forces keep the last solution);
 /// the trial contact states start from the accepted ones. Public for
 /// benchmarks, which time the stages one by one.
@@ -132,7 +138,7 @@ pub fn prepare(model: &Model, data: &mut Data) {
     // 2. Joint torques at k (explicit, from q[k] and q[k−1]).
     crate::control::joint_torques(model, data);
 
-    // Predictor: quadratic extrapolation of q through the last three
+    // 3. Predictor: quadratic extrapolation of q through the last three
     // configurations (exact for the discrete free fall), linear at k = 1,
     // the initial velocity at k = 0.
     for i in 0..nq {
@@ -148,7 +154,7 @@ pub fn prepare(model: &Model, data: &mut Data) {
     data.seen.fill(0);
 }
 
-/// Stage 3's inputs for the current trial states (contact equations, row
+/// Stage 4's inputs for the current trial states (contact equations, row
 /// scales), split from `data`: the step's [`NewtonSystem`](fbd_solver::NewtonSystem),
 /// the solver and the unknowns `z`. Public for benchmarks.
 pub fn system<'a>(
@@ -248,22 +254,10 @@ fn make_record(
     let mech = &model.mech;
     let lay = mech.layout();
     let nc = mech.contacts.len().min(MAX_CONTACTS);
-    let mut r = StepRecord {
-        step: data.k,
-        t: data.k as f64 * model.dt(),
-        q: [0.0; 7],
-        contacts: nc,
-        point: [[0.0; 2]; MAX_CONTACTS],
-        state: [StateCode::St1; MAX_CONTACTS],
-        fa: [0.0; MAX_CONTACTS],
-        n: [0.0; MAX_CONTACTS],
-        joint_force: [[0.0; 2]; MAX_JOINTS],
-        torque: [0.0; MAX_JOINTS],
-        kinetic: 0.0,
-        potential: energy::potential(mech, &data.fbd.kin),
-        newton_iterations,
-        state_trials,
-    };
+    let mut r = StepRecord::zeroed(data.k, data.k as f64 * model.dt(), nc);
+    r.potential = energy::potential(mech, &data.fbd.kin);
+    r.newton_iterations = newton_iterations;
+    r.state_trials = state_trials;
     r.q.copy_from_slice(&data.q[..7]);
     for c in 0..nc {
         r.point[c] = data.fbd.kin.pos[mech.contacts[c].point];

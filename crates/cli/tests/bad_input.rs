@@ -6,8 +6,11 @@
 //! `trajectory.csv` in the `--out` directory. The last tests feed arbitrary
 //! bytes and mutations of `examples/paper.toml` to the loader.
 
+mod common;
+
+use common::{fbd, s};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use fbd_cli::Config;
 use fbd_cli::config::parse_str;
@@ -18,20 +21,8 @@ const USAGE: i32 = 2;
 const SIMULATION: i32 = 3;
 const IO: i32 = 4;
 
-fn fbd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbd"))
-        .args(args)
-        .output()
-        .expect("the fbd binary runs")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
 fn paper_toml() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/paper.toml"))
-        .unwrap()
+    std::fs::read_to_string(common::examples().join("paper.toml")).unwrap()
 }
 
 /// Checks the exit status and that stderr is one `error:` line without a

@@ -1,7 +1,10 @@
 //! End-to-end tests of the `fbd` binary (SPEC §4–§6).
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+
+use common::{example, fbd, s, stderr, stdout, write};
+use std::path::Path;
+use std::process::Output;
 
 const FILES: [&str; 7] = [
     "trajectory.csv",
@@ -15,45 +18,12 @@ const FILES: [&str; 7] = [
 
 const SPEC_COLUMNS: &str = "t,rx,ry,phi_z,theta2_3,theta3_3,theta2_4,theta3_4,tip3_x,tip3_y,tip4_x,tip4_y,state3,state4,fa3,n3,fa4,n4,hip3_fx,hip3_fy,knee3_fx,knee3_fy,hip4_fx,hip4_fy,knee4_fx,knee4_fy";
 
-fn fbd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbd"))
-        .args(args)
-        .output()
-        .expect("the fbd binary runs")
-}
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../examples")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
 /// The one-line error message, checked to be exactly one line.
 fn one_line_error(o: &Output) -> String {
     let e = stderr(o);
     assert_eq!(e.lines().count(), 1, "stderr is not one line: {e:?}");
     assert!(e.starts_with("error: "), "{e:?}");
     e
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 fn json(path: &Path) -> serde_json::Value {

@@ -2,23 +2,11 @@
 //! short runs in temporary directories).
 
 use std::collections::BTreeSet;
+mod common;
+
+use common::{examples, fbd, s};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn fbd(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_fbd"))
-        .args(args)
-        .output()
-        .expect("the fbd binary runs")
-}
-
-fn examples() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
+use std::process::Output;
 
 fn text(o: &Output) -> String {
     format!(

@@ -97,6 +97,9 @@ pub struct FbdData {
     pub dt: f64,
     /// Scale of contact position rows, `M/Δt²` (N/m).
     pub position_gain: f64,
+    /// `kin_next` holds the positions of a candidate set by
+    /// [`evaluate_next`] (and no Newton iterate since).
+    next_is_candidate: bool,
     acc: Vec<[f64; 3]>,
 }
 
@@ -113,6 +116,7 @@ impl FbdData {
             torque: vec![0.0; mech.joints.len()],
             dt: 0.0,
             position_gain: 0.0,
+            next_is_candidate: false,
             acc: vec![[0.0; 3]; mech.bodies.len()],
         }
     }
@@ -153,12 +157,29 @@ pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, 
     }
 }
 
-/// Accepts `q[k+1]`: `q[k]` becomes the previous configuration and `q[k+1]`
-/// the current one.
-pub fn advance(mech: &Mechanism, data: &mut FbdData, q_next: &[f64]) {
+/// Evaluates the point positions at a candidate `q[k+1]` into
+/// `data.kin_next` (after the solve, for the contact check), so that
+/// [`advance`] can accept it without evaluating them again.
+pub fn evaluate_next(mech: &Mechanism, data: &mut FbdData, q_next: &[f64]) {
+    mech.chains.eval_positions(q_next, &mut data.kin_next);
+    data.next_is_candidate = true;
+}
+
+/// Accepts the candidate of [`evaluate_next`]: `q[k]` becomes the previous
+/// configuration and `q[k+1]` the current one (its positions are reused,
+/// its Jacobians evaluated).
+///
+/// # Panics
+/// If [`evaluate_next`] was not called since the last [`eval`].
+pub fn advance(mech: &Mechanism, data: &mut FbdData) {
+    assert!(
+        data.next_is_candidate,
+        "advance needs evaluate_next at the accepted configuration"
+    );
     std::mem::swap(&mut data.kin_prev, &mut data.kin);
-    mech.chains.eval_positions(q_next, &mut data.kin);
+    std::mem::swap(&mut data.kin, &mut data.kin_next);
     mech.chains.eval_jacobians(&mut data.kin);
+    data.next_is_candidate = false;
 }
 
 /// A key identifying the sparsity pattern: the contact states' codes in
@@ -191,6 +212,7 @@ pub fn eval<S: JacobianSink>(
     assert_eq!(r.len(), lay.dim(), "residual vector has the wrong length");
     let nq = lay.nq;
     mech.chains.eval_positions(&z[..nq], &mut data.kin_next);
+    data.next_is_candidate = false;
     if S::ACTIVE {
         mech.chains.eval_jacobians(&mut data.kin_next);
     }

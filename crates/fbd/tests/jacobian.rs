@@ -57,7 +57,8 @@ fn check(terrain: &Terrain, states: [ContactState; 6], first_step: bool) {
     if first_step {
         prepare_step(&mech, &mut data, History::Initial { qdot: &qdot }, 0.01);
     } else {
-        fbd_dynamics::advance(&mech, &mut data, &q1);
+        fbd_dynamics::evaluate_next(&mech, &mut data, &q1);
+        fbd_dynamics::advance(&mech, &mut data);
         prepare_step(&mech, &mut data, History::Previous, 0.01);
     }
     let curved = !matches!(terrain, Terrain::Flat { .. } | Terrain::None);

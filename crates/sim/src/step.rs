@@ -20,7 +20,7 @@ pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
 use fbd_contact::{ContactState, Trial, transition};
-use fbd_dynamics::{ContactEquation, History, advance, prepare_step};
+use fbd_dynamics::{ContactEquation, History, advance, evaluate_next, prepare_step};
 use fbd_solver::NewtonSolver;
 
 /// Solves step `data.k` and advances the state to `k + 1`.
@@ -50,8 +50,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
                 residual: report.residual,
             });
         }
-        mech.chains
-            .eval_positions(&data.z[..nq], &mut data.fbd.kin_next);
+        evaluate_next(mech, &mut data.fbd, &data.z[..nq]);
         if !check_contacts(model, data) {
             break;
         }
@@ -95,7 +94,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     std::mem::swap(&mut data.q_prev2, &mut data.q_prev);
     data.q_prev.copy_from_slice(&data.q);
     data.q.copy_from_slice(&data.z[..nq]);
-    advance(mech, &mut data.fbd, &data.z[..nq]);
+    advance(mech, &mut data.fbd);
     data.k += 1;
     Ok(record)
 }

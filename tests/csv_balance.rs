@@ -26,9 +26,10 @@ fn run_cli(config: Option<&str>, dir: &Path) {
     );
 }
 
-/// Reads `trajectory.csv` into records, using only the SPEC columns and the
-/// torque columns.
-fn read_rows(path: &Path) -> Vec<StepRecord> {
+/// Reads `trajectory.csv` into records, using only the SPEC columns, the
+/// `<point>_state, <point>_fa, <point>_n` columns of the extra contact points
+/// of `model` (in its contact order) and the torque columns.
+fn read_rows(path: &Path, model: &Model) -> Vec<StepRecord> {
     let mut rd = csv::Reader::from_path(path).unwrap();
     let head = rd.headers().unwrap().clone();
     let col = |name: &str| {
@@ -51,7 +52,7 @@ fn read_rows(path: &Path) -> Vec<StepRecord> {
         .enumerate()
         .map(|(k, rec)| {
             let rec = rec.unwrap();
-            let mut r = StepRecord::zeroed(k, f(&rec, "t"), 2);
+            let mut r = StepRecord::zeroed(k, f(&rec, "t"), model.mech.contacts.len());
             for (i, c) in q_cols.iter().enumerate() {
                 r.q[i] = f(&rec, c);
             }
@@ -63,6 +64,12 @@ fn read_rows(path: &Path) -> Vec<StepRecord> {
                 r.state[c] = state(&rec[col(&format!("state{leg}"))]);
                 r.fa[c] = f(&rec, &format!("fa{leg}"));
                 r.n[c] = f(&rec, &format!("n{leg}"));
+            }
+            for (c, spec) in model.mech.contacts.iter().enumerate().skip(2) {
+                let name = &spec.name;
+                r.state[c] = state(&rec[col(&format!("{name}_state"))]);
+                r.fa[c] = f(&rec, &format!("{name}_fa"));
+                r.n[c] = f(&rec, &format!("{name}_n"));
             }
             for (j, name) in joints.iter().enumerate() {
                 r.joint_force[j] = [
@@ -80,9 +87,12 @@ fn read_rows(path: &Path) -> Vec<StepRecord> {
 fn default_run_balances_from_the_csv() {
     let dir = tempfile::tempdir().unwrap();
     run_cli(None, dir.path());
-    let rows = read_rows(&dir.path().join("out/trajectory.csv"));
-    assert_eq!(rows.len(), 46);
     let model = Model::planar(&PlanarParams::default()).unwrap();
+    let rows = read_rows(&dir.path().join("out/trajectory.csv"), &model);
+    assert_eq!(rows.len(), 101);
+    // The run exercises knee and hip contacts, carrying load at the end.
+    let last = rows.last().unwrap();
+    assert!(last.n[2..6].iter().all(|&n| n > 0.0), "{:?}", last.n);
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");
     // The check has teeth: a 1 N error in one written force is caught.
@@ -114,14 +124,15 @@ rate_deg = [140.0, -60.0]
 "#;
     let dir = tempfile::tempdir().unwrap();
     run_cli(Some(config), dir.path());
-    let rows = read_rows(&dir.path().join("out/trajectory.csv"));
-    let mut p = PlanarParams {
+    // The mechanism (bodies, joints, contact points) is what the balance
+    // needs; the initial state is read from the file.
+    let p = PlanarParams {
         dt: 0.005,
         terrain: fbd_contact::Terrain::None,
         ..PlanarParams::default()
     };
-    p.q0 = rows[0].q;
     let model = Model::planar(&p).unwrap();
+    let rows = read_rows(&dir.path().join("out/trajectory.csv"), &model);
     // Joint forces are far from zero in a tumbling flight.
     let peak = rows
         .iter()

@@ -25,6 +25,7 @@
 use std::alloc::System;
 
 use fbd_contact::{ContactState, Friction, Terrain};
+use fbd_dynamics::ContactPoints;
 use fbd_sim::{Data, Model, PlanarParams, step};
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
 
@@ -35,6 +36,12 @@ fn params(case: &str) -> PlanarParams {
     let mut p = PlanarParams {
         dt: 1e-3,
         duration: 10.0,
+        // The paper's model: the states named are those of the feet.
+        contact_points: ContactPoints {
+            tips: true,
+            knees: false,
+            hips: false,
+        },
         ..PlanarParams::default()
     };
     if case == "flight" {

@@ -15,6 +15,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use fbd_contact::{ContactState, Friction, Terrain};
+use fbd_dynamics::ContactPoints;
 use fbd_sim::{Data, Model, PlanarParams, step};
 
 /// Time step of every fixture (s).
@@ -49,6 +50,12 @@ impl Case {
         let mut p = PlanarParams {
             dt: DT,
             duration: 10.0,
+            // The paper's model: the states named are those of the feet.
+            contact_points: ContactPoints {
+                tips: true,
+                knees: false,
+                hips: false,
+            },
             ..PlanarParams::default()
         };
         if let Case::Flight = self {

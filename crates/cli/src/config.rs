@@ -370,14 +370,21 @@ pub enum PointKind {
 #[serde(deny_unknown_fields, default)]
 pub struct ContactConfig {
     /// Which points of every leg can touch the terrain; must include
-    /// `"tips"`. Default `["tips"]`.
+    /// `"tips"`. Default `["tips", "knees", "hips"]`
+    /// (`ContactPoints::default()`).
     pub points: Vec<PointKind>,
 }
 
 impl Default for ContactConfig {
     fn default() -> Self {
+        let d = ContactPoints::default();
+        let kinds = [
+            (d.tips, PointKind::Tips),
+            (d.knees, PointKind::Knees),
+            (d.hips, PointKind::Hips),
+        ];
         Self {
-            points: vec![PointKind::Tips],
+            points: kinds.into_iter().filter(|k| k.0).map(|k| k.1).collect(),
         }
     }
 }

@@ -52,6 +52,8 @@ const LEG4: RGBColor = RGBColor(214, 39, 40);
 const LEG4_LIGHT: RGBColor = RGBColor(245, 140, 60);
 const EVENT: RGBColor = RGBColor(150, 150, 150);
 const GROUND: RGBColor = RGBColor(120, 85, 45);
+/// Samples of the terrain profile drawn in `stance.svg`.
+const TERRAIN_SAMPLES: usize = 400;
 
 /// The legend box every chart draws, upper right.
 pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a>(
@@ -269,14 +271,20 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
         .flat_map(|p| [p[0][1], p[1][1]]);
     let xs: Vec<f64> = xs.collect();
     let mut ys: Vec<f64> = ys.collect();
-    let ground = match d.terrain {
-        Some(Terrain::Flat { height }) if height.is_finite() => Some(height),
-        _ => None,
+    // The terrain profile y = ϱ(x), sampled across the plotted range.
+    let ground = d.terrain.as_ref().filter(|t| t.exists());
+    let profile = |a: f64, b: f64| -> Vec<(f64, f64)> {
+        let t = ground.expect("profile of an existing terrain");
+        (0..=TERRAIN_SAMPLES)
+            .map(|i| a + (b - a) * i as f64 / TERRAIN_SAMPLES as f64)
+            .map(|x| (x, t.height(x)))
+            .filter(|p| p.1.is_finite())
+            .collect()
     };
-    if let Some(h) = ground {
-        ys.push(h);
-    }
     let (mut x0, mut x1) = range(&xs);
+    if ground.is_some() {
+        ys.extend(profile(x0, x1).into_iter().map(|p| p.1));
+    }
     let (mut y0, mut y1) = range(&ys);
     // Margins, label areas and caption of the chart below (pixels).
     let (margin, xl, yl, caption) = (16.0, 48.0, 70.0, 40.0);
@@ -318,14 +326,12 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
-        if let Some(h) = ground {
+        if ground.is_some() {
             chart
-                .draw_series(LineSeries::new([(x0, h), (x1, h)], GROUND.stroke_width(3)))
+                .draw_series(LineSeries::new(profile(x0, x1), GROUND.stroke_width(3)))
                 .map_err(err)?
                 .label("terrain")
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], GROUND.stroke_width(3))
-                });
+                .legend(legend_line(GROUND, 3));
         }
         let n = d.stances.len().max(2) - 1;
         for (i, s) in d.stances.iter().enumerate() {

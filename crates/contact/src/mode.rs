@@ -150,6 +150,13 @@ pub struct ContactParams {
     /// A point within this distance of the terrain at `t = 0` starts in ST2
     /// (SPEC §3). Default `1e-9` m.
     pub initial_tol: f64,
+    /// Dimensionless regularisation β of the contact position rows
+    /// (`K·(p − a) + β·F = 0` with `K = M/Δt²`, see `fbd_dynamics::assemble`):
+    /// a point under load `N` sits `β·N·Δt²/M` below its anchor. It makes
+    /// statically indeterminate contact sets (two sticking points on one
+    /// body) solvable. Default `1e-8`: 1e-10 m for 1 kN on the default
+    /// robot at Δt = 0.01 s, and far above round-off in the Jacobian.
+    pub regularization: f64,
 }
 
 impl Default for ContactParams {
@@ -159,6 +166,7 @@ impl Default for ContactParams {
             force_tol: 1e-7,
             speed_tol: 1e-9,
             initial_tol: 1e-9,
+            regularization: 1e-8,
         }
     }
 }

@@ -6,6 +6,14 @@
 //! position rows are multiplied by `K = M/Δt²` so that they are forces too,
 //! which keeps the Jacobian well scaled for partial pivoting.
 //!
+//! Contact position rows carry a small dimensionless regularisation β
+//! ([`ContactEquation::regularization`]): ST2 reads `K·(p − a) + β·F = 0`
+//! and ST3's normal row `K·(p_y − ϱ(p_x)) + β·N = 0`. A point under load `N`
+//! thus sits `β·N/K` below its anchor (≈ 1e-10 m for 1 kN in the default
+//! experiment), and statically indeterminate contact sets — two sticking
+//! points on one rigid body, a knee and a foot on one link — stay solvable:
+//! their forces split as equal stiff springs would split them.
+//!
 //! The Jacobian is written entry by entry through a [`JacobianSink`]; the
 //! same code path with [`pattern`] declares the structure, so the two cannot
 //! drift apart.
@@ -53,6 +61,8 @@ pub struct ContactEquation {
     pub normal: [f64; 2],
     /// Dynamic friction coefficient μD (used in ST3).
     pub mu_dynamic: f64,
+    /// Regularisation β of the position rows (see the module docs).
+    pub regularization: f64,
 }
 
 impl Default for ContactEquation {
@@ -62,6 +72,7 @@ impl Default for ContactEquation {
             tangent: [1.0, 0.0],
             normal: [0.0, 1.0],
             mu_dynamic: 0.0,
+            regularization: 0.0,
         }
     }
 }
@@ -268,12 +279,13 @@ pub fn eval<S: JacobianSink>(
                 r[row + 1] = n;
             }
             ContactState::Stick { anchor } => {
-                r[row] = k * (p[0] - anchor[0]);
-                r[row + 1] = k * (p[1] - anchor[1]);
+                let b = eq.regularization;
+                r[row] = k * (p[0] - anchor[0]) + b * (fa * eq.tangent[0] + n * eq.normal[0]);
+                r[row + 1] = k * (p[1] - anchor[1]) + b * (fa * eq.tangent[1] + n * eq.normal[1]);
             }
             ContactState::Slide { dir } => {
                 r[row] = fa + dir * eq.mu_dynamic * n;
-                r[row + 1] = k * terrain.clearance(p);
+                r[row + 1] = k * terrain.clearance(p) + eq.regularization * n;
             }
         }
     }
@@ -321,10 +333,17 @@ fn force_entries<S: JacobianSink>(mech: &Mechanism, data: &FbdData, jac: &mut S)
                 jac.add(crow, ca, 1.0);
                 jac.add(crow + 1, cn, 1.0);
             }
-            ContactState::Stick { .. } => {}
+            ContactState::Stick { .. } => {
+                let b = eq.regularization;
+                jac.add(crow, ca, b * eq.tangent[0]);
+                jac.add(crow, cn, b * eq.normal[0]);
+                jac.add(crow + 1, ca, b * eq.tangent[1]);
+                jac.add(crow + 1, cn, b * eq.normal[1]);
+            }
             ContactState::Slide { dir } => {
                 jac.add(crow, ca, 1.0);
                 jac.add(crow, cn, dir * eq.mu_dynamic);
+                jac.add(crow + 1, cn, eq.regularization);
             }
         }
     }

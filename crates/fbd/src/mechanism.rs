@@ -137,12 +137,15 @@ pub struct ContactPoints {
 }
 
 impl Default for ContactPoints {
-    /// The paper's model: tips only.
+    /// Tips, knees and hips: a collapsing robot comes to rest on its knees
+    /// and body instead of falling through the ground. (The paper's model
+    /// has the tips only; its reported events are those of the tips and do
+    /// not change.)
     fn default() -> Self {
         Self {
             tips: true,
-            knees: false,
-            hips: false,
+            knees: true,
+            hips: true,
         }
     }
 }

@@ -76,6 +76,9 @@ fn check(terrain: &Terrain, states: [ContactState; 6], first_step: bool) {
             tangent,
             normal,
             mu_dynamic: 0.3,
+            // Far larger than the default so that its entries show in the
+            // finite differences.
+            regularization: 0.05,
         };
     }
     data.torque

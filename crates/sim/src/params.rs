@@ -11,8 +11,9 @@ pub struct PlanarParams {
     /// Time step Δt (s). Default 0.01, the paper's §6 value.
     pub dt: f64,
     /// Simulated duration (s); the run solves `round(duration/dt) + 1` steps
-    /// so that the output covers `[0, duration]`. Default 0.45: touchdown,
-    /// sticking and sliding of both legs, before the body reaches the floor.
+    /// so that the output covers `[0, duration]`. Default 1.0: touchdown,
+    /// sticking and sliding of both feet, the body and knees landing, and
+    /// the robot at rest on the ground (all points sticking from 0.73 s).
     pub duration: f64,
     /// Gravitational acceleration (m/s²). Default 9.81.
     pub gravity: f64,
@@ -52,7 +53,7 @@ pub struct PlanarParams {
     pub terrain: Terrain,
     /// Soil friction. Default μS = 0.4, μD = 0.3 (paper §6).
     pub friction: Friction,
-    /// Which points can touch the terrain. Default: the tips only.
+    /// Which points can touch the terrain. Default: tips, knees and hips.
     pub contact_points: ContactPoints,
     /// Write every `stride`-th step. Default 1.
     pub stride: usize,
@@ -68,7 +69,7 @@ impl Default for PlanarParams {
         let lower_length = 0.42;
         Self {
             dt: 0.01,
-            duration: 0.45,
+            duration: 1.0,
             gravity: 9.81,
             body_mass: 10.0,
             body_inertia: 0.3,

@@ -5,8 +5,9 @@
 //!    ([`crate::control`]);
 //! 3. **predictor**: a starting guess for `q[k+1]` (forces from the last step);
 //! 4. **solve**: Newton on the FBD equations with the current contact states;
-//! 5. **contact check**: every point's switching rule on the trial solution;
-//!    any switch → back to 4. A repeated state combination means no
+//! 5. **contact check**: every point's switching rule on the trial solution
+//!    (touchdowns all at once, other switches one at a time, see
+//!    [`check_contacts`]); any switch → back to 4. A repeated state combination means no
 //!    combination the rules reach is consistent; before giving up, a point
 //!    that flip-flopped between ST1 (it penetrates when free) and ST2 (it
 //!    would pull on the ground when stuck) is tried in ST3, sliding opposite
@@ -192,15 +193,23 @@ fn set_contact_equations(model: &Model, data: &mut Data) {
             tangent,
             normal,
             mu_dynamic: model.params.friction.mu_dynamic,
+            regularization: model.contact.regularization,
         };
     }
 }
 
 /// Applies the switching rules to the trial solution; `true` if any point
-/// switched.
+/// switched. Every touchdown (ST1 → ST2) is applied at once: a point that
+/// penetrates must carry a force. Of the other switches — lift-off, the
+/// start or end of a slide — only the most violated one is applied before
+/// re-solving, since one of them changes the forces on all the others (at an
+/// impact of several points, switching them all together chases its tail):
+/// lift-offs first (most negative `N`), then slips (largest `|Fa| − μS·N`),
+/// then slide reversals.
 fn check_contacts(model: &Model, data: &mut Data) -> bool {
     let lay = model.mech.layout();
-    let mut changed = false;
+    let mut touchdown = false;
+    let mut best: Option<(usize, ContactState, f64)> = None;
     for (c, spec) in model.mech.contacts.iter().enumerate() {
         let eq = &data.fbd.contact[c];
         let trial = Trial {
@@ -215,18 +224,80 @@ fn check_contacts(model: &Model, data: &mut Data) -> bool {
         if matches!(data.trial[c], ContactState::Stick { .. }) {
             data.stick_fa[c] = trial.fa;
         }
-        if let Some(next) = transition(
+        let Some(next) = transition(
             &data.trial[c],
             &trial,
             &model.params.terrain,
             &model.params.friction,
             &model.contact,
-        ) {
-            data.trial[c] = next;
-            changed = true;
+        ) else {
+            continue;
+        };
+        // SPEC §3: ST3 → ST2 needs the reversal *and* |Fa| ≤ μS·N; a point
+        // that already tried sticking in this search and had to slide again
+        // stays sliding at the friction limit.
+        let stick_failed = data.seen[c] & 0b110 == 0b110;
+        if stick_failed
+            && matches!(data.trial[c], ContactState::Slide { .. })
+            && matches!(next, ContactState::Stick { .. })
+        {
+            continue;
+        }
+        // Priority: lift-off > slip > slide reversal, then the violation.
+        let priority = match (data.trial[c], next) {
+            (ContactState::Free, _) => {
+                data.trial[c] = next;
+                touchdown = true;
+                continue;
+            }
+            (_, ContactState::Free) => 2e12 - trial.n,
+            (ContactState::Stick { .. }, _) => {
+                1e12 + trial.fa.abs() - model.params.friction.mu_static * trial.n
+            }
+            _ => 0.0,
+        };
+        if best.is_none_or(|b| priority > b.2) {
+            best = Some((c, next, priority));
         }
     }
-    changed
+    if !touchdown {
+        let Some((c, next, _)) = best else {
+            return false;
+        };
+        data.trial[c] = next;
+    }
+    rigid_anchors(model, data);
+    true
+}
+
+/// Anchors of points that share a rigid body. SPEC §3 anchors a touchdown
+/// where the point's straight path `p[k] → p[k+1]` crosses the terrain; for
+/// two points of one body (a knee and a foot of one link, both hips) those
+/// crossings belong to different instants and are not a rigid placement, so
+/// sticking at both would tear the body apart. When a body has more than one
+/// point in contact, each of its points that is anchored anew this trial
+/// (ST2 now, not ST2 in the accepted state) is anchored at the terrain below
+/// its trial position `p[k+1]`, which all come from one configuration.
+/// A point alone on its body — every foot of the paper's model — keeps the
+/// SPEC's crossing.
+fn rigid_anchors(model: &Model, data: &mut Data) {
+    let mech = &model.mech;
+    for (c, spec) in mech.contacts.iter().enumerate() {
+        if !matches!(data.trial[c], ContactState::Stick { .. })
+            || matches!(data.states[c], ContactState::Stick { .. })
+        {
+            continue;
+        }
+        let shared = mech.contacts.iter().enumerate().any(|(o, other)| {
+            o != c && other.body == spec.body && !matches!(data.trial[o], ContactState::Free)
+        });
+        if shared {
+            let x = data.fbd.kin_next.pos[spec.point][0];
+            data.trial[c] = ContactState::Stick {
+                anchor: [x, model.params.terrain.height(x)],
+            };
+        }
+    }
 }
 
 fn states_key(states: &[ContactState]) -> u64 {

@@ -1,0 +1,92 @@
+//! The paper's passive robot with knee and hip contacts (the default): it
+//! falls, lands on its feet, slips, lands on its body and knees, and comes
+//! to rest on the ground — and on frictionless ground its energy never grows
+//! beyond the scheme's O(Δt²) oscillation.
+
+mod common;
+
+use common::physics::{run_ok, worst_body_imbalance};
+use fbd_contact::StateCode;
+use fbd_sim::PlanarParams;
+
+#[test]
+fn the_passive_experiment_runs_to_rest() {
+    let p = PlanarParams::default();
+    assert!(p.contact_points.knees && p.contact_points.hips);
+    let (model, rows, summary) = run_ok(&p);
+    let last = rows.last().unwrap();
+    assert!((last.t - p.duration).abs() < 1e-9);
+    // Every point of the robot on the ground, sticking, carrying the weight.
+    assert_eq!(last.contacts, 6);
+    assert!(
+        last.state[..6].iter().all(|s| *s == StateCode::St2),
+        "{:?}",
+        last.state
+    );
+    let w = model.mech.total_mass() * p.gravity;
+    let n: f64 = last.n[..6].iter().sum();
+    let fa: f64 = last.fa[..6].iter().sum();
+    assert!((n - w).abs() < 1e-6 * w, "Σn = {n}, weight {w}");
+    assert!(fa.abs() < 1e-6 * w, "Σfa = {fa}");
+    assert!(last.n[..6].iter().all(|&n| n > 0.0), "{:?}", &last.n[..6]);
+    assert!(
+        last.kinetic < 1e-12,
+        "kinetic energy at the end {}",
+        last.kinetic
+    );
+    // Knees and hips took part: each touched down during the run.
+    for name in ["knee3", "knee4", "hip3", "hip4"] {
+        assert!(
+            summary
+                .events
+                .iter()
+                .any(|e| format!("{}{}", e.point, e.leg) == name && e.from == StateCode::St1),
+            "{name} never touched down"
+        );
+    }
+    let (worst, at) = worst_body_imbalance(&model, &rows);
+    assert!(worst < 1e-6, "{at}");
+}
+
+#[test]
+fn energy_never_grows_beyond_second_order_on_frictionless_ground() {
+    // A thrown, spinning robot with moving legs lands on frictionless ground:
+    // impacts dissipate, sliding does not, nothing may create energy. The
+    // discrete energy (central-difference velocities) may exceed its start
+    // only by the scheme's O(Δt²) oscillation.
+    let excess = |dt: f64| {
+        let mut p = PlanarParams {
+            dt,
+            duration: 1.5,
+            ..PlanarParams::default()
+        };
+        p.friction.mu_static = 0.0;
+        p.friction.mu_dynamic = 0.0;
+        p.qdot0 = [0.7, 1.5, 2.0, -3.0, 4.0, 2.5, -1.0];
+        let (_, rows, summary) = run_ok(&p);
+        assert!(
+            summary.events.iter().any(|e| e.to == StateCode::St3),
+            "the run must slide"
+        );
+        let e0 = rows[0].kinetic + rows[0].potential;
+        let last = rows.last().unwrap();
+        assert!(
+            last.kinetic + last.potential < 0.5 * e0,
+            "impacts must dissipate"
+        );
+        rows.iter()
+            .map(|r| r.kinetic + r.potential - e0)
+            .fold(f64::MIN, f64::max)
+            / e0
+    };
+    let (e1, e2, e3) = (excess(0.005), excess(0.0025), excess(0.00125));
+    eprintln!("relative energy excess {e1:e} {e2:e} {e3:e}");
+    assert!(e1 < 1e-6, "energy grew by {e1} of its start");
+    for (a, b) in [(e1, e2), (e2, e3)] {
+        let ratio = a / b;
+        assert!(
+            (3.0..5.5).contains(&ratio),
+            "halving Δt divided the excess by {ratio} (relative excesses {e1:e}, {e2:e}, {e3:e}); O(Δt²) expects ≈ 4"
+        );
+    }
+}

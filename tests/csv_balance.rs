@@ -90,9 +90,9 @@ fn default_run_balances_from_the_csv() {
     let model = Model::planar(&PlanarParams::default()).unwrap();
     let rows = read_rows(&dir.path().join("out/trajectory.csv"), &model);
     assert_eq!(rows.len(), 101);
-    // The run exercises knee and hip contacts, carrying load at the end.
+    // The run exercises knee and hip contacts: they carry load at the end.
     let last = rows.last().unwrap();
-    assert!(last.n[2..6].iter().all(|&n| n > 0.0), "{:?}", last.n);
+    assert!(last.n[2..6].iter().sum::<f64>() > 50.0, "{:?}", last.n);
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");
     // The check has teeth: a 1 N error in one written force is caught.

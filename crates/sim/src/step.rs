@@ -193,7 +193,8 @@ fn set_contact_equations(model: &Model, data: &mut Data) {
             tangent,
             normal,
             mu_dynamic: model.params.friction.mu_dynamic,
-            regularization: model.contact.regularization,
+            regularization: model.contact.regularization
+                + model.contact_compliance[c] * data.fbd.position_gain,
         };
     }
 }
@@ -264,6 +265,15 @@ fn check_contacts(model: &Model, data: &mut Data) -> bool {
         let Some((c, next, _)) = best else {
             return false;
         };
+        // A point that slid, tried sticking and must slide again is locked in
+        // ST3 from now on (see above): the search has learnt something, and
+        // returning to an earlier combination is no longer a cycle.
+        if data.seen[c] & 0b100 != 0
+            && matches!(data.trial[c], ContactState::Stick { .. })
+            && matches!(next, ContactState::Slide { .. })
+        {
+            data.visited.clear();
+        }
         data.trial[c] = next;
     }
     rigid_anchors(model, data);
@@ -272,30 +282,43 @@ fn check_contacts(model: &Model, data: &mut Data) -> bool {
 
 /// Anchors of points that share a rigid body. SPEC §3 anchors a touchdown
 /// where the point's straight path `p[k] → p[k+1]` crosses the terrain; for
-/// two points of one body (a knee and a foot of one link, both hips) those
-/// crossings belong to different instants and are not a rigid placement, so
-/// sticking at both would tear the body apart. When a body has more than one
-/// point in contact, each of its points that is anchored anew this trial
-/// (ST2 now, not ST2 in the accepted state) is anchored at the terrain below
-/// its trial position `p[k+1]`, which all come from one configuration.
-/// A point alone on its body — every foot of the paper's model — keeps the
-/// SPEC's crossing.
+/// two points of one body (a knee and a foot of one link, both hips) two
+/// such anchors are not a rigid placement — their distance differs from the
+/// points' by the body's motion during the step — and sticking at both
+/// would tear the body apart. So on each body, the first point to stick
+/// keeps its anchor (an already sticking point, or else the first point
+/// anchored now, which keeps the SPEC's crossing), and every other point
+/// anchored now is placed on the terrain at its rigid distance from that
+/// reference, on its side. A point alone on its body — every foot of the
+/// paper's model — is untouched.
 fn rigid_anchors(model: &Model, data: &mut Data) {
     let mech = &model.mech;
-    for (c, spec) in mech.contacts.iter().enumerate() {
-        if !matches!(data.trial[c], ContactState::Stick { .. })
-            || matches!(data.states[c], ContactState::Stick { .. })
-        {
+    for body in 0..mech.bodies.len() {
+        let on_body = || (0..mech.contacts.len()).filter(move |&c| mech.contacts[c].body == body);
+        let fresh = |data: &Data, c: usize| {
+            matches!(data.trial[c], ContactState::Stick { .. })
+                && !matches!(data.states[c], ContactState::Stick { .. })
+        };
+        let kept = on_body()
+            .find(|&c| matches!(data.trial[c], ContactState::Stick { .. }) && !fresh(data, c));
+        let Some(reference) = kept.or_else(|| on_body().find(|&c| fresh(data, c))) else {
             continue;
-        }
-        let shared = mech.contacts.iter().enumerate().any(|(o, other)| {
-            o != c && other.body == spec.body && !matches!(data.trial[o], ContactState::Free)
-        });
-        if shared {
-            let x = data.fbd.kin_next.pos[spec.point][0];
-            data.trial[c] = ContactState::Stick {
-                anchor: [x, model.params.terrain.height(x)],
-            };
+        };
+        let ContactState::Stick { anchor: from } = data.trial[reference] else {
+            unreachable!("the reference sticks")
+        };
+        let p_ref = data.fbd.kin.pos[mech.contacts[reference].point];
+        for c in on_body() {
+            if c == reference || !fresh(data, c) {
+                continue;
+            }
+            let p = data.fbd.kin.pos[mech.contacts[c].point];
+            let dist = (p[0] - p_ref[0]).hypot(p[1] - p_ref[1]);
+            let anchor = model
+                .params
+                .terrain
+                .point_at_distance(from, dist, p[0] - p_ref[0]);
+            data.trial[c] = ContactState::Stick { anchor };
         }
     }
 }

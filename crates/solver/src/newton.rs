@@ -56,6 +56,10 @@ use crate::{JacobianSink, NewtonSystem, SolverError};
 ///    (badly scaled rows) without ever reporting a stagnating iterate far
 ///    from a root as converged: a tiny step with a large residual is not
 ///    convergence (the line search then usually fails → `Diverged`).
+/// 3. **Floor test** — when the line search cannot decrease the residual at
+///    all and `‖r‖ ≤ step_residual_factor · residual_tol`, the iterate is at
+///    the same round-off floor (e.g. poorly determined unknowns, whose steps
+///    are never negligible, make the residual noisy) and is accepted.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonParams {
     /// Maximum number of Newton steps before giving up with
@@ -737,6 +741,15 @@ impl Workspace {
                     }
                 }
                 alpha *= 0.5;
+            }
+            if !accepted && rnorm <= params.step_residual_factor * params.residual_tol {
+                // No decrease is possible, and the residual is already within
+                // the round-off allowance of the step test: the floor.
+                return Ok(NewtonReport {
+                    iterations: chord + iter,
+                    residual: rnorm,
+                    factorizations: iter + 1,
+                });
             }
             if !accepted {
                 return Err(if any_finite {

@@ -188,6 +188,40 @@ fn system_without_real_root_diverges() {
 }
 
 #[test]
+fn a_residual_at_its_noise_floor_is_accepted_but_not_one_far_from_it() {
+    // r = x − 1 ± ε (the sign of x − 1): |r| ≥ ε everywhere, so with
+    // ε = 2e-9 the residual cannot be pushed below residual_tol = 1e-9, and
+    // the Newton steps (~ε) are never "negligible" (step_tol = 1e-12): only
+    // the floor test — no decrease possible, ‖r‖ ≤ step_residual_factor·tol —
+    // accepts it. Without that test this is `Diverged`.
+    let noisy = |level: f64| Small {
+        n: 1,
+        key: 11,
+        entries: vec![(0, 0)],
+        f: move |x: &[f64], r: &mut [f64], j: &mut dyn FnMut(usize, usize, f64)| {
+            let e = x[0] - 1.0;
+            r[0] = e + if e >= 0.0 { level } else { -level };
+            j(0, 0, 1.0);
+        },
+    };
+    let mut x = vec![0.0];
+    let report = NewtonSolver::default()
+        .solve(&mut noisy(2e-9), &mut x)
+        .expect("a residual at the round-off floor is converged");
+    assert!(
+        report.residual >= 2e-9 && report.residual <= 1e-6,
+        "{report:?}"
+    );
+    assert!((x[0] - 1.0).abs() < 1e-8);
+    // The same floor at 1e-3 is far above the allowance: diverged.
+    let mut x = vec![0.0];
+    let err = NewtonSolver::default()
+        .solve(&mut noisy(1e-3), &mut x)
+        .unwrap_err();
+    assert!(matches!(err, SolverError::Diverged { .. }), "{err}");
+}
+
+#[test]
 fn iteration_limit_reports_diverged_at_max_iterations() {
     // Converges, but needs more than one step.
     let mut sys = TrigChain::with_root(&root10(), 1);

@@ -7,11 +7,9 @@
 //! `GlobalAlloc` needs `unsafe impl`, which the workspace lints forbid). The
 //! counters are process-global, so this file holds a single `#[test]`.
 //!
-//! Cases, at Δt = 1 ms with the default experiment's robot:
-//! * flight — no terrain, both tips ST1;
-//! * stick — both tips on flat ground, μS huge: both ST2;
-//! * slide — both tips on the ground, μS = μD = 0, body moving at 0.5 m/s:
-//!   both ST3.
+//! Cases: the benchmarks' fixtures (`benches/common/mod.rs`), the default
+//! experiment's robot at Δt = 1 ms with its feet in flight (ST1), sticking
+//! (ST2) or sliding (ST3).
 //!
 //! Each case builds a `Model`, runs 2010 steps once so that the solver has
 //! met every contact pattern of the run (the first solve of a pattern builds
@@ -19,64 +17,26 @@
 //! restarts from a fresh `Data` with that warm solver, steps 10 times
 //! (the first step uses the initial velocities) and counts the heap traffic
 //! of the next 2000 `fbd_sim::step` calls, which must be zero.
-//! (Contact *events* are outside this guarantee: an `Event` carries the
-//! point's name as a `String`.)
+//! (Contact *events* are outside this guarantee: the event list grows, in
+//! amortised steps, past its initial capacity of 64.)
 
 use std::alloc::System;
 
-use fbd_contact::{ContactState, Friction, Terrain};
-use fbd_dynamics::ContactPoints;
-use fbd_sim::{Data, Model, PlanarParams, step};
+use fbd_sim::{Data, step};
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
+
+/// The benchmarks' fixtures: the same three cases.
+#[path = "../benches/common/mod.rs"]
+mod fixtures;
+use fixtures::Case;
 
 #[global_allocator]
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
-fn params(case: &str) -> PlanarParams {
-    let mut p = PlanarParams {
-        dt: 1e-3,
-        duration: 10.0,
-        // The paper's model: the states named are those of the feet.
-        contact_points: ContactPoints {
-            tips: true,
-            knees: false,
-            hips: false,
-        },
-        ..PlanarParams::default()
-    };
-    if case == "flight" {
-        p.terrain = Terrain::None;
-        return p;
-    }
-    let th3 = 250f64.to_radians();
-    p.q0 = [0.0, -p.lower_length * th3.sin(), 0.0, 0.0, th3, 0.0, th3];
-    if case == "stick" {
-        p.friction = Friction {
-            mu_static: 1e6,
-            mu_dynamic: 0.3,
-        };
-    } else {
-        p.friction = Friction {
-            mu_static: 0.0,
-            mu_dynamic: 0.0,
-        };
-        p.qdot0[0] = 0.5;
-    }
-    p
-}
-
-fn in_state(case: &str, s: &ContactState) -> bool {
-    match case {
-        "flight" => matches!(s, ContactState::Free),
-        "stick" => matches!(s, ContactState::Stick { .. }),
-        _ => matches!(s, ContactState::Slide { .. }),
-    }
-}
-
 #[test]
 fn steady_stepping_does_not_allocate() {
-    for case in ["flight", "stick", "slide"] {
-        let model = Model::planar(&params(case)).expect("valid parameters");
+    for case in Case::ALL {
+        let model = case.model();
         // A first pass registers every contact pattern the run meets (the
         // state search may try a pattern for one trial without an event:
         // its first solve builds its structure and symbolic LU).
@@ -91,11 +51,7 @@ fn steady_stepping_does_not_allocate() {
         for _ in 0..10 {
             step(&model, &mut data).expect("warm-up step");
         }
-        assert!(
-            data.states.iter().all(|s| in_state(case, s)),
-            "{case}: {:?}",
-            data.states
-        );
+        assert!(case.holds(&data.states), "{case:?}: {:?}", data.states);
         let events = data.events.len();
         let patterns = data.symbolic_factorizations();
 
@@ -105,25 +61,21 @@ fn steady_stepping_does_not_allocate() {
         }
         let stats = region.change();
 
-        assert!(
-            data.states.iter().all(|s| in_state(case, s)),
-            "{case}: {:?}",
-            data.states
-        );
+        assert!(case.holds(&data.states), "{case:?}: {:?}", data.states);
         assert_eq!(
             data.events.len(),
             events,
-            "{case}: no events in a steady state"
+            "{case:?}: no events in a steady state"
         );
         assert_eq!(
             data.symbolic_factorizations(),
             patterns,
-            "{case}: a new contact pattern in the measured pass"
+            "{case:?}: a new contact pattern in the measured pass"
         );
         assert!(
             stats.allocations == 0 && stats.reallocations == 0 && stats.deallocations == 0,
-            "{case}: heap traffic in 2000 steady steps: {stats:?}"
+            "{case:?}: heap traffic in 2000 steady steps: {stats:?}"
         );
-        eprintln!("{case}: 2000 steps, {stats:?}");
+        eprintln!("{case:?}: 2000 steps, {stats:?}");
     }
 }

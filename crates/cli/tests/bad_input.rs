@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{fbd, s};
+use common::{FAILS_AT_STEP_49, fbd, s};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -326,12 +326,6 @@ fn non_utf8_file_is_rejected() {
 }
 
 // ---- output directory: fails before simulating (exit 4) ----
-
-/// The failing experiment: the paper's model (contact at the feet only) run
-/// to 1 s; its body falls through the floor, a leg straightens and Newton
-/// diverges at step 49. If it were simulated the exit status would be 3, so
-/// exit 4 proves the directory was checked first.
-const FAILS_AT_STEP_49: &str = "[time]\nduration = 1.0\n[contact]\npoints = [\"tips\"]\n";
 
 #[test]
 fn output_dir_that_cannot_be_created_fails_before_simulating() {

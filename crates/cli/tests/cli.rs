@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{example, fbd, s, stderr, stdout, write};
+use common::{FAILS_AT_STEP_49, example, fbd, s, stderr, stdout, write};
 use std::path::Path;
 use std::process::Output;
 
@@ -364,16 +364,9 @@ fn hexapod_run_is_not_implemented_yet() {
 
 #[test]
 fn a_failed_simulation_still_writes_everything() {
-    // The paper's model (contact at the feet only) run to 1 s fails
-    // deterministically at step 49: the body has fallen through the floor, a
-    // leg straightens and Newton diverges. A run that succeeds here is a
-    // regression of this test.
+    // A run that succeeds here is a regression of this test.
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write(
-        dir.path(),
-        "fail.toml",
-        "[time]\nduration = 1.0\n[contact]\npoints = [\"tips\"]\n",
-    );
+    let cfg = write(dir.path(), "fail.toml", FAILS_AT_STEP_49);
     let out = dir.path().join("o");
     let o = fbd(&["run", s(&cfg), "--out", s(&out)]);
     assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));

@@ -43,3 +43,8 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     std::fs::write(&p, text).unwrap();
     p
 }
+
+/// The reference failing experiment: the paper's model (contact at the feet
+/// only) run to 1 s. Its body falls through the floor, a leg straightens and
+/// Newton diverges, deterministically at step 49 (t = 0.49 s).
+pub const FAILS_AT_STEP_49: &str = "[time]\nduration = 1.0\n[contact]\npoints = [\"tips\"]\n";

@@ -11,7 +11,8 @@
 //! or output error. Every error is one line on stderr, `error: …`.
 
 pub mod cli;
-pub mod config;
+/// The configuration: the `fbd-scenario` crate.
+pub use fbd_scenario as config;
 pub mod error;
 pub mod kinematics;
 pub mod output;

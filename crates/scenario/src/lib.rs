@@ -1,4 +1,7 @@
-//! The TOML configuration of SPEC §4.
+//! # fbd-scenario
+//!
+//! The TOML configuration of a run (schema, defaults, loading, validation),
+//! shared by the `fbd` command line, the Python package and Rust programs.
 //!
 //! * Every table and key is optional; omitted keys take the built-in default
 //!   experiment ([`fbd_sim::PlanarParams::default`], the paper's §6 falling

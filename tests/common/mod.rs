@@ -1,5 +1,6 @@
 //! Shared helpers of the workspace-level tests.
 #![allow(dead_code)]
 
+pub mod gait;
 pub mod physics;
 pub mod strategies;

@@ -125,3 +125,41 @@ pub fn planar_q() -> impl Strategy<Value = [f64; PLANAR_NQ]> {
     )
         .prop_map(|(x, y, p, a, b, c, d)| [x, y, p, a, b, c, d])
 }
+
+/// Gait parameters of a walk the paper's robot can reach from the default
+/// stance ([`fbd_sim::gait::InitialPose::default`]): a preset kind, period
+/// 0.8–1.2 s, forward ±0.08 m/s, lateral ±0.03 m/s, yaw ±10°/s, swing
+/// height 2–8 cm, body height ±2 cm, roll and pitch ±4°, sway 0–1.5 cm,
+/// ramp 0–1 s.
+pub fn gait_params() -> impl Strategy<Value = fbd_sim::gait::GaitParams> {
+    use fbd_sim::gait::{Command, GaitKind, GaitParams};
+    let kind = prop_oneof![
+        Just(GaitKind::Tripod),
+        Just(GaitKind::Ripple),
+        Just(GaitKind::Wave)
+    ];
+    (
+        kind,
+        0.8..1.2f64,
+        (-0.08..0.08f64, -0.03..0.03f64, -10.0..10.0f64),
+        (0.02..0.08f64, -0.02..0.02f64),
+        (-4.0..4.0f64, -4.0..4.0f64, 0.0..0.015f64, 0.0..1.0f64),
+    )
+        .prop_map(
+            |(kind, period, (fwd, lat, yaw), (swing, height), (roll, pitch, sway, ramp))| {
+                GaitParams {
+                    period,
+                    forward: Command::Constant(fwd),
+                    lateral: Command::Constant(lat),
+                    yaw_rate: Command::Constant(yaw.to_radians()),
+                    swing_height: swing,
+                    height,
+                    roll: roll.to_radians(),
+                    pitch: pitch.to_radians(),
+                    sway,
+                    ramp,
+                    ..GaitParams::preset(kind)
+                }
+            },
+        )
+}

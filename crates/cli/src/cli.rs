@@ -11,20 +11,27 @@ use crate::CliError;
 ///
 /// Simulates the planar two-leg model of the paper's §6 (a hexapod
 /// falling onto flat ground, legs 3 and 4), writing trajectories, contact
-/// events and the plots of the paper's Fig. 7. Exit status: 0 ok, 2 usage
-/// or configuration error, 3 simulation failed (partial files written),
-/// 4 input/output error.
+/// events and the plots of the paper's Fig. 7. Without a command, `fbd`
+/// is `fbd run`: the built-in experiment, files in out/ (or --out DIR).
+/// Exit status: 0 ok, 2 usage or configuration error, 3 simulation failed
+/// (partial files written), 4 input/output error, 130 interrupted
+/// (Ctrl-C; the steps computed so far are written). Every key, file and
+/// column: docs/reference.md.
 #[derive(Debug, Parser)]
 #[command(
     name = "fbd",
     version,
     propagate_version = true,
-    arg_required_else_help = true
+    args_conflicts_with_subcommands = true
 )]
 pub struct Cli {
-    /// The command to run.
+    /// The command to run (default: run).
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
+    /// Output directory of the built-in experiment when no command is
+    /// given.
+    #[arg(short, long, value_name = "DIR", default_value = "out")]
+    pub out: PathBuf,
 }
 
 /// The subcommands.
@@ -40,13 +47,25 @@ pub enum Command {
     /// docs/sweep.md): DIR/runs/<i>/, DIR/index.csv, DIR/sweep.svg;
     /// `fbd sweep merge` joins shard directories.
     Sweep(crate::sweep::SweepArgs),
+    /// Write DIR/viewer.html, the animated viewer of a finished run, from
+    /// DIR/config.toml, DIR/trajectory.csv and DIR/events.csv (`fbd run`
+    /// writes it too); open it in a browser, no network needed.
+    View(ViewArgs),
+}
+
+/// Arguments of `fbd view`.
+#[derive(Debug, Args)]
+pub struct ViewArgs {
+    /// Output folder of `fbd run`.
+    #[arg(value_name = "DIR")]
+    pub dir: PathBuf,
 }
 
 /// Arguments of `fbd run`.
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// TOML configuration (SPEC §4). Without it: the built-in default, the
-    /// paper's falling experiment.
+    /// TOML configuration (every key: docs/reference.md). Without it: the
+    /// built-in default, the paper's falling experiment.
     #[arg(value_name = "CONFIG")]
     pub config: Option<PathBuf>,
     /// Output directory, created if needed.
@@ -65,8 +84,10 @@ pub struct KinematicsArgs {
 /// Runs the parsed command, printing its normal output to `out`.
 pub fn dispatch(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     match cli.command {
-        Command::Run(a) => crate::run::run_command(a.config.as_deref(), &a.out, out),
-        Command::Kinematics(a) => crate::kinematics::kinematics_command(&a.config, out),
-        Command::Sweep(a) => crate::sweep::sweep_command(a, out),
+        None => crate::run::run_command(None, &cli.out, out),
+        Some(Command::Run(a)) => crate::run::run_command(a.config.as_deref(), &a.out, out),
+        Some(Command::Kinematics(a)) => crate::kinematics::kinematics_command(&a.config, out),
+        Some(Command::Sweep(a)) => crate::sweep::sweep_command(a, out),
+        Some(Command::View(a)) => crate::viewer::view::view_command(&a.dir, out),
     }
 }

@@ -17,6 +17,10 @@ pub enum CliError {
     /// (exit 3).
     #[error("{0}")]
     Simulation(String),
+    /// SIGINT or SIGTERM stopped the command; what was computed is written
+    /// (exit 130).
+    #[error("{0}")]
+    Interrupted(String),
     /// Reading or writing a file failed (exit 4).
     #[error("{0}")]
     Io(String),
@@ -30,14 +34,15 @@ impl CliError {
     /// Exit status for an internal error (a caught panic).
     pub const INTERNAL: u8 = 70;
 
-    /// The process exit status of this error (SPEC §5): 2 usage or
-    /// configuration, 3 simulation, 4 input/output.
+    /// The process exit status of this error: 2 usage or configuration,
+    /// 3 simulation, 4 input/output, 130 interrupted.
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Config(e) if e.is_io() => 4,
             CliError::Config(_) | CliError::Usage(_) => 2,
             CliError::Simulation(_) => 3,
             CliError::Io(_) | CliError::BrokenPipe => 4,
+            CliError::Interrupted(_) => crate::interrupt::EXIT,
         }
     }
 

@@ -14,12 +14,16 @@ pub mod cli;
 /// The configuration: the `fbd-scenario` crate.
 pub use fbd_scenario as config;
 pub mod error;
+pub mod hexapod;
+pub mod interrupt;
 pub mod kinematics;
 pub mod output;
 pub mod plot;
 pub mod run;
+pub mod steptime;
 pub mod sweep;
 pub mod sweep_plot;
+pub mod viewer;
 
 pub use config::{Config, ConfigError, Override};
 pub use error::CliError;
@@ -51,6 +55,7 @@ where
             .unwrap_or_default();
         eprintln!("error: internal error: {}{at}", msg.replace('\n', " "));
     }));
+    interrupt::install();
     let cli = match cli::Cli::try_parse_from(args) {
         Ok(c) => c,
         Err(e) => {

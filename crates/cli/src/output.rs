@@ -8,11 +8,12 @@
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use fbd_sim::{Event, StepRecord};
+use fbd_sim::{Event, LimitEvent, RetryEvent, RunSummary, StepRecord};
 use serde::Serialize;
 use tempfile::NamedTempFile;
 
 use crate::CliError;
+use crate::steptime::StepTimes;
 
 /// Names of the files `fbd run` writes, in the order they are written.
 pub const FILES: [&str; 7] = [
@@ -46,8 +47,8 @@ pub const TAIL_COLUMNS: [&str; 8] = [
 ];
 
 /// A new temporary file in `dir`, readable like an ordinary file once
-/// renamed.
-fn temp_in(dir: &Path, name: &str) -> Result<NamedTempFile, CliError> {
+/// renamed ([`persist`]).
+pub fn temp_in(dir: &Path, name: &str) -> Result<NamedTempFile, CliError> {
     let prefix = format!(".{name}.");
     let mut b = tempfile::Builder::new();
     b.prefix(&prefix).suffix(".tmp");
@@ -60,10 +61,17 @@ fn temp_in(dir: &Path, name: &str) -> Result<NamedTempFile, CliError> {
         .map_err(|e| CliError::io(format!("{}: cannot create a file", dir.display()), &e))
 }
 
-fn persist(tmp: NamedTempFile, dest: &Path) -> Result<(), CliError> {
+/// Renames a finished temporary file to `dest` (all-or-nothing).
+pub fn persist(tmp: NamedTempFile, dest: &Path) -> Result<(), CliError> {
     tmp.persist(dest)
         .map_err(|e| CliError::io(dest.display(), &e.error))?;
     Ok(())
+}
+
+/// `n` and the noun agreeing with it: `count(1, "run", "runs")` is
+/// `"1 run"`, `count(2, …)` `"2 runs"`.
+pub fn count(n: usize, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
 }
 
 /// Writes `bytes` to `dir/name` all-or-nothing; returns the path.
@@ -125,6 +133,7 @@ pub struct TrajectoryWriter {
     out: BufWriter<NamedTempFile>,
     dest: PathBuf,
     num: ryu::Buffer,
+    times: StepTimes,
     tips: [Option<usize>; 2],
     extras: Vec<usize>,
     error: Option<io::Error>,
@@ -132,14 +141,16 @@ pub struct TrajectoryWriter {
 }
 
 impl TrajectoryWriter {
-    /// Opens the temporary file in `dir` and writes the header.
-    pub fn create(dir: &Path, contacts: &[String]) -> Result<Self, CliError> {
+    /// Opens the temporary file in `dir` and writes the header; `dt` is
+    /// the time step (times are written as the decimal of k·Δt).
+    pub fn create(dir: &Path, contacts: &[String], dt: f64) -> Result<Self, CliError> {
         let dest = dir.join("trajectory.csv");
         let tmp = temp_in(dir, "trajectory.csv")?;
         let mut w = Self {
             out: BufWriter::with_capacity(1 << 16, tmp),
             dest,
             num: ryu::Buffer::new(),
+            times: StepTimes::new(dt),
             tips: [
                 contacts.iter().position(|n| n == "tip3"),
                 contacts.iter().position(|n| n == "tip4"),
@@ -185,7 +196,7 @@ impl TrajectoryWriter {
     }
 
     fn write_row(&mut self, r: &StepRecord) -> io::Result<()> {
-        self.out.write_all(self.num.format(r.t).as_bytes())?;
+        self.times.write(&mut self.out, r.step, r.t)?;
         for &x in &r.q {
             self.f(x)?;
         }
@@ -238,12 +249,13 @@ impl TrajectoryWriter {
     }
 }
 
-/// `events.csv`: header `t,leg,from,to,point`, one row per event.
-pub fn events_csv(events: &[Event]) -> String {
+/// `events.csv`: header `t,leg,from,to,point`, one row per event; times
+/// as the decimal of k·Δt.
+pub fn events_csv(events: &[Event], dt: f64) -> String {
     let mut s = String::from("t,leg,from,to,point\n");
-    let mut num = ryu::Buffer::new();
+    let times = StepTimes::new(dt);
     for e in events {
-        s.push_str(num.format(e.t));
+        s.push_str(&times.string(e.step, e.t));
         s.push_str(&format!(
             ",{},{},{},{}\n",
             e.leg,
@@ -260,26 +272,88 @@ pub fn events_csv(events: &[Event]) -> String {
 pub struct EventJson {
     /// Start of the first step solved in the new state (s).
     pub t: f64,
-    /// Hexapod leg number.
-    pub leg: usize,
-    /// `tip`, `knee` or `hip`.
+    /// Hexapod leg number (null for a retried step).
+    pub leg: Option<usize>,
+    /// `tip`, `knee` or `hip`; `hip_limit` or `knee_limit` for a joint
+    /// reaching (`free` → `min`/`max`) or leaving an end of its range;
+    /// `substeps` for a step solved again in substeps (`1` → `n`).
     pub point: String,
     /// Previous state.
-    pub from: &'static str,
+    pub from: String,
     /// New state.
-    pub to: &'static str,
+    pub to: String,
 }
 
-impl From<&Event> for EventJson {
-    fn from(e: &Event) -> Self {
+impl EventJson {
+    /// The event with its time rounded to the decimal of k·Δt.
+    pub fn new(e: &Event, times: &StepTimes) -> Self {
         Self {
-            t: e.t,
-            leg: e.leg,
+            t: times.value(e.step, e.t),
+            leg: Some(e.leg),
             point: e.point.to_owned(),
-            from: e.from.as_str(),
-            to: e.to.as_str(),
+            from: e.from.as_str().to_owned(),
+            to: e.to.as_str().to_owned(),
         }
     }
+
+    /// A joint-limit event.
+    pub fn limit(e: &LimitEvent, times: &StepTimes) -> Self {
+        Self {
+            t: times.value(e.step, e.t),
+            leg: Some(e.leg),
+            point: e.point().to_owned(),
+            from: e.from.as_str().to_owned(),
+            to: e.to.as_str().to_owned(),
+        }
+    }
+
+    /// A step retried in `n` substeps: `from` 1, `to` n.
+    pub fn retry(e: &RetryEvent, times: &StepTimes) -> Self {
+        Self {
+            t: times.value(e.step, e.t),
+            leg: None,
+            point: "substeps".to_owned(),
+            from: "1".to_owned(),
+            to: e.substeps.to_string(),
+        }
+    }
+}
+
+/// Every event of a run — contact, joint-limit and retried-step events —
+/// in time order (contact events first at equal times), with the step and
+/// floating-point time of each.
+pub fn run_events(run: &RunSummary, times: &StepTimes) -> Vec<(usize, f64, EventJson)> {
+    let mut all: Vec<(usize, f64, EventJson)> = run
+        .events
+        .iter()
+        .map(|e| (e.step, e.t, EventJson::new(e, times)))
+        .chain(
+            run.limit_events
+                .iter()
+                .map(|e| (e.step, e.t, EventJson::limit(e, times))),
+        )
+        .chain(
+            run.retries
+                .iter()
+                .map(|e| (e.step, e.t, EventJson::retry(e, times))),
+        )
+        .collect();
+    all.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    all
+}
+
+/// `events.csv` of a whole run ([`run_events`]): contact events as
+/// [`events_csv`] writes them, then joint-limit rows (`t,4,free,max,knee_limit`)
+/// and retried steps (`t,,1,8,substeps`: the leg is empty) in time order.
+pub fn run_events_csv(run: &RunSummary, dt: f64) -> String {
+    let mut s = String::from("t,leg,from,to,point\n");
+    let times = StepTimes::new(dt);
+    for (step, t, e) in run_events(run, &times) {
+        s.push_str(&times.string(step, t));
+        let leg = e.leg.map(|l| l.to_string()).unwrap_or_default();
+        s.push_str(&format!(",{leg},{},{},{}\n", e.from, e.to, e.point));
+    }
+    s
 }
 
 /// Peak contact forces of one contact point over the run (N).
@@ -307,7 +381,8 @@ pub struct Energy {
 /// `summary.json`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
-    /// `"ok"` or `"error"`.
+    /// `"ok"`, `"error"`, or `"interrupted"` (SIGINT/SIGTERM stopped the
+    /// run; the steps before are written).
     pub status: &'static str,
     /// The error message, or null.
     pub error: Option<String>,
@@ -321,8 +396,11 @@ pub struct Summary {
     pub steps_per_second: Option<f64>,
     /// Symbolic LU factorisations performed.
     pub symbolic_factorizations: usize,
-    /// Contact events, as `events.csv`.
+    /// Contact, joint-limit and retried-step events, as `events.csv`.
     pub events: Vec<EventJson>,
+    /// Steps that could not be solved whole and were solved in substeps
+    /// of Δt/2, Δt/4, … (each is a `substeps` event).
+    pub retried_steps: usize,
     /// `"planar"`.
     pub model: &'static str,
     /// Time step (s).

@@ -1,11 +1,30 @@
 //! The SVG plots of `fbd run`: the two graphs of the paper's Fig. 7
-//! (`tips.svg`: tip positions versus time; `forces.svg`: contact forces
-//! versus time) and a Fig. 6-like drawing of the structure at regular
+//! (`tips.svg`: tip positions versus time; `forces.svg`: contact forces of
+//! every point that ever touched), `joints.svg` (joint angles),
+//! `torques.svg` (actuator torques, when any), `energy.svg` (kinetic,
+//! potential, total) and a Fig. 6-like drawing of the structure at regular
 //! instants (`stance.svg`).
+//!
+//! How the curves are drawn:
+//!
+//! * every step of the run is recorded ([`PlotRecorder`]), reduced on the
+//!   fly to the first, smallest, largest and last value of each of
+//!   [`COLUMNS`] time columns ([`MinMax`]): a 600 000-step run plots in a
+//!   few thousand points per curve and keeps its peaks;
+//! * a curve is one SVG polyline; a dashed curve carries
+//!   `stroke-dasharray` (never one element per dash), and its legend
+//!   sample is dashed the same way;
+//! * the legend sits beside the plot, never over a curve; curves that
+//!   coincide stay visible (solid and dashed alternate, later curves on
+//!   top);
+//! * every contact-event line is labelled (leg, point, new state) at the
+//!   top of the plot; events closer than a few pixels share a label.
 
-use fbd_contact::Terrain;
+use fbd_contact::{StateCode, Terrain};
+use fbd_sim::{Event, StepRecord};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 /// The structure at one instant (inertial x, y in metres).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -20,24 +39,263 @@ pub struct Stance {
     pub tip: [[f64; 2]; 2],
 }
 
+/// One curve: `(t, value)` points in time order; a NaN value breaks the
+/// line.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Trace {
+    /// Legend label.
+    pub label: String,
+    /// The points.
+    pub pts: Vec<(f64, f64)>,
+}
+
+/// A contact event drawn as a labelled vertical line.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EventMark {
+    /// Time (s).
+    pub t: f64,
+    /// Short label, e.g. `4 tip ST2`.
+    pub label: String,
+}
+
+impl EventMark {
+    /// The mark of a contact event: leg, point and new state.
+    pub fn of(e: &Event) -> Self {
+        Self {
+            t: e.t,
+            label: format!("{} {} {}", e.leg, e.point, e.to.as_str()),
+        }
+    }
+}
+
 /// Everything the plots show.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PlotData {
-    /// Sample times (s).
-    pub t: Vec<f64>,
-    /// Tip positions: `tip[leg][axis]` with leg 0 = leg 3, 1 = leg 4, axis
-    /// 0 = x, 1 = y (m).
-    pub tip: [[Vec<f64>; 2]; 2],
-    /// Tangential force on tips 3 and 4 (N).
-    pub fa: [Vec<f64>; 2],
-    /// Normal force on tips 3 and 4 (N).
-    pub n: [Vec<f64>; 2],
-    /// Contact event times (s).
-    pub events: Vec<f64>,
+    /// Tip positions: tip 3 x, tip 3 y, tip 4 x, tip 4 y (m).
+    pub tips: Vec<Trace>,
+    /// Normal force of every contact point that ever touched (N).
+    pub normal: Vec<Trace>,
+    /// Tangential force of the same points, same order (N).
+    pub tangential: Vec<Trace>,
+    /// Joint angles θ2₃, θ3₃, θ2₄, θ3₄ (degrees).
+    pub joints: Vec<Trace>,
+    /// Joint torques, hip 3, knee 3, hip 4, knee 4 (N·m); empty when every
+    /// torque is zero (a passive run).
+    pub torques: Vec<Trace>,
+    /// Kinetic, potential and total energy (J).
+    pub energy: Vec<Trace>,
+    /// Contact events.
+    pub events: Vec<EventMark>,
     /// Snapshots of the structure.
     pub stances: Vec<Stance>,
     /// The ground.
     pub terrain: Option<Terrain>,
+}
+
+/// Time columns of the min/max reduction of every curve (a little more
+/// than the plot's width in pixels).
+pub const COLUMNS: usize = 1000;
+
+/// Reduces a curve on the fly to at most four points per time column: the
+/// first, the smallest, the largest and the last value, in time order. A
+/// non-finite value breaks the line.
+#[derive(Clone, Debug)]
+pub struct MinMax {
+    t0: f64,
+    per_second: f64,
+    column: Option<i64>,
+    first: (f64, f64),
+    lo: (f64, f64),
+    hi: (f64, f64),
+    last: (f64, f64),
+    out: Vec<(f64, f64)>,
+}
+
+impl MinMax {
+    /// For times from `t0` to `t1`.
+    pub fn new(t0: f64, t1: f64) -> Self {
+        let span = if t1 > t0 { t1 - t0 } else { 1.0 };
+        Self {
+            t0,
+            per_second: COLUMNS as f64 / span,
+            column: None,
+            first: (0.0, 0.0),
+            lo: (0.0, 0.0),
+            hi: (0.0, 0.0),
+            last: (0.0, 0.0),
+            out: Vec::with_capacity(4 * COLUMNS + 8),
+        }
+    }
+
+    /// Adds the value `v` at time `t` (times increasing).
+    pub fn push(&mut self, t: f64, v: f64) {
+        if !v.is_finite() {
+            self.flush();
+            if self.out.last().is_some_and(|p| p.1.is_finite()) {
+                self.out.push((t, f64::NAN));
+            }
+            return;
+        }
+        let c = ((t - self.t0) * self.per_second).floor() as i64;
+        if self.column == Some(c) {
+            if v < self.lo.1 {
+                self.lo = (t, v);
+            }
+            if v > self.hi.1 {
+                self.hi = (t, v);
+            }
+            self.last = (t, v);
+        } else {
+            self.flush();
+            self.column = Some(c);
+            self.first = (t, v);
+            self.lo = (t, v);
+            self.hi = (t, v);
+            self.last = (t, v);
+        }
+    }
+
+    fn flush(&mut self) {
+        if self.column.take().is_none() {
+            return;
+        }
+        let (a, b) = if self.lo.0 <= self.hi.0 {
+            (self.lo, self.hi)
+        } else {
+            (self.hi, self.lo)
+        };
+        for p in [self.first, a, b, self.last] {
+            if self.out.last() != Some(&p) {
+                self.out.push(p);
+            }
+        }
+    }
+
+    /// The reduced curve.
+    pub fn finish(mut self) -> Vec<(f64, f64)> {
+        self.flush();
+        self.out
+    }
+}
+
+/// Gathers the curves of a planar run step by step (every step, not only
+/// the rows of `trajectory.csv`).
+pub struct PlotRecorder {
+    names: Vec<String>,
+    tips: [Option<usize>; 2],
+    touched: Vec<bool>,
+    tip: [MinMax; 4],
+    normal: Vec<MinMax>,
+    tangential: Vec<MinMax>,
+    joints: [MinMax; 4],
+    torques: [MinMax; 4],
+    torque_used: bool,
+    energy: [MinMax; 3],
+}
+
+impl PlotRecorder {
+    /// For a run from `t = 0` to `t_end` of a model whose contact points
+    /// are `names` (record order).
+    pub fn new(names: &[String], t_end: f64) -> Self {
+        let m = || MinMax::new(0.0, t_end);
+        Self {
+            names: names.to_vec(),
+            tips: [
+                names.iter().position(|n| n == "tip3"),
+                names.iter().position(|n| n == "tip4"),
+            ],
+            touched: vec![false; names.len()],
+            tip: std::array::from_fn(|_| m()),
+            normal: names.iter().map(|_| m()).collect(),
+            tangential: names.iter().map(|_| m()).collect(),
+            joints: std::array::from_fn(|_| m()),
+            torques: std::array::from_fn(|_| m()),
+            torque_used: false,
+            energy: std::array::from_fn(|_| m()),
+        }
+    }
+
+    /// Adds one step.
+    pub fn push(&mut self, r: &StepRecord) {
+        let t = r.t;
+        for (leg, c) in self.tips.iter().enumerate() {
+            let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
+            self.tip[2 * leg].push(t, p[0]);
+            self.tip[2 * leg + 1].push(t, p[1]);
+        }
+        for c in 0..self.names.len().min(r.contacts) {
+            self.touched[c] |= r.state[c] != StateCode::St1;
+            self.normal[c].push(t, r.n[c]);
+            self.tangential[c].push(t, r.fa[c]);
+        }
+        for (k, m) in self.joints.iter_mut().enumerate() {
+            m.push(t, r.q[3 + k].to_degrees());
+        }
+        for (k, m) in self.torques.iter_mut().enumerate() {
+            m.push(t, r.torque[k]);
+        }
+        self.torque_used |= r.torque.iter().any(|x| *x != 0.0);
+        self.energy[0].push(t, r.kinetic);
+        self.energy[1].push(t, r.potential);
+        self.energy[2].push(t, r.kinetic + r.potential);
+    }
+
+    /// The plot data; `stances` and `terrain` come from the caller.
+    pub fn finish(
+        self,
+        events: &[Event],
+        stances: Vec<Stance>,
+        terrain: Option<Terrain>,
+    ) -> PlotData {
+        let traces = |labels: &[&str], ms: Vec<MinMax>| -> Vec<Trace> {
+            labels
+                .iter()
+                .zip(ms)
+                .map(|(l, m)| Trace {
+                    label: (*l).to_owned(),
+                    pts: m.finish(),
+                })
+                .collect()
+        };
+        let mut normal = Vec::new();
+        let mut tangential = Vec::new();
+        for (((name, n), fa), touched) in self
+            .names
+            .iter()
+            .zip(self.normal)
+            .zip(self.tangential)
+            .zip(&self.touched)
+        {
+            if *touched {
+                normal.push(Trace {
+                    label: format!("n {name}"),
+                    pts: n.finish(),
+                });
+                tangential.push(Trace {
+                    label: format!("fa {name}"),
+                    pts: fa.finish(),
+                });
+            }
+        }
+        PlotData {
+            tips: traces(&["tip3 x", "tip3 y", "tip4 x", "tip4 y"], self.tip.into()),
+            normal,
+            tangential,
+            joints: traces(
+                &["θ2 leg 3", "θ3 leg 3", "θ2 leg 4", "θ3 leg 4"],
+                self.joints.into(),
+            ),
+            torques: if self.torque_used {
+                traces(&["hip 3", "knee 3", "hip 4", "knee 4"], self.torques.into())
+            } else {
+                Vec::new()
+            },
+            energy: traces(&["kinetic", "potential", "total"], self.energy.into()),
+            events: events.iter().map(EventMark::of).collect(),
+            stances,
+            terrain,
+        }
+    }
 }
 
 type PlotResult<T> = Result<T, String>;
@@ -52,8 +310,31 @@ const LEG4: RGBColor = RGBColor(214, 39, 40);
 const LEG4_LIGHT: RGBColor = RGBColor(245, 140, 60);
 const EVENT: RGBColor = RGBColor(150, 150, 150);
 const GROUND: RGBColor = RGBColor(120, 85, 45);
+/// Colours of the contact points in `forces.svg`, by kind and leg
+/// (tip, knee, hip × leg 3, leg 4).
+const POINT_COLORS: [[RGBColor; 2]; 3] = [
+    [LEG3, LEG4],
+    [RGBColor(44, 160, 44), RGBColor(148, 103, 189)],
+    [RGBColor(140, 86, 75), RGBColor(227, 119, 194)],
+];
+/// A palette for anything else.
+const PALETTE: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(214, 39, 40),
+    RGBColor(44, 160, 44),
+    RGBColor(255, 127, 14),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+/// Dash pattern of dashed curves and of event lines (px).
+const DASH: &str = "9 5";
+const EVENT_DASH: &str = "4 4";
 /// Samples of the terrain profile drawn in `stance.svg`.
 const TERRAIN_SAMPLES: usize = 400;
+/// Width of the legend column beside a chart (px).
+const LEGEND_WIDTH: u32 = 190;
 
 /// The legend box every chart draws, upper right.
 pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a>(
@@ -105,32 +386,163 @@ pub(crate) fn range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64)
     (lo - pad, hi + pad)
 }
 
-struct Series<'a> {
-    label: &'a str,
-    values: &'a [f64],
+/// How a curve is drawn.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Style {
     color: RGBColor,
+    width: u32,
     dashed: bool,
 }
 
+/// The SVG attribute text plotters writes for a stroke of `color`, `width`.
+fn stroke_attr(color: RGBColor, width: u32) -> String {
+    format!(
+        "stroke=\"#{:02X}{:02X}{:02X}\" stroke-width=\"{width}\"",
+        color.0, color.1, color.2
+    )
+}
+
+/// Makes every stroke of `(color, width)` dashed with `pattern`: one
+/// element per curve, whatever its length. Each dashed style's colour
+/// and width are unique in its chart.
+fn dash(svg: &mut String, color: RGBColor, width: u32, pattern: &str) {
+    let a = stroke_attr(color, width);
+    let b = format!("{a} stroke-dasharray=\"{pattern}\"");
+    *svg = svg.replace(&a, &b);
+}
+
+/// A legend entry in the column beside the chart.
+struct Entry {
+    label: String,
+    style: Style,
+}
+
+/// Draws the legend entries in `area`, top-down.
+fn side_legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    entries: &[Entry],
+) -> PlotResult<()> {
+    let font = ("sans-serif", 13).into_font().color(&BLACK);
+    for (i, e) in entries.iter().enumerate() {
+        let y = 50 + 20 * i as i32;
+        area.draw(&PathElement::new(
+            vec![(6, y), (40, y)],
+            e.style.color.stroke_width(e.style.width),
+        ))
+        .map_err(err)?;
+        area.draw(&Text::new(
+            e.label.clone(),
+            (46, y),
+            font.pos(Pos::new(HPos::Left, VPos::Center)),
+        ))
+        .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Draws `pts` as one polyline per run of finite points.
+fn draw_trace<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    pts: &[(f64, f64)],
+    style: Style,
+) -> PlotResult<()> {
+    for run in pts.split(|p| !(p.0.is_finite() && p.1.is_finite())) {
+        if run.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(LineSeries::new(
+                run.iter().copied(),
+                style.color.stroke_width(style.width),
+            ))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// Draws the event lines and their labels (rotated, at the top; events
+/// within 8 px share one label).
+fn draw_events<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    events: &[EventMark],
+    y: (f64, f64),
+) -> PlotResult<()> {
+    let (x0, x1) = {
+        let r = chart.x_range();
+        (r.start, r.end)
+    };
+    let mut groups: Vec<(i32, f64, Vec<&str>)> = Vec::new();
+    for e in events.iter().filter(|e| e.t >= x0 && e.t <= x1) {
+        let px = chart.backend_coord(&(e.t, y.1)).0;
+        match groups.last_mut() {
+            Some(g) if (px - g.0).abs() < 8 => {
+                if !g.2.contains(&e.label.as_str()) {
+                    g.2.push(&e.label);
+                }
+            }
+            _ => groups.push((px, e.t, vec![&e.label])),
+        }
+    }
+    let font = ("sans-serif", 11)
+        .into_font()
+        .transform(FontTransform::Rotate270)
+        .color(&RGBColor(90, 90, 90));
+    for (_, t, labels) in &groups {
+        chart
+            .draw_series(LineSeries::new(
+                [(*t, y.0), (*t, y.1)],
+                EVENT.stroke_width(1),
+            ))
+            .map_err(err)?;
+        let text = match labels.as_slice() {
+            [a] => (*a).to_owned(),
+            [a, b] => format!("{a}, {b}"),
+            [a, b, rest @ ..] => format!("{a}, {b} +{}", rest.len()),
+            [] => String::new(),
+        };
+        let (px, py) = chart.backend_coord(&(*t, y.1));
+        chart
+            .plotting_area()
+            .strip_coord_spec()
+            .draw(&Text::new(
+                text,
+                (
+                    px + 2 - chart.plotting_area().get_base_pixel().0,
+                    py + 4 - chart.plotting_area().get_base_pixel().1,
+                ),
+                font.pos(Pos::new(HPos::Right, VPos::Top)),
+            ))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// A chart of curves against time, legend beside it, events labelled.
 fn time_chart(
     title: &str,
     y_desc: &str,
-    t: &[f64],
-    series: &[Series<'_>],
-    events: &[f64],
+    series: &[(&Trace, Style)],
+    events: &[EventMark],
+    t_range: (f64, f64),
 ) -> PlotResult<String> {
     let mut buf = String::new();
     {
-        let root = SVGBackend::with_string(&mut buf, (960, 540)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut buf, (960 + LEGEND_WIDTH, 540)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let (x0, x1) = range(t);
-        let (y0, y1) = range(series.iter().flat_map(|s| s.values.iter()));
-        let mut chart = ChartBuilder::on(&root)
+        let (left, right) = root.split_horizontally(960);
+        let (y0, y1) = range(series.iter().flat_map(|s| s.0.pts.iter().map(|p| &p.1)));
+        // Room above the curves for the event labels.
+        let y1 = if events.is_empty() {
+            y1
+        } else {
+            y1 + 0.18 * (y1 - y0)
+        };
+        let mut chart = ChartBuilder::on(&left)
             .caption(title, ("sans-serif", 22))
             .margin(14)
             .x_label_area_size(48)
             .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
+            .build_cartesian_2d(t_range.0..t_range.1, y0..y1)
             .map_err(err)?;
         chart
             .configure_mesh()
@@ -141,123 +553,202 @@ fn time_chart(
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
-        for (i, &te) in events.iter().enumerate() {
-            let s = chart
-                .draw_series(DashedLineSeries::new(
-                    [(te, y0), (te, y1)],
-                    4,
-                    4,
-                    EVENT.stroke_width(1),
-                ))
-                .map_err(err)?;
-            if i == 0 {
-                s.label("contact event").legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], EVENT.stroke_width(1))
-                });
-            }
+        draw_events(&mut chart, events, (y0, y1))?;
+        // Solid curves first, dashed ones on top: coinciding curves show
+        // both colours.
+        for (trace, style) in series.iter().filter(|s| !s.1.dashed) {
+            draw_trace(&mut chart, &trace.pts, *style)?;
         }
-        for s in series {
-            let points = t
-                .iter()
-                .zip(s.values)
-                .filter(|(a, b)| a.is_finite() && b.is_finite())
-                .map(|(a, b)| (*a, *b));
-            let color = s.color;
-            let style = color.stroke_width(2);
-            let drawn = if s.dashed {
-                chart
-                    .draw_series(DashedLineSeries::new(points, 8, 5, style))
-                    .map_err(err)?
-            } else {
-                chart
-                    .draw_series(LineSeries::new(points, style))
-                    .map_err(err)?
-            };
-            drawn.label(s.label).legend(legend_line(color, 2));
+        for (trace, style) in series.iter().filter(|s| s.1.dashed) {
+            draw_trace(&mut chart, &trace.pts, *style)?;
         }
-        draw_legend(&mut chart)?;
+        let mut entries: Vec<Entry> = series
+            .iter()
+            .map(|(t, s)| Entry {
+                label: t.label.clone(),
+                style: *s,
+            })
+            .collect();
+        if !events.is_empty() {
+            entries.push(Entry {
+                label: "contact event".into(),
+                style: Style {
+                    color: EVENT,
+                    width: 1,
+                    dashed: true,
+                },
+            });
+        }
+        side_legend(&right, &entries)?;
         root.present().map_err(err)?;
     }
+    for (_, s) in series.iter().filter(|s| s.1.dashed) {
+        dash(&mut buf, s.color, s.width, DASH);
+    }
+    dash(&mut buf, EVENT, 1, EVENT_DASH);
     Ok(buf)
+}
+
+/// The time axis: from the first to the last point of any curve.
+fn time_range(d: &PlotData) -> (f64, f64) {
+    let ts = d
+        .tips
+        .iter()
+        .chain(&d.energy)
+        .chain(&d.joints)
+        .flat_map(|t| t.pts.iter().map(|p| &p.0));
+    let (lo, hi) = ts.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &t| {
+        (a.min(t), b.max(t))
+    });
+    if lo < hi { (lo, hi) } else { (0.0, 1.0) }
+}
+
+/// Solid `strong` for the first of each pair, dashed `light` for the
+/// second: `[(a, solid), (b, dashed)]` per leg.
+fn paired(traces: &[Trace]) -> Vec<(&Trace, Style)> {
+    let colors = [LEG3, LEG3_LIGHT, LEG4, LEG4_LIGHT];
+    traces
+        .iter()
+        .zip(colors)
+        .enumerate()
+        .map(|(i, (t, color))| {
+            (
+                t,
+                Style {
+                    color,
+                    width: 2,
+                    dashed: i % 2 == 1,
+                },
+            )
+        })
+        .collect()
 }
 
 /// `tips.svg`: x and y of both tips versus time (Fig. 7, graph 1).
 pub fn tips_svg(d: &PlotData) -> PlotResult<String> {
-    let series = [
-        Series {
-            label: "tip3 x",
-            values: &d.tip[0][0],
-            color: LEG3,
-            dashed: false,
-        },
-        Series {
-            label: "tip3 y",
-            values: &d.tip[0][1],
-            color: LEG3_LIGHT,
-            dashed: true,
-        },
-        Series {
-            label: "tip4 x",
-            values: &d.tip[1][0],
-            color: LEG4,
-            dashed: false,
-        },
-        Series {
-            label: "tip4 y",
-            values: &d.tip[1][1],
-            color: LEG4_LIGHT,
-            dashed: true,
-        },
-    ];
     time_chart(
         "Tip positions of legs 3 and 4 (inertial frame)",
         "position (m)",
-        &d.t,
-        &series,
+        &paired(&d.tips),
         &d.events,
+        time_range(d),
     )
 }
 
-/// `forces.svg`: tangential and normal force on both tips versus time
-/// (Fig. 7, graph 2).
+/// The colour of a contact point by its name (`tip3`, `knee4`, …).
+fn point_color(label: &str, fallback: usize) -> RGBColor {
+    let name = label.rsplit(' ').next().unwrap_or(label);
+    let kind = match name.trim_end_matches(|c: char| c.is_ascii_digit()) {
+        "tip" => Some(0),
+        "knee" => Some(1),
+        "hip" => Some(2),
+        _ => None,
+    };
+    let leg = match name.chars().last() {
+        Some('3') => Some(0),
+        Some('4') => Some(1),
+        _ => None,
+    };
+    match (kind, leg) {
+        (Some(k), Some(l)) => POINT_COLORS[k][l],
+        _ => PALETTE[fallback % PALETTE.len()],
+    }
+}
+
+/// `color` mixed with white by `f` (0 = unchanged).
+fn lighter(c: RGBColor, f: f64) -> RGBColor {
+    let m = |v: u8| (f64::from(v) + f * (255.0 - f64::from(v))).round() as u8;
+    RGBColor(m(c.0), m(c.1), m(c.2))
+}
+
+/// `forces.svg`: normal (solid) and tangential (dashed, lighter) force of
+/// every contact point that ever touched (Fig. 7, graph 2).
 pub fn forces_svg(d: &PlotData) -> PlotResult<String> {
-    let series = [
-        Series {
-            label: "n3 (normal)",
-            values: &d.n[0],
+    let mut series = Vec::new();
+    for (i, (n, fa)) in d.normal.iter().zip(&d.tangential).enumerate() {
+        let c = point_color(&n.label, i);
+        series.push((
+            n,
+            Style {
+                color: c,
+                width: 2,
+                dashed: false,
+            },
+        ));
+        series.push((
+            fa,
+            Style {
+                color: lighter(c, 0.45),
+                width: 2,
+                dashed: true,
+            },
+        ));
+    }
+    time_chart(
+        "Contact forces: normal n (solid), tangential fa (dashed)",
+        "force (N)",
+        &series,
+        &d.events,
+        time_range(d),
+    )
+}
+
+/// `joints.svg`: the joint angles of legs 3 and 4.
+pub fn joints_svg(d: &PlotData) -> PlotResult<String> {
+    time_chart(
+        "Joint angles of legs 3 and 4",
+        "angle (°)",
+        &paired(&d.joints),
+        &d.events,
+        time_range(d),
+    )
+}
+
+/// `torques.svg`: the actuator torques; `None` for a passive run.
+pub fn torques_svg(d: &PlotData) -> Option<PlotResult<String>> {
+    (!d.torques.is_empty()).then(|| {
+        time_chart(
+            "Joint torques (hips solid, knees dashed)",
+            "torque (N·m)",
+            &paired(&d.torques),
+            &d.events,
+            time_range(d),
+        )
+    })
+}
+
+/// `energy.svg`: kinetic, potential and total mechanical energy.
+pub fn energy_svg(d: &PlotData) -> PlotResult<String> {
+    let styles = [
+        Style {
+            color: RGBColor(255, 127, 14),
+            width: 2,
+            dashed: false,
+        },
+        Style {
             color: LEG3,
+            width: 2,
             dashed: false,
         },
-        Series {
-            label: "fa3 (tangential)",
-            values: &d.fa[0],
-            color: LEG3_LIGHT,
-            dashed: true,
-        },
-        Series {
-            label: "n4 (normal)",
-            values: &d.n[1],
-            color: LEG4,
-            dashed: false,
-        },
-        Series {
-            label: "fa4 (tangential)",
-            values: &d.fa[1],
-            color: LEG4_LIGHT,
+        Style {
+            color: BLACK,
+            width: 2,
             dashed: true,
         },
     ];
+    let series: Vec<(&Trace, Style)> = d.energy.iter().zip(styles).collect();
     time_chart(
-        "Contact forces on the tips of legs 3 and 4",
-        "force (N)",
-        &d.t,
+        "Mechanical energy",
+        "energy (J)",
         &series,
         &d.events,
+        time_range(d),
     )
 }
 
 /// `stance.svg`: the body segment hip3–hip4 and both legs drawn at each
-/// snapshot over the terrain, equal scales on both axes (Fig. 6).
+/// snapshot over the terrain, equal scales on both axes (Fig. 6); the
+/// legend gives each snapshot's time.
 pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
     let xs = d
         .stances
@@ -291,18 +782,30 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
     let width = 1000.0;
     let pw = width - 2.0 * margin - yl;
     let ph = (pw * (y1 - y0) / (x1 - x0)).clamp(250.0, 900.0);
-    let height = ph + 2.0 * margin + xl + caption;
+    let height =
+        (ph + 2.0 * margin + xl + caption).max(60.0 + 20.0 * (d.stances.len() as f64 + 3.0));
     // Equal aspect: widen the tighter range to the plot area's ratio.
-    let scale = (pw / (x1 - x0)).min(ph / (y1 - y0));
+    let ph_eff = height - 2.0 * margin - xl - caption;
+    let scale = (pw / (x1 - x0)).min(ph_eff / (y1 - y0));
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let (hx, hy) = (0.5 * pw / scale, 0.5 * ph / scale);
+    let (hx, hy) = (0.5 * pw / scale, 0.5 * ph_eff / scale);
     (x0, x1, y0, y1) = (cx - hx, cx + hx, cy - hy, cy + hy);
 
+    let n = d.stances.len().max(2) - 1;
+    // From light to dark as time goes on.
+    let mix = |i: usize, c: RGBColor| {
+        let f = i as f64 / n as f64;
+        lighter(c, 1.0 - f)
+    };
     let mut buf = String::new();
     {
-        let root = SVGBackend::with_string(&mut buf, (width as u32, height.round() as u32))
-            .into_drawing_area();
+        let root = SVGBackend::with_string(
+            &mut buf,
+            (width as u32 + LEGEND_WIDTH, height.round() as u32),
+        )
+        .into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
+        let (left, right) = root.split_horizontally(width as u32);
         let title = match (d.stances.first(), d.stances.last()) {
             (Some(a), Some(b)) => format!(
                 "Positions of the structure, t = {:.3} s (light) to {:.3} s (dark)",
@@ -310,7 +813,7 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
             ),
             _ => "Positions of the structure".to_owned(),
         };
-        let mut chart = ChartBuilder::on(&root)
+        let mut chart = ChartBuilder::on(&left)
             .caption(title, ("sans-serif", 22))
             .margin(margin as u32)
             .x_label_area_size(xl as u32)
@@ -326,54 +829,134 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
+        let mut entries = Vec::new();
         if ground.is_some() {
             chart
                 .draw_series(LineSeries::new(profile(x0, x1), GROUND.stroke_width(3)))
-                .map_err(err)?
-                .label("terrain")
-                .legend(legend_line(GROUND, 3));
+                .map_err(err)?;
+            entries.push(Entry {
+                label: "terrain".into(),
+                style: Style {
+                    color: GROUND,
+                    width: 3,
+                    dashed: false,
+                },
+            });
         }
-        let n = d.stances.len().max(2) - 1;
         for (i, s) in d.stances.iter().enumerate() {
-            // From light to dark as time goes on.
-            let f = i as f64 / n as f64;
-            let shade = |c: u8| (255.0 - f * (255.0 - f64::from(c))).round() as u8;
-            let mix = |c: RGBColor| RGBColor(shade(c.0), shade(c.1), shade(c.2));
             let ok = |p: [f64; 2]| p[0].is_finite() && p[1].is_finite();
             let body = [s.hip[0], s.hip[1]];
             if body.iter().all(|p| ok(*p)) {
                 chart
                     .draw_series(LineSeries::new(
                         body.map(|p| (p[0], p[1])),
-                        mix(RGBColor(20, 20, 20)).stroke_width(4),
+                        mix(i, RGBColor(20, 20, 20)).stroke_width(4),
                     ))
                     .map_err(err)?;
             }
             for (leg, color) in [(0, LEG3), (1, LEG4)] {
                 let pts = [s.hip[leg], s.knee[leg], s.tip[leg]];
                 if pts.iter().all(|p| ok(*p)) {
-                    let style = mix(color).stroke_width(2);
+                    let style = mix(i, color).stroke_width(2);
                     chart
                         .draw_series(LineSeries::new(pts.map(|p| (p[0], p[1])), style))
                         .map_err(err)?;
                     chart
                         .draw_series(
                             pts.iter()
-                                .map(|p| Circle::new((p[0], p[1]), 3, mix(color).filled())),
+                                .map(|p| Circle::new((p[0], p[1]), 3, mix(i, color).filled())),
                         )
                         .map_err(err)?;
                 }
             }
         }
         for (label, color) in [("leg 3", LEG3), ("leg 4", LEG4)] {
-            chart
-                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
-                .map_err(err)?
-                .label(label)
-                .legend(legend_line(color, 2));
+            entries.push(Entry {
+                label: label.into(),
+                style: Style {
+                    color,
+                    width: 2,
+                    dashed: false,
+                },
+            });
         }
-        draw_legend(&mut chart)?;
+        for (i, s) in d.stances.iter().enumerate() {
+            entries.push(Entry {
+                label: format!("body at t = {:.3} s", s.t),
+                style: Style {
+                    color: mix(i, RGBColor(20, 20, 20)),
+                    width: 4,
+                    dashed: false,
+                },
+            });
+        }
+        side_legend(&right, &entries)?;
         root.present().map_err(err)?;
     }
     Ok(buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn min_max_keeps_the_extremes_of_every_column() {
+        let steps = 600_000;
+        let mut m = MinMax::new(0.0, 6.0);
+        let mut peak = (0.0, f64::NEG_INFINITY);
+        let mut trough = (0.0, f64::INFINITY);
+        for k in 0..=steps {
+            let t = k as f64 * 1e-5;
+            // A fast oscillation with one spike.
+            let v = (t * 377.0).sin() + if k == 123_457 { 5.0 } else { 0.0 };
+            if v > peak.1 {
+                peak = (t, v);
+            }
+            if v < trough.1 {
+                trough = (t, v);
+            }
+            m.push(t, v);
+        }
+        let pts = m.finish();
+        assert!(pts.len() <= 4 * COLUMNS + 4, "{} points", pts.len());
+        assert!(pts.contains(&peak), "the spike {peak:?} was dropped");
+        assert!(pts.contains(&trough), "the trough {trough:?} was dropped");
+        assert!(
+            pts.windows(2).all(|w| w[0].0 <= w[1].0),
+            "not in time order"
+        );
+        assert_eq!(pts.first().map(|p| p.0), Some(0.0));
+        assert_eq!(pts.last().map(|p| p.0), Some(steps as f64 * 1e-5));
+    }
+
+    #[test]
+    fn min_max_breaks_the_line_at_missing_values() {
+        let mut m = MinMax::new(0.0, 1.0);
+        for k in 0..10 {
+            let t = k as f64 / 10.0;
+            m.push(t, if k == 5 { f64::NAN } else { t });
+        }
+        let pts = m.finish();
+        assert_eq!(pts.iter().filter(|p| p.1.is_nan()).count(), 1);
+    }
+
+    #[test]
+    fn dashed_curves_are_one_element_with_a_dash_pattern() {
+        let trace = Trace {
+            label: "a".into(),
+            pts: (0..500)
+                .map(|k| (k as f64, (k as f64 * 0.1).sin()))
+                .collect(),
+        };
+        let style = Style {
+            color: LEG3_LIGHT,
+            width: 2,
+            dashed: true,
+        };
+        let svg = time_chart("t", "y (m)", &[(&trace, style)], &[], (0.0, 500.0)).unwrap();
+        let attr = format!("{} stroke-dasharray=\"{DASH}\"", stroke_attr(LEG3_LIGHT, 2));
+        // The curve and its legend sample.
+        assert_eq!(svg.matches(&attr).count(), 2, "{svg}");
+    }
 }

@@ -3,26 +3,25 @@
 use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::Path;
+use std::sync::atomic::AtomicBool;
 
 use fbd_kinematics::planar::PlanarChains;
 use fbd_sim::{Model, RunSummary, StepRecord};
 
 use crate::CliError;
 use crate::config::{self, Config};
-use crate::output::{self, Energy, EventJson, PeakForce, Summary, TrajectoryWriter};
-use crate::plot::{self, PlotData, Stance};
+use crate::output::{self, Energy, PeakForce, Summary, TrajectoryWriter};
+use crate::plot::{self, PlotData, PlotRecorder, Stance};
+use crate::viewer::{self, planar::PlanarScene};
+use crate::steptime::StepTimes;
 
-/// Most samples kept per plotted curve.
-const PLOT_SAMPLES: usize = 4000;
 /// Snapshot intervals of `stance.svg` (one more snapshot than this).
 const STANCE_INTERVALS: usize = 10;
 
 /// What the plots and the summary need, gathered step by step.
 struct Collector {
-    every: usize,
     snapshot_steps: Vec<usize>,
-    tips: [Option<usize>; 2],
-    plot: PlotData,
+    plot: PlotRecorder,
     snapshots: Vec<(f64, [f64; 7])>,
     last: Option<StepRecord>,
     peak_contact: Vec<PeakForce>,
@@ -32,35 +31,15 @@ struct Collector {
 impl Collector {
     fn new(model: &Model, names: &[String]) -> Self {
         let steps = model.steps.max(1);
-        let every = steps.div_ceil(PLOT_SAMPLES).max(1);
-        let n = steps.div_ceil(every) + 1;
-        let mut plot = PlotData {
-            terrain: Some(model.params.terrain.clone()),
-            ..PlotData::default()
-        };
-        plot.t.reserve(n);
-        for v in plot
-            .tip
-            .iter_mut()
-            .flatten()
-            .chain(plot.fa.iter_mut())
-            .chain(plot.n.iter_mut())
-        {
-            v.reserve(n);
-        }
+        let plot = PlotRecorder::new(names, (steps - 1) as f64 * model.params.dt);
         let last_step = steps - 1;
         let mut snapshot_steps: Vec<usize> = (0..=STANCE_INTERVALS)
             .map(|i| ((i * last_step) as f64 / STANCE_INTERVALS as f64).round() as usize)
             .collect();
         snapshot_steps.dedup();
         Self {
-            every,
             snapshots: Vec::with_capacity(snapshot_steps.len() + 1),
             snapshot_steps,
-            tips: [
-                names.iter().position(|n| n == "tip3"),
-                names.iter().position(|n| n == "tip4"),
-            ],
             plot,
             last: None,
             peak_contact: vec![PeakForce::default(); names.len()],
@@ -69,9 +48,7 @@ impl Collector {
     }
 
     fn push(&mut self, r: &StepRecord) {
-        if r.step.is_multiple_of(self.every) {
-            self.sample(r);
-        }
+        self.plot.push(r);
         if self.snapshot_steps.binary_search(&r.step).is_ok() {
             self.snapshots.push((r.t, r.q));
         }
@@ -85,56 +62,50 @@ impl Collector {
         self.last = Some(*r);
     }
 
-    fn sample(&mut self, r: &StepRecord) {
-        self.plot.t.push(r.t);
-        for (leg, c) in self.tips.iter().enumerate() {
-            let (p, fa, n) = c.map_or(([f64::NAN; 2], f64::NAN, f64::NAN), |c| {
-                (r.point[c], r.fa[c], r.n[c])
-            });
-            self.plot.tip[leg][0].push(p[0]);
-            self.plot.tip[leg][1].push(p[1]);
-            self.plot.fa[leg].push(fa);
-            self.plot.n[leg].push(n);
-        }
-    }
-
     /// Completes the plot data after the run.
     fn finish(
         mut self,
         model: &Model,
         run: &RunSummary,
     ) -> (PlotData, Option<StepRecord>, Vec<PeakForce>, [f64; 4]) {
-        if let Some(r) = self.last {
-            if self.plot.t.last() != Some(&r.t) {
-                self.sample(&r);
-            }
-            if self.snapshots.last().map(|s| s.0) != Some(r.t) {
-                self.snapshots.push((r.t, r.q));
-            }
+        if let Some(r) = self.last
+            && self.snapshots.last().map(|s| s.0) != Some(r.t)
+        {
+            self.snapshots.push((r.t, r.q));
         }
-        self.plot.events = run.events.iter().map(|e| e.t).collect();
         let chains: &PlanarChains = &model.mech.chains;
         let ix = &model.index;
         let mut data = chains.new_data();
+        let mut stances = Vec::with_capacity(self.snapshots.len());
         for (t, q) in &self.snapshots {
             chains.eval_positions(q, &mut data);
             let p = |i: [usize; 2]| [data.pos[i[0]], data.pos[i[1]]];
-            self.plot.stances.push(Stance {
+            stances.push(Stance {
                 t: *t,
                 hip: p(ix.hip),
                 knee: p(ix.knee),
                 tip: p(ix.tip),
             });
         }
-        (self.plot, self.last, self.peak_contact, self.peak_joint)
+        let plot = self.plot.finish(
+            &run.events,
+            stances,
+            Some(model.params.terrain.clone()),
+        );
+        (plot, self.last, self.peak_contact, self.peak_joint)
     }
 }
 
-fn first_time(run: &RunSummary, leg: usize, pred: impl Fn(&fbd_sim::Event) -> bool) -> Option<f64> {
+fn first_time(
+    run: &RunSummary,
+    times: &StepTimes,
+    leg: usize,
+    pred: impl Fn(&fbd_sim::Event) -> bool,
+) -> Option<f64> {
     run.events
         .iter()
         .find(|e| e.leg == leg && e.point == "tip" && pred(e))
-        .map(|e| e.t)
+        .map(|e| times.value(e.step, e.t))
 }
 
 fn summary(
@@ -147,23 +118,41 @@ fn summary(
     joints: [f64; 4],
 ) -> Summary {
     use fbd_contact::StateCode;
+    let times = StepTimes::new(model.params.dt);
     let legs = ["leg3", "leg4"];
     let by_leg = |pred: &dyn Fn(&fbd_sim::Event) -> bool| -> BTreeMap<String, Option<f64>> {
         legs.iter()
             .zip([3, 4])
-            .map(|(name, leg)| ((*name).to_owned(), first_time(run, leg, pred)))
+            .map(|(name, leg)| ((*name).to_owned(), first_time(run, &times, leg, pred)))
             .collect()
     };
     let steps_per_second = (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds);
     Summary {
-        status: if run.error.is_some() { "error" } else { "ok" },
-        error: run.error.as_ref().map(ToString::to_string),
+        status: if run.error.is_some() {
+            "error"
+        } else if run.interrupted {
+            "interrupted"
+        } else {
+            "ok"
+        },
+        error: match &run.error {
+            Some(e) => Some(e.to_string()),
+            None if run.interrupted => Some(format!(
+                "interrupted (SIGINT or SIGTERM) after {} of {} steps",
+                run.steps, model.steps
+            )),
+            None => None,
+        },
         steps: run.steps,
         newton_iterations: run.newton_iterations,
         wall_seconds: run.wall_seconds,
         steps_per_second,
         symbolic_factorizations: run.symbolic_factorizations,
-        events: run.events.iter().map(EventJson::from).collect(),
+        events: output::run_events(run, &times)
+            .into_iter()
+            .map(|e| e.2)
+            .collect(),
+        retried_steps: run.retries.len(),
         model: "planar",
         dt: model.params.dt,
         duration: model.params.duration,
@@ -181,7 +170,7 @@ fn summary(
             .collect(),
         peak_joint_force_max: joints.iter().copied().fold(0.0, f64::max),
         final_energy: last.map(|r| Energy {
-            t: r.t,
+            t: times.value(r.step, r.t),
             kinetic: r.kinetic,
             potential: r.potential,
             total: r.kinetic + r.potential,
@@ -189,9 +178,9 @@ fn summary(
     }
 }
 
-/// One line per event: `t=0.190 s  leg 4  ST1 -> ST2` (the point is named
-/// when it is not the tip).
-pub fn event_line(e: &fbd_sim::Event) -> String {
+/// One line per event: `t=0.19 s  leg 4  ST1 -> ST2` (the point is named
+/// when it is not the tip; the time is the decimal of k·Δt).
+pub fn event_line(e: &fbd_sim::Event, times: &StepTimes) -> String {
     let kind = e.point;
     let point = if kind == "tip" {
         String::new()
@@ -199,28 +188,41 @@ pub fn event_line(e: &fbd_sim::Event) -> String {
         format!("{kind}  ")
     };
     format!(
-        "t={:.3} s  leg {}  {point}{} -> {}",
-        e.t,
+        "t={} s  leg {}  {point}{} -> {}",
+        times.string(e.step, e.t),
         e.leg,
         e.from.as_str(),
         e.to.as_str()
     )
 }
 
-/// `fbd run`: loads `config` (the built-in default when `None`), checks
-/// the output directory, simulates while streaming `trajectory.csv`, then
-/// writes the other files. On a simulation error every file is still
-/// written and the error is returned ([`CliError::Simulation`], exit 3).
-pub fn run_command(
-    config_path: Option<&Path>,
-    out_dir: &Path,
-    out: &mut dyn Write,
-) -> Result<(), CliError> {
-    let (config, source) = match config_path {
-        Some(p) => (config::load(p)?, p.display().to_string()),
-        None => (Config::default(), "the built-in default".to_owned()),
-    };
-    let planar = match &config {
+/// What [`simulate`] produced.
+pub struct Simulated {
+    /// The run: steps, events, and the error that stopped it, if any.
+    pub run: RunSummary,
+    /// The content of `summary.json`.
+    pub summary: Summary,
+    /// The names of the model's contact points, in record order.
+    pub contacts: Vec<String>,
+    /// The first failure writing a file (every file is still attempted).
+    pub io_error: Option<CliError>,
+}
+
+/// Simulates the loaded `config` (named `source` in messages), handing every
+/// `output.stride`-th step's record to `on_row`; when `out_dir` is given,
+/// writes the files of `fbd run` there, streaming `trajectory.csv`. A
+/// simulation error does not make this fail: it is in `run.error`, with
+/// every file written. The run stops before its next step once `stop` is
+/// set (`run.interrupted`). Fails for a hexapod configuration, an invalid
+/// model or an output directory that cannot be created.
+pub fn simulate(
+    config: &Config,
+    source: &str,
+    out_dir: Option<&Path>,
+    stop: &AtomicBool,
+    on_row: &mut dyn FnMut(&StepRecord),
+) -> Result<Simulated, CliError> {
+    let planar = match config {
         Config::Planar(c) => c,
         Config::Hexapod(_) => {
             return Err(CliError::Usage(format!(
@@ -228,25 +230,49 @@ pub fn run_command(
             )));
         }
     };
-    let model = planar.model(&source)?;
+    let model = planar.model(source)?;
 
-    output::prepare_dir(out_dir)?;
     let names: Vec<String> = model.mech.contacts.iter().map(|c| c.name.clone()).collect();
-    let mut traj = TrajectoryWriter::create(out_dir, &names)?;
+    let mut traj = match out_dir {
+        Some(dir) => {
+            output::prepare_dir(dir)?;
+            Some(TrajectoryWriter::create(dir, &names, model.dt())?)
+        }
+        None => None,
+    };
     let mut collect = Collector::new(&model, &names);
     // The simulator hands over every `stride`-th step; the plots and peaks
     // want them all, so stride is applied here.
     let stride = model.params.stride.max(1);
     let mut every_step = model.clone();
     every_step.params.stride = 1;
-    let run = fbd_sim::run(&every_step, |r: &StepRecord| {
+    let mut rows = 0;
+    // viewer.html: one frame per trajectory row (decimated when long).
+    let mut view = out_dir
+        .map(|d| PlanarScene::new(&model, model.steps.div_ceil(stride), &d.display().to_string()));
+    let run = fbd_sim::run_until(&every_step, stop, |r: &StepRecord| {
         if r.step.is_multiple_of(stride) {
-            traj.write(r);
+            if let Some(t) = traj.as_mut() {
+                t.write(r);
+            }
+            if let Some(v) = view.as_mut() {
+                v.push(r);
+            }
+            on_row(r);
+            rows += 1;
         }
         collect.push(r);
     });
-    let rows = traj.rows();
     let (plot_data, last, peaks, joints) = collect.finish(&model, &run);
+    let s = summary(&model, &names, &run, rows, last, peaks, joints);
+    let Some(out_dir) = out_dir else {
+        return Ok(Simulated {
+            run,
+            summary: s,
+            contacts: names,
+            io_error: None,
+        });
+    };
 
     // Write every file even if one fails; report the first failure.
     let mut io_error: Option<CliError> = None;
@@ -257,13 +283,14 @@ pub fn run_command(
             io_error = Some(e);
         }
     };
-    keep(traj.finish());
+    if let Some(t) = traj {
+        keep(t.finish());
+    }
     keep(output::write_file(
         out_dir,
         "events.csv",
-        output::events_csv(&run.events).as_bytes(),
+        output::run_events_csv(&run, model.dt()).as_bytes(),
     ));
-    let s = summary(&model, &names, &run, rows, last, peaks, joints);
     let json =
         serde_json::to_string_pretty(&s).map_err(|e| CliError::Io(format!("summary.json: {e}")));
     keep(
@@ -274,31 +301,78 @@ pub fn run_command(
         "config.toml",
         config.to_toml().as_bytes(),
     ));
+    let torques = plot::torques_svg(&plot_data).map(|svg| ("torques.svg", svg));
     for (name, svg) in [
         ("tips.svg", plot::tips_svg(&plot_data)),
         ("forces.svg", plot::forces_svg(&plot_data)),
         ("stance.svg", plot::stance_svg(&plot_data)),
-    ] {
+        ("joints.svg", plot::joints_svg(&plot_data)),
+        ("energy.svg", plot::energy_svg(&plot_data)),
+    ]
+    .into_iter()
+    .chain(torques)
+    {
         keep(
             svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
                 .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
         );
     }
+    if let Some(v) = view {
+        keep(viewer::write(out_dir, &v.finish(&run.events)));
+    }
+    Ok(Simulated {
+        run,
+        summary: s,
+        contacts: names,
+        io_error,
+    })
+}
+
+/// `fbd run`: loads `config` (the built-in default when `None`), checks
+/// the output directory, simulates while streaming `trajectory.csv`, then
+/// writes the other files ([`simulate`]). On a simulation error every file
+/// is still written and the error is returned ([`CliError::Simulation`],
+/// exit 3).
+pub fn run_command(
+    config_path: Option<&Path>,
+    out_dir: &Path,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let (config, source) = match config_path {
+        Some(p) => (config::load(p)?, p.display().to_string()),
+        None => (Config::default(), "the built-in default".to_owned()),
+    };
+    if let Config::Hexapod(h) = &config {
+        return crate::hexapod::run_command(h, &config, &source, out_dir, out);
+    }
+    let Simulated {
+        run,
+        io_error,
+        summary,
+        ..
+    } = simulate(
+        &config,
+        &source,
+        Some(out_dir),
+        crate::interrupt::flag(),
+        &mut |_| {},
+    )?;
 
     let mut text = String::new();
+    let times = StepTimes::new(summary.dt);
     for e in &run.events {
-        text.push_str(&event_line(e));
+        text.push_str(&event_line(e, &times));
         text.push('\n');
     }
     text.push_str(&format!(
-        "{} {} steps, {} Newton iterations, {:.3} s\n",
-        if run.error.is_some() {
+        "{} {}, {}, {:.3} s\n",
+        if run.error.is_some() || run.interrupted {
             "stopped after"
         } else {
             "solved"
         },
-        run.steps,
-        run.newton_iterations,
+        output::count(run.steps, "step", "steps"),
+        output::count(run.newton_iterations, "Newton iteration", "Newton iterations"),
         run.wall_seconds
     ));
     if io_error.is_none() {
@@ -316,8 +390,22 @@ pub fn run_command(
         return Err(e);
     }
     if let Some(e) = &run.error {
+        let advice = match &config {
+            Config::Planar(p) => p.advice(e).map(|a| format!("; {a}")),
+            Config::Hexapod(_) => None,
+        };
         return Err(CliError::Simulation(format!(
-            "{e} ({source}; the steps computed so far are in {})",
+            "{e} ({source}; the steps computed so far are in {}){}",
+            out_dir.display(),
+            advice.unwrap_or_default()
+        )));
+    }
+    if run.interrupted {
+        return Err(CliError::Interrupted(format!(
+            "interrupted after {} of {} steps (t = {} s); the steps computed so far are in {}",
+            run.steps,
+            summary.steps_planned,
+            times.string(run.steps, run.steps as f64 * summary.dt),
             out_dir.display()
         )));
     }

@@ -24,13 +24,14 @@ use std::collections::BTreeMap;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Mutex, OnceLock};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
 
 use crate::CliError;
+use crate::output::count;
 use crate::config::{self, Config, Override};
 
 /// The fixed columns of `index.csv` after `run, status` and the varied
@@ -168,6 +169,18 @@ pub struct SweepFile {
     /// Dotted keys and their values.
     #[serde(default)]
     pub vary: Vary,
+    /// Keys computed from varied ones: `"key" = { from = "varied.key",
+    /// scale = X }` sets `key` to `X ×` the run's value of `varied.key`
+    /// (e.g. μD = 0.75·μS).
+    #[serde(default, skip_serializing_if = "Vary::is_empty")]
+    pub derive: Vary,
+}
+
+impl Vary {
+    /// `true` when no key is listed.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
 }
 
 /// splitmix64: a tiny deterministic PRNG.
@@ -211,8 +224,44 @@ pub fn format_value(v: &toml::Value) -> String {
     }
 }
 
-/// Expands the sweep into the varied values of every run.
+/// Expands the sweep into the values of every run: the varied keys, then
+/// the derived ones (`[derive]`, see [`SweepFile::derive`]).
 pub fn expand(s: &SweepFile, file: &str) -> Result<Vec<Vec<toml::Value>>, String> {
+    let mut runs = expand_vary(s, file)?;
+    let keys = &s.vary.0;
+    for (k, v) in &s.derive.0 {
+        let rule = v.as_table().and_then(|t| {
+            let from = t.get("from")?.as_str()?;
+            let scale = as_f64(t.get("scale")?)?;
+            (t.len() == 2 && scale.is_finite()).then_some((from, scale))
+        });
+        let Some((from, scale)) = rule else {
+            return Err(format!(
+                "{file}: derive.\"{k}\": expected {{ from = \"varied.key\", scale = X }} with a finite X"
+            ));
+        };
+        let Some(i) = keys.iter().position(|(vk, _)| vk == from) else {
+            return Err(format!(
+                "{file}: derive.\"{k}\": from = \"{from}\" is not a key of [vary]"
+            ));
+        };
+        if keys.iter().any(|(vk, _)| vk == k) {
+            return Err(format!("{file}: derive.\"{k}\": the key is also in [vary]"));
+        }
+        for run in &mut runs {
+            let Some(x) = as_f64(&run[i]) else {
+                return Err(format!(
+                    "{file}: derive.\"{k}\": vary.\"{from}\" has a value that is not a number ({})",
+                    format_value(&run[i])
+                ));
+            };
+            run.push(toml::Value::Float(scale * x));
+        }
+    }
+    Ok(runs)
+}
+
+fn expand_vary(s: &SweepFile, file: &str) -> Result<Vec<Vec<toml::Value>>, String> {
     let keys = &s.vary.0;
     let bad = |msg: String| format!("{file}: {msg}");
     if keys.is_empty() {
@@ -268,20 +317,37 @@ pub fn expand(s: &SweepFile, file: &str) -> Result<Vec<Vec<toml::Value>>, String
             let samples = s
                 .samples
                 .ok_or_else(|| bad("mode = \"random\" needs `samples`".into()))?;
-            let mut ranges = Vec::new();
+            // Each key: `{ min = X, max = Y }` (a number) or `{ min = [..],
+            // max = [..] }` (an array, one draw per component in order).
+            let mut ranges: Vec<(Vec<(f64, f64)>, bool)> = Vec::new();
             for (k, v) in keys {
-                let range = v.as_table().and_then(|t| {
-                    (t.len() == 2)
-                        .then(|| Some((as_f64(t.get("min")?)?, as_f64(t.get("max")?)?)))
-                        .flatten()
+                let range = v.as_table().filter(|t| t.len() == 2).and_then(|t| {
+                    let (lo, hi) = (t.get("min")?, t.get("max")?);
+                    match (lo, hi) {
+                        (toml::Value::Array(lo), toml::Value::Array(hi))
+                            if lo.len() == hi.len() && !lo.is_empty() =>
+                        {
+                            let pairs: Option<Vec<(f64, f64)>> = lo
+                                .iter()
+                                .zip(hi)
+                                .map(|(a, b)| Some((as_f64(a)?, as_f64(b)?)))
+                                .collect();
+                            Some((pairs?, true))
+                        }
+                        _ => Some((vec![(as_f64(lo)?, as_f64(hi)?)], false)),
+                    }
                 });
                 match range {
-                    Some((lo, hi)) if lo.is_finite() && hi.is_finite() && lo <= hi => {
-                        ranges.push((lo, hi));
+                    Some((pairs, array))
+                        if pairs
+                            .iter()
+                            .all(|(lo, hi)| lo.is_finite() && hi.is_finite() && lo <= hi) =>
+                    {
+                        ranges.push((pairs, array));
                     }
                     _ => {
                         return Err(bad(format!(
-                            "vary.\"{k}\": expected {{ min = X, max = Y }} with finite X <= Y (mode = \"random\")"
+                            "vary.\"{k}\": expected {{ min = X, max = Y }} with finite X <= Y, or arrays of equal length (mode = \"random\")"
                         )));
                     }
                 }
@@ -291,7 +357,17 @@ pub fn expand(s: &SweepFile, file: &str) -> Result<Vec<Vec<toml::Value>>, String
                 .map(|_| {
                     ranges
                         .iter()
-                        .map(|(lo, hi)| toml::Value::Float(lo + (hi - lo) * rng.unit()))
+                        .map(|(pairs, array)| {
+                            let mut draws: Vec<toml::Value> = pairs
+                                .iter()
+                                .map(|(lo, hi)| toml::Value::Float(lo + (hi - lo) * rng.unit()))
+                                .collect();
+                            if *array {
+                                toml::Value::Array(draws)
+                            } else {
+                                draws.remove(0)
+                            }
+                        })
                         .collect()
                 })
                 .collect())
@@ -330,7 +406,7 @@ pub struct SweepJson {
 pub struct Row {
     /// Global run index.
     pub run: usize,
-    /// "ok" or "error".
+    /// "ok", "error" or "interrupted".
     pub status: String,
     /// The varied values, formatted ([`format_value`]).
     pub values: Vec<String>,
@@ -491,12 +567,7 @@ pub struct Plan {
 /// configuration (errors name the run and the key).
 pub fn plan(path: &Path) -> Result<Plan, CliError> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| {
-        CliError::Config(config::ConfigError::Unreadable {
-            file: name.clone(),
-            what: e.to_string(),
-        })
-    })?;
+    let text = config::read_text(path)?;
     let mut file: SweepFile = toml::from_str(&text).map_err(|e| {
         let at = e.span().map_or(String::new(), |sp| {
             let before = &text[..sp.start.min(text.len())];
@@ -510,15 +581,24 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         ))
     })?;
     let values = expand(&file, &name).map_err(CliError::Usage)?;
-    let keys: Vec<String> = file.vary.0.iter().map(|(k, _)| k.clone()).collect();
+    let keys: Vec<String> = file
+        .vary
+        .0
+        .iter()
+        .chain(&file.derive.0)
+        .map(|(k, _)| k.clone())
+        .collect();
     let (base_text, base_name) = match &file.base {
         Some(b) => {
             let p = path.parent().unwrap_or(Path::new("")).join(b);
-            let t = std::fs::read_to_string(&p).map_err(|e| {
-                CliError::Config(config::ConfigError::Unreadable {
-                    file: p.display().to_string(),
-                    what: format!("base of {name}: {e}"),
-                })
+            let t = config::read_text(&p).map_err(|e| match e {
+                config::ConfigError::Unreadable { file, what } => {
+                    config::ConfigError::Unreadable {
+                        file,
+                        what: format!("{what} (the base of {name})"),
+                    }
+                }
+                other => other,
             })?;
             // Record the resolved base so sweep.json is self-describing.
             file.base = Some(p.display().to_string());
@@ -560,22 +640,6 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         keys,
         values,
         configs,
-    })
-}
-
-/// Set by Ctrl-C: workers take no new run.
-fn stop_flag() -> &'static AtomicBool {
-    static STOP: OnceLock<AtomicBool> = OnceLock::new();
-    STOP.get_or_init(|| {
-        // Install once; a second Ctrl-C while stopping exits at once.
-        let _ = ctrlc::set_handler(|| {
-            let stop = STOP.get().expect("initialised before the handler");
-            if stop.swap(true, Ordering::SeqCst) {
-                std::process::exit(130);
-            }
-            eprintln!("\ninterrupted: finishing the runs in progress (Ctrl-C again to quit now)");
-        });
-        AtomicBool::new(false)
     })
 }
 
@@ -677,7 +741,10 @@ fn run_one(dir: &Path, config: &Config, run: usize, values: Vec<String>) -> Row 
     let row = match row_from_summary(dir, run, values.clone()) {
         Some(mut r) => {
             if let Some(e) = err {
-                r.status = "error".into();
+                // An interrupted run keeps its status (`--resume` reruns it).
+                if r.status != "interrupted" {
+                    r.status = "error".into();
+                }
                 if r.error.is_empty() {
                     r.error = e.replace('\n', " ");
                 }
@@ -778,7 +845,9 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
         }
     }
     let skipped = rows.len();
-    let stop = stop_flag();
+    // Set by SIGINT/SIGTERM: workers take no new run, and the runs in
+    // progress stop at their next step with status "interrupted".
+    let stop: &AtomicBool = crate::interrupt::flag();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(jobs.min(todo.len().max(1)))
         .build()
@@ -824,13 +893,17 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
         .map(|r| r.run)
         .collect();
     let shard_txt = if shard_n > 1 {
-        format!(", shard {shard_i}/{shard_n}: {} runs", mine.len())
+        format!(
+            ", shard {shard_i}/{shard_n}: {}",
+            count(mine.len(), "run", "runs")
+        )
     } else {
         String::new()
     };
     writeln!(
         out,
-        "sweep: {total} runs{shard_txt}; ran {ran_n}, skipped {skipped} finished; {} ok, {} failed\nfiles in {}: index.csv sweep.json sweep.svg runs/",
+        "sweep: {}{shard_txt}; ran {ran_n}, skipped {skipped} finished; {} ok, {} failed\nfiles in {}: index.csv sweep.json sweep.svg runs/",
+        count(total, "run", "runs"),
         rows.len() - failed.len(),
         failed.len(),
         dir.display()
@@ -838,18 +911,21 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
     .map_err(CliError::stdout)?;
     let interrupted = stop.load(Ordering::SeqCst);
     if interrupted {
-        return Err(CliError::Simulation(format!(
-            "interrupted: {} of {} runs finished (index.csv lists them); `--resume` continues",
-            rows.len(),
-            mine.len()
+        let stopped = rows.iter().filter(|r| r.status == "interrupted").count();
+        return Err(CliError::Interrupted(format!(
+            "interrupted: {} of {} finished, {stopped} stopped part-way (status \"interrupted\" in index.csv), {} not started; `--resume` continues",
+            rows.len() - stopped,
+            count(mine.len(), "run", "runs"),
+            mine.len() - rows.len()
         )));
     }
     if !failed.is_empty() {
         let list: Vec<String> = failed.iter().take(10).map(ToString::to_string).collect();
         return Err(CliError::Simulation(format!(
-            "{} of {} runs failed (runs {}{}); see the error column of {}",
+            "{} of {} failed ({} {}{}); see the error column of {}",
             failed.len(),
-            rows.len(),
+            count(rows.len(), "run", "runs"),
+            if failed.len() == 1 { "run" } else { "runs" },
             list.join(", "),
             if failed.len() > 10 { ", …" } else { "" },
             dir.join("index.csv").display()
@@ -880,7 +956,19 @@ pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError>
     let mut sources: BTreeMap<usize, PathBuf> = BTreeMap::new();
     for d in &m.dirs {
         let p = d.join("sweep.json");
-        let text = std::fs::read_to_string(&p).map_err(|e| CliError::io(p.display(), &e))?;
+        if !d.is_dir() {
+            return Err(CliError::Config(config::ConfigError::Unreadable {
+                file: d.display().to_string(),
+                what: "no such directory".into(),
+            }));
+        }
+        let text = config::read_text(&p).map_err(|e| match e {
+            config::ConfigError::Unreadable { file, what } => config::ConfigError::Unreadable {
+                file,
+                what: format!("{what} (not an output directory of `fbd sweep`)"),
+            },
+            other => other,
+        })?;
         let j: SweepJson = serde_json::from_str(&text)
             .map_err(|e| CliError::Io(format!("{}: {e}", p.display())))?;
         match &first {
@@ -934,10 +1022,10 @@ pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError>
     let failed = rows.iter().filter(|r| r.status != "ok").count();
     writeln!(
         out,
-        "merged {} of {} runs from {} directories into {} ({failed} failed, {} missing)",
+        "merged {} of {} from {} into {} ({failed} failed, {} missing)",
         rows.len(),
-        j.total_runs,
-        m.dirs.len(),
+        count(j.total_runs, "run", "runs"),
+        count(m.dirs.len(), "directory", "directories"),
         m.out.display(),
         missing.len()
     )
@@ -945,9 +1033,9 @@ pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError>
     if !missing.is_empty() {
         let list: Vec<String> = missing.iter().take(20).map(ToString::to_string).collect();
         return Err(CliError::Simulation(format!(
-            "{} of {} runs missing: {}{} (run their shards again with --resume)",
+            "{} of {} missing: {}{} (run their shards again with --resume)",
             missing.len(),
-            j.total_runs,
+            count(j.total_runs, "run", "runs"),
             list.join(", "),
             if missing.len() > 20 { ", …" } else { "" }
         )));

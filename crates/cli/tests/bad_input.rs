@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::{FAILS_AT_STEP_49, fbd, s};
+use common::{FAIL_STEP, FAILS, fail_prefix, fbd, s};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -291,10 +291,95 @@ fn unknown_terrain_kind_lists_the_valid_ones() {
 }
 
 #[test]
-fn empty_file_is_rejected() {
-    for text in ["", "  \n\t\n"] {
-        Case::new(text).rejected(&["empty"]);
+fn empty_file_is_the_default_experiment() {
+    // As a file with one key is filled from the defaults, an empty one (or
+    // one of blanks and comments) is all defaults.
+    let default = Case::new("");
+    let o = fbd(&["run", "--out", s(&default.out())]);
+    assert!(o.status.success(), "{o:?}");
+    let expected = std::fs::read(default.out().join("config.toml")).unwrap();
+    for text in ["", "  \n\t\n", "# nothing but a comment\n"] {
+        let c = Case::new(text);
+        let o = c.run();
+        assert!(o.status.success(), "{text:?}: {o:?}");
+        let got = std::fs::read(c.out().join("config.toml")).unwrap();
+        assert_eq!(got, expected, "{text:?}");
     }
+}
+
+#[test]
+fn negative_gravity_is_rejected_as_a_magnitude() {
+    let e = Case::new("[world]\ngravity = -9.81\n").rejected(&["world.gravity", "magnitude"]);
+    assert!(e.contains("got -9.81"), "{e}");
+    // Zero gravity is allowed (a robot floating in space).
+    let c = Case::new("[world]\ngravity = 0.0\n[time]\nduration = 0.05\n");
+    assert!(c.run().status.success());
+}
+
+#[test]
+fn a_typo_in_a_key_suggests_the_key() {
+    let e = Case::new("[terrain]\nmu_statc = 0.5\n").rejected(&["cfg.toml:2:1"]);
+    assert!(e.contains("did you mean `mu_static`?"), "{e}");
+    let e = Case::new("[tme]\ndt = 0.01\n").rejected(&["cfg.toml:1:"]);
+    assert!(e.contains("did you mean `time`?"), "{e}");
+    // No suggestion when nothing is close.
+    let e = Case::new("[body]\nwingspan = 2.0\n").rejected(&["wingspan"]);
+    assert!(!e.contains("did you mean"), "{e}");
+}
+
+#[test]
+fn a_failure_at_a_large_step_suggests_a_smaller_one() {
+    // Thrown at the ground at 10 m/s with Δt = 0.2 s (the lower links swing
+    // on a time scale of 0.21 s): the first step cannot be solved.
+    let hard = "[initial]\nvelocity = [0.0, -10.0]\n[time]\nduration = 1.0\n";
+    let c = Case::new(&format!("{hard}dt = 0.2\n"));
+    let o = c.run();
+    let e = check_error(&o, SIMULATION, &["time.dt = 0.2 s is likely too large"]);
+    assert!(e.trim_end().ends_with("try time.dt = 0.01"), "{e}");
+    // The suggested step runs.
+    let c = Case::new(&format!("{hard}dt = 0.01\n"));
+    let o = c.run();
+    assert!(o.status.success(), "{o:?}");
+}
+
+#[test]
+fn a_missing_file_reads_the_same_in_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let missing = dir.path().join("nope.toml");
+    let out = dir.path().join("out");
+    let want = format!("error: {}: no such file\n", missing.display());
+    for args in [
+        vec!["run", s(&missing), "--out", s(&out)],
+        vec!["kinematics", s(&missing)],
+        vec!["sweep", s(&missing), "--out", s(&out)],
+    ] {
+        let o = fbd(&args);
+        check_error(&o, USAGE, &[]);
+        assert_eq!(String::from_utf8_lossy(&o.stderr), want, "{args:?}");
+    }
+    // A sweep whose base is missing names the base and the sweep.
+    let sweep = dir.path().join("sweep.toml");
+    std::fs::write(
+        &sweep,
+        "base = \"nope.toml\"\n[vary]\n\"time.dt\" = [0.01]\n",
+    )
+    .unwrap();
+    let o = fbd(&["sweep", s(&sweep), "--out", s(&out)]);
+    check_error(
+        &o,
+        USAGE,
+        &[&format!("{}: no such file (the base of", missing.display())],
+    );
+    // merge: a missing directory, and a directory that is not a sweep's.
+    let nodir = dir.path().join("nodir");
+    let o = fbd(&["sweep", "merge", s(&nodir), "--out", s(&out)]);
+    check_error(
+        &o,
+        USAGE,
+        &[&format!("{}: no such directory", nodir.display())],
+    );
+    let o = fbd(&["sweep", "merge", s(dir.path()), "--out", s(&out)]);
+    check_error(&o, USAGE, &["sweep.json: no such file"]);
 }
 
 #[test]
@@ -329,7 +414,7 @@ fn non_utf8_file_is_rejected() {
 
 #[test]
 fn output_dir_that_cannot_be_created_fails_before_simulating() {
-    let c = Case::new(FAILS_AT_STEP_49);
+    let c = Case::new(FAILS);
     let file = c.dir.path().join("plain_file");
     std::fs::write(&file, "x").unwrap();
     let under_file = file.join("sub");
@@ -349,23 +434,24 @@ fn output_dir_that_cannot_be_created_fails_before_simulating() {
 #[cfg(unix)]
 #[test]
 fn runtime_failure_names_step_time_and_residual() {
-    let c = Case::new(FAILS_AT_STEP_49);
+    let c = Case::new(FAILS);
     let o = c.run();
     let e = check_error(&o, SIMULATION, &["residual", s(&c.cfg)]);
-    assert!(e.starts_with("error: step 49 (t = 0.490000 s): "), "{e}");
+    assert!(e.starts_with(&format!("error: {}", fail_prefix())), "{e}");
     let out = c.out();
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["status"], "error");
     let msg = summary["error"].as_str().unwrap();
     assert!(
-        msg.starts_with("step 49 (t = 0.490000 s): ") && msg.contains("residual"),
+        msg.starts_with(&fail_prefix()) && msg.contains("residual"),
         "{msg}"
     );
     let rows = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     let last = rows.lines().last().unwrap();
-    assert_eq!(rows.lines().count(), 1 + 49);
-    assert!(last.starts_with("0.48,"), "{last}");
+    assert_eq!(rows.lines().count(), 1 + FAIL_STEP);
+    // Times are the decimal of k·Δt.
+    assert!(last.starts_with("2.0,"), "{last}");
     assert_no_temp_files(&out);
 }
 

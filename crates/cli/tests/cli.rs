@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{FAILS_AT_STEP_49, example, fbd, s, stderr, stdout, write};
+use common::{FAIL_STEP, FAILS, example, fail_prefix, fbd, s, stderr, stdout, write};
 use std::path::Path;
 use std::process::Output;
 
@@ -366,12 +366,12 @@ fn hexapod_run_is_not_implemented_yet() {
 fn a_failed_simulation_still_writes_everything() {
     // A run that succeeds here is a regression of this test.
     let dir = tempfile::tempdir().unwrap();
-    let cfg = write(dir.path(), "fail.toml", FAILS_AT_STEP_49);
+    let cfg = write(dir.path(), "fail.toml", FAILS);
     let out = dir.path().join("o");
     let o = fbd(&["run", s(&cfg), "--out", s(&out)]);
     assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
     let e = one_line_error(&o);
-    assert!(e.starts_with("error: step 49 (t = 0.49"), "{e}");
+    assert!(e.starts_with(&format!("error: {}", fail_prefix())), "{e}");
     assert!(e.contains("residual") && e.contains(s(&cfg)), "{e}");
     assert!(!e.contains("panicked"), "{e}");
     for f in FILES {
@@ -383,20 +383,20 @@ fn a_failed_simulation_still_writes_everything() {
         summary["error"]
             .as_str()
             .unwrap()
-            .starts_with("step 49 (t = "),
+            .starts_with(&fail_prefix()),
         "{summary}"
     );
-    assert_eq!(summary["steps"], 49);
-    assert_eq!(summary["rows_written"], 49);
+    assert_eq!(summary["steps"], FAIL_STEP);
+    assert_eq!(summary["rows_written"], FAIL_STEP);
     let text = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
     let t: Vec<f64> = text
         .lines()
         .skip(1)
         .map(|l| l.split(',').next().unwrap().parse().unwrap())
         .collect();
-    assert_eq!(t.len(), 49, "rows for t = 0 … 0.48");
+    assert_eq!(t.len(), FAIL_STEP, "rows for t = 0 … 2.0");
     for (k, t) in t.iter().enumerate() {
-        assert!((t - k as f64 * 0.01).abs() < 1e-12, "row {k}: t = {t}");
+        assert!((t - k as f64 * 0.2).abs() < 1e-12, "row {k}: t = {t}");
     }
 }
 

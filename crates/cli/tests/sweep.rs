@@ -249,9 +249,9 @@ fn a_failing_run_is_isolated() {
     let f = sweep_file(
         t.path(),
         "f.toml",
-        // Feet-only contact to 1 s fails at step 49 (the body falls through
-        // the floor); with knees and hips, or stopped earlier, it does not.
-        "mode = \"zip\"\n[vary]\n\"time.duration\" = [0.3, 1.0, 0.2]\n\"contact.points\" = [[\"tips\"], [\"tips\"], [\"tips\"]]\n",
+        // Dropped from 20 m with Δt = 0.2 s, the landing step fails (step
+        // 11); stopped before the landing, it does not.
+        "mode = \"zip\"\n[vary]\n\"time.duration\" = [1.0, 4.0, 0.6]\n\"time.dt\" = [0.2, 0.2, 0.2]\n\"initial.position\" = [[0.0, 20.0], [0.0, 20.0], [0.0, 20.0]]\n",
     );
     let out = t.path().join("out");
     let o = fbd(&["sweep", s(&f), "--out", s(&out), "--jobs", "2"]);
@@ -264,7 +264,7 @@ fn a_failing_run_is_isolated() {
     assert_eq!(rows[2][1], "ok");
     assert_eq!(rows[1][1], "error");
     assert!(!rows[1][error].is_empty(), "{:?}", rows[1]);
-    assert!(rows[1][error].contains("step 49"), "{:?}", rows[1]);
+    assert!(rows[1][error].contains("step 11"), "{:?}", rows[1]);
     let sum = std::fs::read_to_string(out.join("runs/1/summary.json")).unwrap();
     assert!(sum.contains("\"status\": \"error\""));
 }

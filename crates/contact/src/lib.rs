@@ -12,8 +12,10 @@
 
 pub mod error;
 pub mod mode;
+pub mod surface;
 pub mod terrain;
 
 pub use error::ContactError;
 pub use mode::{ContactParams, ContactState, Friction, StateCode, Trial, transition};
+pub use surface::Surface;
 pub use terrain::{STEP_RAMP, Terrain, TerrainIssue};

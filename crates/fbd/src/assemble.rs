@@ -14,6 +14,15 @@
 //! points on one rigid body, a knee and a foot on one link — stay solvable:
 //! their forces split as equal stiff springs would split them.
 //!
+//! Joint limits ([`Mechanism::with_limits`]) are one-sided stops: each
+//! adds an unknown stop moment `λ` (N·m), acting on the joint's child as
+//! `+axis·λ` and on its parent as `−axis·λ` like a joint torque (positive
+//! `λ` drives the angle up), and one equation. A free joint reads `λ = 0`;
+//! a joint at an end reads `Kθ·(θ[k+1] − θ_end) + β·λ = 0` with
+//! `Kθ = (M/Δt²)·ℓ²` (ℓ: [`Mechanism::length_scale`]), so that its angle
+//! stops at the end within one step — a plastic stop. Whether the stop
+//! pushes (`λ` away from the end) is the state search's business.
+//!
 //! The Jacobian is written entry by entry through a [`JacobianSink`]; the
 //! same code path with [`pattern`] declares the structure, so the two cannot
 //! drift apart.
@@ -21,6 +30,7 @@
 use crate::body::{BodyStep, cross};
 use crate::mechanism::Mechanism;
 use fbd_contact::{ContactState, Terrain};
+use fbd_kinematics::LimitSide;
 use fbd_kinematics::planar::PlanarData;
 
 /// Receives Jacobian entries.
@@ -77,6 +87,57 @@ impl Default for ContactEquation {
     }
 }
 
+/// The state of one joint limit in a step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LimitState {
+    /// Inside its range: the stop exerts no moment.
+    Free,
+    /// At an end of its range: `θ[k+1]` is held at `angle`.
+    At {
+        /// Which end.
+        side: LimitSide,
+        /// The end's angle (rad).
+        angle: f64,
+    },
+}
+
+impl LimitState {
+    /// 0 free, 1 at the lower end, 2 at the upper end.
+    pub fn key(&self) -> u64 {
+        match self {
+            LimitState::Free => 0,
+            LimitState::At {
+                side: LimitSide::Lower,
+                ..
+            } => 1,
+            LimitState::At { .. } => 2,
+        }
+    }
+
+    /// `true` at an end.
+    pub fn is_at(&self) -> bool {
+        matches!(self, LimitState::At { .. })
+    }
+}
+
+/// The equation a joint limit contributes in this step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LimitEquation {
+    /// Free, or at an end.
+    pub state: LimitState,
+    /// Regularisation β of the stop row (see the module docs).
+    pub regularization: f64,
+}
+
+impl Default for LimitEquation {
+    fn default() -> Self {
+        Self {
+            state: LimitState::Free,
+            regularization: 0.0,
+        }
+    }
+}
+
 /// Where the previous configuration comes from.
 #[derive(Clone, Copy, Debug)]
 pub enum History<'a> {
@@ -102,12 +163,16 @@ pub struct FbdData {
     pub body: Vec<BodyStep>,
     /// Per-contact equations of this step.
     pub contact: Vec<ContactEquation>,
+    /// Per-limit equations of this step (order of [`Mechanism::limits`]).
+    pub limit: Vec<LimitEquation>,
     /// Joint torques at `k` (N·m), positive towards larger joint angles.
     pub torque: Vec<f64>,
     /// Time step (s).
     pub dt: f64,
     /// Scale of contact position rows, `M/Δt²` (N/m).
     pub position_gain: f64,
+    /// Scale of joint-limit rows, `Kθ = (M/Δt²)·ℓ²` (N·m/rad).
+    pub limit_gain: f64,
     /// `kin_next` holds the positions of a candidate set by
     /// [`evaluate_next`] (and no Newton iterate since).
     next_is_candidate: bool,
@@ -124,9 +189,11 @@ impl FbdData {
             kin,
             body: vec![BodyStep::default(); mech.bodies.len()],
             contact: vec![ContactEquation::default(); mech.contacts.len()],
+            limit: vec![LimitEquation::default(); mech.limits.len()],
             torque: vec![0.0; mech.joints.len()],
             dt: 0.0,
             position_gain: 0.0,
+            limit_gain: 0.0,
             next_is_candidate: false,
             acc: vec![[0.0; 3]; mech.bodies.len()],
         }
@@ -152,6 +219,8 @@ pub fn set_configuration(mech: &Mechanism, data: &mut FbdData, q: &[f64]) {
 pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, dt: f64) {
     data.dt = dt;
     data.position_gain = mech.total_mass() / (dt * dt);
+    let l = mech.length_scale();
+    data.limit_gain = data.position_gain * l * l;
     for b in 0..mech.bodies.len() {
         let x_k = FbdData::body_coords(mech, &data.kin, b);
         data.body[b] = match history {
@@ -194,11 +263,16 @@ pub fn advance(mech: &Mechanism, data: &mut FbdData) {
 }
 
 /// A key identifying the sparsity pattern: the contact states' codes in
-/// base 3 (the slide direction changes values, not structure).
+/// base 3 (the slide direction changes values, not structure), then one
+/// bit per joint limit (free or at an end).
 pub fn pattern_key(data: &FbdData) -> u64 {
-    data.contact
+    let k = data
+        .contact
         .iter()
-        .fold(0u64, |k, c| k * 3 + c.state.code() as u64)
+        .fold(0u64, |k, c| k * 3 + c.state.code() as u64);
+    data.limit
+        .iter()
+        .fold(k, |k, l| k * 2 + u64::from(l.state.is_at()))
 }
 
 /// Pushes every structural `(row, col)` of the Jacobian for the current
@@ -258,6 +332,12 @@ pub fn eval<S: JacobianSink>(
         a[1] += f[1];
         a[2] += cross([p[0] - c[0], p[1] - c[1]], f);
     }
+    for (l, &j) in mech.limits.iter().enumerate() {
+        let spec = &mech.joints[j];
+        let m = spec.axis_z * z[lay.limit_moment(l)];
+        data.acc[spec.child][2] += m;
+        data.acc[spec.parent][2] -= m;
+    }
     for (b, spec) in mech.bodies.iter().enumerate() {
         let x = FbdData::body_coords(mech, &data.kin_next, b);
         let bs = &data.body[b];
@@ -288,6 +368,16 @@ pub fn eval<S: JacobianSink>(
                 r[row + 1] = k * terrain.clearance(p) + eq.regularization * n;
             }
         }
+    }
+    for (l, &j) in mech.limits.iter().enumerate() {
+        let eq = &data.limit[l];
+        let lambda = z[lay.limit_moment(l)];
+        r[lay.limit_row(l)] = match eq.state {
+            LimitState::Free => lambda,
+            LimitState::At { angle, .. } => {
+                data.limit_gain * (z[mech.joints[j].q_index] - angle) + eq.regularization * lambda
+            }
+        };
     }
     if S::ACTIVE {
         force_entries(mech, data, jac);
@@ -347,6 +437,23 @@ fn force_entries<S: JacobianSink>(mech: &Mechanism, data: &FbdData, jac: &mut S)
             }
         }
     }
+    for (l, &j) in mech.limits.iter().enumerate() {
+        let spec = &mech.joints[j];
+        let col = lay.limit_moment(l);
+        // r[rot] = v·(I·ψ̈ − Σ moments), the stop adds ±axis·λ.
+        let (vc, vp) = (
+            mech.bodies[spec.child].versor_z,
+            mech.bodies[spec.parent].versor_z,
+        );
+        jac.add(lay.body_row(spec.child) + 2, col, -vc * spec.axis_z);
+        jac.add(lay.body_row(spec.parent) + 2, col, vp * spec.axis_z);
+        let eq = &data.limit[l];
+        let d = match eq.state {
+            LimitState::Free => 1.0,
+            LimitState::At { .. } => eq.regularization,
+        };
+        jac.add(lay.limit_row(l), col, d);
+    }
 }
 
 /// Entries in the `q[k+1]` columns: `∂(second difference)/∂q` of every body
@@ -394,6 +501,11 @@ fn position_entries<S: JacobianSink>(
                     );
                 }
             }
+        }
+    }
+    for (l, &j) in mech.limits.iter().enumerate() {
+        if data.limit[l].state.is_at() {
+            jac.add(lay.limit_row(l), mech.joints[j].q_index, data.limit_gain);
         }
     }
 }

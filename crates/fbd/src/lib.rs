@@ -42,8 +42,8 @@ pub mod body;
 pub mod mechanism;
 
 pub use assemble::{
-    ContactEquation, FbdData, History, JacobianSink, NoJacobian, advance, eval, evaluate_next,
-    pattern, pattern_key, prepare_step, set_configuration,
+    ContactEquation, FbdData, History, JacobianSink, LimitEquation, LimitState, NoJacobian,
+    advance, eval, evaluate_next, pattern, pattern_key, prepare_step, set_configuration,
 };
 pub use mechanism::{
     BodySpec, ContactPoints, ContactSpec, JointSpec, Layout, Mechanism, TwoLegInertia,

@@ -79,12 +79,23 @@ pub struct Layout {
     pub joints: usize,
     /// Contact points.
     pub contacts: usize,
+    /// Joint limits (one stop moment each).
+    pub limits: usize,
 }
 
 impl Layout {
     /// Unknowns = equations.
     pub fn dim(&self) -> usize {
-        self.nq + 2 * self.joints + 2 * self.contacts
+        self.nq + 2 * self.joints + 2 * self.contacts + self.limits
+    }
+    /// Column of joint limit `l`'s stop moment (N·m, positive towards
+    /// larger joint angles).
+    pub fn limit_moment(&self, l: usize) -> usize {
+        self.nq + 2 * self.joints + 2 * self.contacts + l
+    }
+    /// Row of joint limit `l`'s equation.
+    pub fn limit_row(&self, l: usize) -> usize {
+        3 * self.bodies + 2 * self.contacts + l
     }
     /// Column of joint `j`'s force component `axis` (0 = x, 1 = y).
     pub fn joint_force(&self, j: usize, axis: usize) -> usize {
@@ -121,6 +132,9 @@ pub struct Mechanism {
     pub contacts: Vec<ContactSpec>,
     /// Gravitational acceleration (m/s², acting along −Y).
     pub gravity: f64,
+    /// Joints with a limit (indices into `joints`), in order; each adds a
+    /// stop moment to the unknowns and an equation ([`Mechanism::with_limits`]).
+    pub limits: Vec<usize>,
     /// Structural `q` columns of each point's Jacobian (sorted).
     pub(crate) point_cols: Vec<Vec<usize>>,
 }
@@ -200,8 +214,24 @@ impl Mechanism {
             joints,
             contacts,
             gravity,
+            limits: Vec::new(),
             point_cols,
         }
+    }
+
+    /// The mechanism with a joint limit (a one-sided stop, see
+    /// `fbd_dynamics::assemble`) on each of `joints` (indices into
+    /// [`Mechanism::joints`]).
+    ///
+    /// # Panics
+    /// On an unknown or repeated joint index.
+    pub fn with_limits(mut self, joints: Vec<usize>) -> Self {
+        for (i, &j) in joints.iter().enumerate() {
+            assert!(j < self.joints.len(), "no joint {j}");
+            assert!(!joints[..i].contains(&j), "joint {j} limited twice");
+        }
+        self.limits = joints;
+        self
     }
 
     /// The paper's planar model: central body, legs 3 and 4 (SPEC §1.4).
@@ -290,6 +320,7 @@ impl Mechanism {
             bodies: self.bodies.len(),
             joints: self.joints.len(),
             contacts: self.contacts.len(),
+            limits: self.limits.len(),
         }
     }
 

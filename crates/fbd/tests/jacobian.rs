@@ -7,8 +7,8 @@
 use fbd_contact::{ContactState, Terrain};
 use fbd_dynamics::mechanism::ContactPoints;
 use fbd_dynamics::{
-    ContactEquation, FbdData, History, JacobianSink, Mechanism, NoJacobian, TwoLegInertia, eval,
-    pattern, prepare_step, set_configuration,
+    ContactEquation, FbdData, History, JacobianSink, LimitEquation, LimitState, Mechanism,
+    NoJacobian, TwoLegInertia, eval, pattern, prepare_step, set_configuration,
 };
 use fbd_kinematics::fd::{FdTolerance, check_jacobian};
 use fbd_kinematics::planar::PlanarGeometry;
@@ -45,10 +45,24 @@ fn mechanism() -> Mechanism {
 /// knees, hips), frames taken from `terrain` under each point as the
 /// simulator sets them, and compares the Jacobian with central differences.
 fn check(terrain: &Terrain, states: [ContactState; 6], first_step: bool) {
-    let mech = mechanism();
+    check_with_limits(terrain, states, first_step, &[]);
+}
+
+/// [`check`] with a joint limit on every joint in `limits` (one state per
+/// joint, `[hip3, knee3, hip4, knee4]`), or none.
+fn check_with_limits(
+    terrain: &Terrain,
+    states: [ContactState; 6],
+    first_step: bool,
+    limits: &[LimitState],
+) {
+    let mut mech = mechanism();
+    if !limits.is_empty() {
+        mech = mech.with_limits((0..limits.len()).collect());
+    }
     let lay = mech.layout();
     let n = lay.dim();
-    assert_eq!(n, 3 * 5 + 2 * 6);
+    assert_eq!(n, 3 * 5 + 2 * 6 + limits.len());
     let mut data = FbdData::new(&mech);
     let q0 = [0.05, 0.55, 0.1, 0.2, 4.2, -0.15, 4.4];
     let q1 = [0.051, 0.549, 0.102, 0.21, 4.19, -0.14, 4.41];
@@ -79,6 +93,13 @@ fn check(terrain: &Terrain, states: [ContactState; 6], first_step: bool) {
             // Far larger than the default so that its entries show in the
             // finite differences.
             regularization: 0.05,
+        };
+    }
+    for (l, &state) in limits.iter().enumerate() {
+        data.limit[l] = LimitEquation {
+            state,
+            // Far larger than the default, as for the contacts.
+            regularization: 0.03,
         };
     }
     data.torque
@@ -130,7 +151,7 @@ fn check(terrain: &Terrain, states: [ContactState; 6], first_step: bool) {
             ..Default::default()
         },
     )
-    .unwrap_or_else(|e| panic!("{terrain:?}, states {states:?}: {e}"));
+    .unwrap_or_else(|e| panic!("{terrain:?}, states {states:?}, limits {limits:?}: {e}"));
 }
 
 const SL: ContactState = ContactState::Slide { dir: -1.0 };
@@ -192,4 +213,61 @@ fn jacobian_on_a_slope_and_a_profile() {
         ],
     };
     check(&profile, [SL, SR, SL, SR, SL, SR], false);
+}
+
+#[test]
+fn jacobian_with_joint_limits_free_and_at_either_end() {
+    use fbd_kinematics::LimitSide;
+    let lower = LimitState::At {
+        side: LimitSide::Lower,
+        angle: 0.3,
+    };
+    let upper = LimitState::At {
+        side: LimitSide::Upper,
+        angle: 4.5,
+    };
+    let flat = Terrain::Flat { height: 0.01 };
+    let st = ContactState::Stick {
+        anchor: [0.5, 0.01],
+    };
+    for first_step in [true, false] {
+        check_with_limits(&flat, [FREE; 6], first_step, &[LimitState::Free; 4]);
+        check_with_limits(
+            &flat,
+            [st, SL, FREE, st, SL, SR],
+            first_step,
+            &[lower, upper, LimitState::Free, upper],
+        );
+        check_with_limits(
+            &flat,
+            [SL, st, st, SL, FREE, st],
+            first_step,
+            &[LimitState::Free, lower, lower, upper],
+        );
+    }
+}
+
+/// A stop moment acts on the joint's two bodies only, equal and opposite:
+/// the rotation rows of child and parent see `∓v·axis` and no other row
+/// depends on it.
+#[test]
+fn stop_moment_enters_child_and_parent_rotation_rows_only() {
+    let mech = mechanism().with_limits(vec![1, 2]);
+    let lay = mech.layout();
+    let data = FbdData::new(&mech);
+    let mut entries = Vec::new();
+    pattern(&mech, &data, &mut entries);
+    for (l, &j) in mech.limits.iter().enumerate() {
+        let col = lay.limit_moment(l);
+        let mut rows: Vec<usize> = entries.iter().filter(|e| e.1 == col).map(|e| e.0).collect();
+        rows.sort_unstable();
+        let spec = &mech.joints[j];
+        let mut expected = vec![
+            lay.body_row(spec.parent) + 2,
+            lay.body_row(spec.child) + 2,
+            lay.limit_row(l),
+        ];
+        expected.sort_unstable();
+        assert_eq!(rows, expected, "limit {l} on joint {}", spec.name);
+    }
 }

@@ -34,6 +34,23 @@ pub enum KinematicsError {
     /// A coordinate of the target (or of the body pose) is NaN or infinite.
     #[error("non-finite target coordinate")]
     NonFinite,
+    /// A joint angle lies outside its [`crate::limits::JointLimits`] range.
+    #[error(
+        "{joint} = {:.3}° is outside its limits [{:.3}°, {:.3}°] by {:.3}°",
+        value.to_degrees(), min.to_degrees(), max.to_degrees(), outside_by.to_degrees()
+    )]
+    JointLimit {
+        /// `"theta1"`, `"theta2"` or `"theta3"`.
+        joint: &'static str,
+        /// The angle (rad).
+        value: f64,
+        /// Lower end of the range (rad).
+        min: f64,
+        /// Upper end of the range (rad).
+        max: f64,
+        /// How far outside the range the angle is (rad).
+        outside_by: f64,
+    },
     /// The inverse kinematics of one leg of a stance failed.
     #[error("leg {leg}: {source}")]
     Leg {

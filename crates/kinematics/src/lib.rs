@@ -13,6 +13,8 @@
 //!   and the leg chain of eq. (4) — the reference definitions.
 //! * [`leg`]: one 3-DOF leg in its base frame: fast forward kinematics and
 //!   the analytic tip Jacobian.
+//! * [`leg_jacobian`]: joint rates and accelerations of one leg from the
+//!   analytic tip Jacobian and its time derivative.
 //! * [`body`]: leg numbering, `γi`, and the body → leg-base transform.
 //! * [`pose`]: the central body's pose, `Rot = Rx(φx)·Rz(φz)·Ry(φy)`.
 //! * [`hexapod`]: allocation-free 24-DOF forward kinematics of every
@@ -24,6 +26,7 @@
 //! * [`planar`]: the planar model as a generic floating-base tree whose
 //!   segment angles are linear in `q`; positions, Jacobians and
 //!   velocity-product terms of every auxiliary point.
+//! * [`limits`]: [`JointLimits`], the `[min, max]` range of θ1, θ2, θ3.
 //! * [`fd`]: the shared central finite-difference checker used by every
 //!   Jacobian test in the workspace.
 
@@ -34,11 +37,14 @@ pub mod fd;
 pub mod hexapod;
 pub mod ik;
 pub mod leg;
+pub mod leg_jacobian;
+pub mod limits;
 pub mod planar;
 pub mod pose;
 pub mod stance;
 
 pub use error::KinematicsError;
+pub use limits::{Joint, JointLimits, LimitSide};
 /// The linear-algebra crate of the public API (`Vector3`, `Matrix3`, …),
 /// re-exported so users need not depend on a matching version.
 pub use nalgebra;

@@ -28,6 +28,9 @@ use fbd_sim::{Model, PlanarParams, SimError};
 use serde::{Deserialize, Serialize};
 
 mod actuation;
+mod gait;
+pub use gait::{GaitConfig, GaitKindConfig, SpeedConfig};
+mod advice;
 pub use actuation::{ControlConfig, ControlKind, ControlLegConfig, TargetDeg};
 
 /// Fixed-length arrays of numbers: serde's `[f64; N]` would silently
@@ -225,6 +228,19 @@ pub struct LegConfig {
     pub lower_inertia: Option<f64>,
     /// Lower link centre of mass, fraction of `c` from the knee.
     pub lower_com: f64,
+    /// θ1 range `[min, max]` (deg, hexapod); `None` until resolved to the
+    /// default of [`fbd_sim::JointLimits`], `[−90, 90]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "fixed::opt")]
+    pub theta1_deg: Option<[f64; 2]>,
+    /// θ2 range `[min, max]` (deg); default `[−120, 120]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "fixed::opt")]
+    pub theta2_deg: Option<[f64; 2]>,
+    /// θ3 range `[min, max]` (deg); default `[180, 330]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "fixed::opt")]
+    pub theta3_deg: Option<[f64; 2]>,
 }
 
 impl Default for LegConfig {
@@ -239,11 +255,37 @@ impl Default for LegConfig {
             lower_mass: p.lower_mass,
             lower_inertia: None,
             lower_com: p.lower_com,
+            theta1_deg: None,
+            theta2_deg: None,
+            theta3_deg: None,
         }
     }
 }
 
 impl LegConfig {
+    /// The joint-limit keys with their values (deg), defaults filled in.
+    pub fn limits_deg(&self) -> [(&'static str, [f64; 2]); 3] {
+        let d = fbd_sim::JointLimits::default();
+        let deg = |r: [f64; 2]| [r[0].to_degrees(), r[1].to_degrees()];
+        [
+            ("leg.theta1_deg", self.theta1_deg.unwrap_or(deg(d.theta1))),
+            ("leg.theta2_deg", self.theta2_deg.unwrap_or(deg(d.theta2))),
+            ("leg.theta3_deg", self.theta3_deg.unwrap_or(deg(d.theta3))),
+        ]
+    }
+
+    /// The joint limits (rad).
+    pub fn joint_limits(&self) -> fbd_sim::JointLimits {
+        let [t1, t2, t3] = self
+            .limits_deg()
+            .map(|(_, r)| [r[0].to_radians(), r[1].to_radians()]);
+        fbd_sim::JointLimits {
+            theta1: t1,
+            theta2: t2,
+            theta3: t3,
+        }
+    }
+
     /// Upper link inertia, the rod default when omitted (kg·m²).
     pub fn upper_inertia(&self) -> f64 {
         self.upper_inertia
@@ -450,6 +492,11 @@ pub struct PlanarInitial {
     pub phi_z_deg: f64,
     /// φ̇z (deg/s).
     pub omega_z_deg: f64,
+    /// Drop height (m, optional): when given, `Ry` (`position[1]`) is
+    /// replaced by the height that puts the lowest contact point this far
+    /// above the terrain, whatever the pose.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub drop_height: Option<f64>,
     /// Leg 3 (middle-left).
     pub leg3: PlanarLegInitial,
     /// Leg 4 (middle-right).
@@ -464,6 +511,7 @@ impl Default for PlanarInitial {
             velocity: [p.qdot0[0], p.qdot0[1]],
             phi_z_deg: 0.0,
             omega_z_deg: 0.0,
+            drop_height: None,
             leg3: PlanarLegInitial::default(),
             leg4: PlanarLegInitial::default(),
         }
@@ -596,6 +644,10 @@ pub struct ConfigFile<I> {
     /// `[control]` (planar model).
     #[serde(default)]
     pub control: ControlConfig,
+    /// `[gait]` (hexapod model): the kinematic gait; without it a hexapod
+    /// run holds its initial pose.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gait: Option<GaitConfig>,
 }
 
 /// A planar configuration.
@@ -617,6 +669,7 @@ impl Default for PlanarConfig {
             contact: ContactConfig::default(),
             output: OutputConfig::default(),
             control: ControlConfig::default(),
+            gait: None,
         };
         c.resolve_common();
         c.resolve_initial();
@@ -628,6 +681,10 @@ impl<I> ConfigFile<I> {
     fn resolve_common(&mut self) {
         self.leg.upper_inertia = Some(self.leg.upper_inertia());
         self.leg.lower_inertia = Some(self.leg.lower_inertia());
+        let [t1, t2, t3] = self.leg.limits_deg().map(|(_, r)| Some(r));
+        self.leg.theta1_deg = t1;
+        self.leg.theta2_deg = t2;
+        self.leg.theta3_deg = t3;
         let mut points = self.contact.points.clone();
         points.sort();
         points.dedup();
@@ -657,12 +714,12 @@ impl<I> ConfigFile<I> {
                 &format!("dt ≤ {}", self.time.duration),
             );
         }
-        if !self.world.gravity.is_finite() {
+        if !(self.world.gravity.is_finite() && self.world.gravity >= 0.0) {
             return err(
                 "world.gravity",
-                "must be finite",
+                "is the magnitude g of gravity (which acts along −Y) and must be finite and ≥ 0",
                 &self.world.gravity,
-                "a finite value",
+                "a finite value ≥ 0, e.g. 9.81",
             );
         }
         positive("body.mass", self.body.mass)?;
@@ -680,6 +737,16 @@ impl<I> ConfigFile<I> {
         ] {
             if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
                 return err(key, "must lie on the link", &v, "a fraction in [0, 1]");
+            }
+        }
+        for (key, [lo, hi]) in self.leg.limits_deg() {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return err(
+                    key,
+                    "must be a finite range [min, max] with min < max",
+                    &format!("[{lo}, {hi}]"),
+                    "finite degrees, min < max",
+                );
             }
         }
         // Checked for every kind: `nan`/`inf` are rejected everywhere, even
@@ -780,6 +847,11 @@ impl PlanarConfig {
         }
         let initial = [self.initial.theta_deg(0), self.initial.theta_deg(1)];
         self.control.resolve(initial);
+        if let Some(h) = self.initial.drop_height {
+            let mut p = self.params();
+            p.set_drop_height(h);
+            self.initial.position[1] = p.q0[1];
+        }
     }
 
     /// Checks every key, in the file's units (degrees for `*_deg` keys).
@@ -792,6 +864,26 @@ impl PlanarConfig {
         check_finite(file, "initial.velocity", &i.velocity)?;
         check_finite(file, "initial.phi_z_deg", &[i.phi_z_deg])?;
         check_finite(file, "initial.omega_z_deg", &[i.omega_z_deg])?;
+        if let Some(h) = i.drop_height
+            && !(h.is_finite() && h >= 0.0)
+        {
+            return Err(ConfigError::semantic(
+                file,
+                "initial.drop_height",
+                "must be finite and ≥ 0",
+                h,
+                "a height ≥ 0 (m)",
+            ));
+        }
+        if self.gait.is_some() {
+            return Err(ConfigError::semantic(
+                file,
+                "gait",
+                "the kinematic gait is for the hexapod",
+                "a [gait] table",
+                "model = \"hexapod\"",
+            ));
+        }
         for (leg, name) in [(0, "leg3"), (1, "leg4")] {
             check_finite(
                 file,
@@ -824,6 +916,7 @@ impl PlanarConfig {
             lower_mass: self.leg.lower_mass,
             lower_inertia: self.leg.lower_inertia(),
             lower_com: self.leg.lower_com,
+            joint_limits: self.leg.joint_limits(),
             q0: [
                 i.position[0],
                 i.position[1],
@@ -877,6 +970,9 @@ impl HexapodConfig {
                 &l.theta_deg,
             )?;
             check_finite(file, &format!("initial.leg{}.rate_deg", n + 1), &l.rate_deg)?;
+        }
+        if let Some(g) = &self.gait {
+            g.validate(file)?;
         }
         Ok(())
     }
@@ -936,6 +1032,10 @@ impl Config {
             Config::Hexapod(c) => {
                 c.model = ModelKind::Hexapod;
                 c.resolve_common();
+                let duration = c.time.duration;
+                if let Some(g) = &mut c.gait {
+                    g.resolve(duration);
+                }
             }
         }
     }
@@ -1053,6 +1153,15 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 /// The message of a toml error, prefixed with the dotted key it concerns
 /// (when toml knows it and the message does not already say it).
 fn describe(err: &toml::de::Error) -> String {
+    let message = describe_key(err);
+    match suggestion(&message) {
+        // `table: unknown field `x`, did you mean `y`? expected one of …`
+        Some(hint) => message.replacen(", expected", &format!(", {hint}expected"), 1),
+        None => message,
+    }
+}
+
+fn describe_key(err: &toml::de::Error) -> String {
     let message = err.message().trim().replace('\n', "; ");
     let mut plain = err.clone();
     plain.set_input(None);
@@ -1065,6 +1174,22 @@ fn describe(err: &toml::de::Error) -> String {
         Some(k) if !k.is_empty() => format!("{k}: {message}"),
         _ => message,
     }
+}
+
+/// `unknown field `x`, expected one of `a`, `b`` → `did you mean `a`?`
+/// when one of the expected keys is close to the unknown one.
+fn suggestion(message: &str) -> Option<String> {
+    let rest = message.split("unknown field `").nth(1)?;
+    let (unknown, rest) = rest.split_once('`')?;
+    let expected = rest.split_once("expected")?.1;
+    expected
+        .split('`')
+        .skip(1)
+        .step_by(2)
+        .map(|k| (strsim::damerau_levenshtein(unknown, k), k))
+        .filter(|&(d, k)| d <= 2.max(k.len() / 3))
+        .min()
+        .map(|(_, k)| format!("did you mean `{k}`? "))
 }
 
 fn syntax_error(file: &str, text: &str, err: &toml::de::Error) -> ConfigError {
@@ -1146,8 +1271,17 @@ pub fn load(path: &Path) -> Result<Config, ConfigError> {
 }
 
 /// Reads the file at `path`, applies `overrides` (dotted keys, e.g. from a
-/// sweep) and parses it ([`parse_str`]).
+/// sweep) and parses it ([`parse_str`]). An empty file is the built-in
+/// default experiment, as a file with some keys is filled from defaults.
 pub fn load_with_overrides(path: &Path, overrides: &[Override]) -> Result<Config, ConfigError> {
+    let text = read_text(path)?;
+    parse_str(&text, &path.display().to_string(), overrides)
+}
+
+/// Reads the UTF-8 text file at `path` with the messages every command
+/// uses: `FILE: no such file`, `FILE: is a directory, expected a TOML
+/// file`, `FILE: is not UTF-8 text (…)`, `FILE: cannot read: …`.
+pub fn read_text(path: &Path) -> Result<String, ConfigError> {
     let file = path.display().to_string();
     let unreadable = |what: &str| ConfigError::Unreadable {
         file: file.clone(),
@@ -1164,9 +1298,7 @@ pub fn load_with_overrides(path: &Path, overrides: &[Override]) -> Result<Config
             });
         }
         Ok(m) if m.is_dir() => {
-            return Err(unreadable(
-                "is a directory, expected a TOML configuration file",
-            ));
+            return Err(unreadable("is a directory, expected a TOML file"));
         }
         Ok(_) => {}
     }
@@ -1174,18 +1306,12 @@ pub fn load_with_overrides(path: &Path, overrides: &[Override]) -> Result<Config
         file: file.clone(),
         what: e.to_string(),
     })?;
-    let text = String::from_utf8(bytes).map_err(|e| {
+    String::from_utf8(bytes).map_err(|e| {
         unreadable(&format!(
             "is not UTF-8 text (invalid byte at offset {})",
             e.utf8_error().valid_up_to()
         ))
-    })?;
-    if text.trim().is_empty() {
-        return Err(unreadable(
-            "the file is empty (expected a TOML configuration, e.g. `model = \"planar\"`)",
-        ));
-    }
-    parse_str(&text, &file, overrides)
+    })
 }
 
 #[cfg(test)]

@@ -166,8 +166,20 @@ impl Control {
 }
 
 /// Stage 2 of [`crate::step()`]: the joint torques of step `data.k` into
-/// `data.fbd.torque`, from `q[k]` and `q[k−1]` (explicit). No allocation.
+/// `data.fbd.torque`, from `q[k]` and `q[k−1]` (explicit): the external
+/// torques [`Data::external_torque`] as given when set (no saturation),
+/// else the configured controller's. No allocation.
 pub fn joint_torques(model: &Model, data: &mut Data) {
+    if let Some(tau) = data.external_torque {
+        let n = data.fbd.torque.len();
+        assert!(
+            n <= tau.len(),
+            "{n} joints, external torques hold {}",
+            tau.len()
+        );
+        data.fbd.torque.copy_from_slice(&tau[..n]);
+        return;
+    }
     let control = &model.params.control;
     let Some((kp, kd, limit)) = control.gains() else {
         data.fbd.torque.fill(0.0);

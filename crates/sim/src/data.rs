@@ -1,9 +1,9 @@
 //! The mutable workspace of a run ([`Data`]), built from a [`Model`].
 
 use crate::Model;
-use crate::record::Event;
+use crate::record::{Event, LimitEvent, RetryEvent};
 use fbd_contact::ContactState;
-use fbd_dynamics::FbdData;
+use fbd_dynamics::{FbdData, LimitState};
 use fbd_solver::NewtonSolver;
 
 /// Everything that changes during a run. All buffers are allocated here,
@@ -29,8 +29,18 @@ pub struct Data {
     pub solver: NewtonSolver,
     /// Contact events so far.
     pub events: Vec<Event>,
+    /// State of each joint limit (order of the mechanism's limits), accepted.
+    pub limit_states: Vec<LimitState>,
+    /// Joint-limit events so far.
+    pub limit_events: Vec<LimitEvent>,
+    /// Steps solved in substeps so far.
+    pub retries: Vec<RetryEvent>,
     /// Newton iterations so far.
     pub newton_iterations: usize,
+    /// Joint torques (N·m, joint order) applied at the next step instead of
+    /// the controller's, when `Some` ([`crate::control::joint_torques`]);
+    /// kept until changed. For controllers outside the simulator.
+    pub external_torque: Option<[f64; crate::record::MAX_JOINTS]>,
     /// Per-row convergence scales of the current contact states.
     pub(crate) scales: Vec<f64>,
     /// Trial states of the state search.
@@ -42,6 +52,19 @@ pub struct Data {
     pub(crate) seen: Vec<u8>,
     /// Per contact, the tangential force of its last sticking trial.
     pub(crate) stick_fa: Vec<f64>,
+    /// Trial states of the joint limits.
+    pub(crate) limit_trial: Vec<LimitState>,
+    /// The step's start, kept for a retry in substeps: `q[k]`, `q[k−1]`,
+    /// `q[k−2]`, the accepted states and the event counts.
+    pub(crate) grid_q: Vec<f64>,
+    pub(crate) grid_q_prev: Vec<f64>,
+    pub(crate) grid_q_prev2: Vec<f64>,
+    pub(crate) grid_states: Vec<ContactState>,
+    pub(crate) grid_limits: Vec<LimitState>,
+    pub(crate) grid_events: [usize; 2],
+    /// The trial states at which the whole step failed (for the error).
+    pub(crate) failed_trial: Vec<ContactState>,
+    pub(crate) failed_limits: Vec<LimitState>,
 }
 
 impl Data {
@@ -64,11 +87,24 @@ impl Data {
             solver: NewtonSolver::new(model.newton),
             events: Vec::with_capacity(64),
             newton_iterations: 0,
+            external_torque: None,
             scales: vec![1.0; lay.dim()],
             trial: model.initial_states.clone(),
             visited: Vec::with_capacity(64),
             seen: vec![0; lay.contacts],
             stick_fa: vec![0.0; lay.contacts],
+            limit_states: vec![LimitState::Free; lay.limits],
+            limit_events: Vec::with_capacity(64),
+            retries: Vec::with_capacity(16),
+            limit_trial: vec![LimitState::Free; lay.limits],
+            grid_q: model.params.q0.to_vec(),
+            grid_q_prev: model.params.q0.to_vec(),
+            grid_q_prev2: model.params.q0.to_vec(),
+            grid_states: model.initial_states.clone(),
+            grid_limits: vec![LimitState::Free; lay.limits],
+            grid_events: [0, 0],
+            failed_trial: model.initial_states.clone(),
+            failed_limits: vec![LimitState::Free; lay.limits],
         }
     }
 

@@ -3,7 +3,8 @@
 use crate::{PlanarParams, SimError};
 use fbd_contact::{ContactParams, ContactState};
 use fbd_dynamics::{Mechanism, TwoLegInertia};
-use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex};
+use fbd_kinematics::Joint;
+use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex, theta2_index};
 use fbd_solver::NewtonParams;
 
 /// Everything fixed during a run: parameters, mechanism, tolerances.
@@ -25,12 +26,26 @@ pub struct Model {
     pub contact_leg: Vec<usize>,
     /// Kind of each contact point: `"tip"`, `"knee"` or `"hip"`.
     pub contact_point: Vec<&'static str>,
-    /// Compliance of each contact point's anchor (m/N): 0 for the feet
-    /// (rigid, as the paper's), [`ContactParams::bumper_compliance`] for
-    /// knees and hips.
+    /// Compliance of each contact point's anchor at the model's Δt (m/N):
+    /// 0 for the feet (rigid, as the paper's), `β_b·Δt²/M` for knees and
+    /// hips ([`ContactParams::bumper_regularization`]).
     pub contact_compliance: Vec<f64>,
+    /// Dimensionless regularisation of each contact point's position rows
+    /// on top of [`ContactParams::regularization`]: 0 for the feet,
+    /// [`ContactParams::bumper_regularization`] for knees and hips. It is
+    /// independent of Δt (so are the impacts it makes plastic).
+    pub contact_bumper: Vec<f64>,
     /// Contact state of each point at `t = 0` (SPEC §3).
     pub initial_states: Vec<ContactState>,
+    /// Which joint of its leg each joint limit (order of
+    /// `mech.limits`) is: θ2 (hips) or θ3 (knees).
+    pub limit_joint: Vec<Joint>,
+    /// Hexapod leg number (3 or 4) of each joint limit.
+    pub limit_leg: Vec<usize>,
+    /// Finest subdivision of a step that cannot be solved whole: it is
+    /// retried as 2, 4, … up to `max_substeps` substeps before the run
+    /// fails. Default 64 (Δt/64: 0.16 ms at the default Δt = 10 ms).
+    pub max_substeps: usize,
 }
 
 fn check(
@@ -198,6 +213,41 @@ impl Model {
             lower_inertia: p.lower_inertia,
         };
         let (mech, index) = Mechanism::two_leg(&geometry, &inertia, p.gravity, p.contact_points);
+        check(
+            p.joint_limits.is_valid(),
+            "leg.theta2_deg",
+            "joint limits must be ranges [min, max] with min < max",
+            format!("{:?}", p.joint_limits),
+            "min < max",
+        )?;
+        // Every joint whose range has a finite end gets a stop; the initial
+        // angles must lie in the ranges.
+        let mut limited = Vec::new();
+        let (mut limit_joint, mut limit_leg) = (Vec::new(), Vec::new());
+        for (j, spec) in mech.joints.iter().enumerate() {
+            let leg = if spec.name.ends_with('3') { 3 } else { 4 };
+            let joint = if spec.q_index == theta2_index(leg - 3) {
+                Joint::Theta2
+            } else {
+                Joint::Theta3
+            };
+            if let Err(e) = p.joint_limits.check(joint, p.q0[spec.q_index]) {
+                check(
+                    false,
+                    &format!("initial.leg{leg}.theta_deg"),
+                    "outside the joint limits",
+                    e,
+                    &format!("angles inside [leg] {}_deg", joint.name()),
+                )?;
+            }
+            let [lo, hi] = p.joint_limits.range(joint);
+            if lo.is_finite() || hi.is_finite() {
+                limited.push(j);
+                limit_joint.push(joint);
+                limit_leg.push(leg);
+            }
+        }
+        let mech = mech.with_limits(limited);
         let contact = ContactParams::default();
         let contact_leg: Vec<usize> = mech
             .contacts
@@ -214,6 +264,17 @@ impl Model {
                     .expect("two-leg contact points are tips, knees or hips")
             })
             .collect();
+        let contact_bumper: Vec<f64> = contact_point
+            .iter()
+            .map(|&k| {
+                if k == "tip" {
+                    0.0
+                } else {
+                    contact.bumper_regularization
+                }
+            })
+            .collect();
+        let total_mass = mech.total_mass();
         let mut kin = mech.chains.new_data();
         mech.chains.eval_positions(&p.q0, &mut kin);
         let mut initial_states = Vec::with_capacity(mech.contacts.len());
@@ -241,18 +302,16 @@ impl Model {
             },
             steps: steps_f as usize + 1,
             contact_leg,
-            contact_compliance: contact_point
+            contact_compliance: contact_bumper
                 .iter()
-                .map(|&k| {
-                    if k == "tip" {
-                        0.0
-                    } else {
-                        contact.bumper_compliance
-                    }
-                })
+                .map(|b| b * p.dt * p.dt / total_mass)
                 .collect(),
+            contact_bumper,
             contact_point,
             initial_states,
+            limit_joint,
+            limit_leg,
+            max_substeps: 64,
         })
     }
 

@@ -4,6 +4,7 @@
 use crate::control::Control;
 use fbd_contact::{Friction, Terrain};
 use fbd_dynamics::mechanism::ContactPoints;
+use fbd_kinematics::JointLimits;
 
 /// Everything that defines a planar simulation.
 #[derive(Clone, Debug, PartialEq)]
@@ -44,6 +45,11 @@ pub struct PlanarParams {
     /// Lower link centre of mass, fraction of `c` from the knee. Default 0.75
     /// (towards the foot).
     pub lower_com: f64,
+    /// Joint limits of θ2 and θ3 (θ1 is unused by the planar model), one-sided
+    /// constraints of the dynamics. Default [`JointLimits::default`]: they
+    /// keep a collapsing leg from folding flat; [`JointLimits::none`]
+    /// switches them off.
+    pub joint_limits: JointLimits,
     /// Initial generalised coordinates `(Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)`
     /// (m, rad). Default: the paper's §6 table, `(0, 0.6, 0, 0, 245°, 0, 255°)`.
     pub q0: [f64; 7],
@@ -82,6 +88,7 @@ impl Default for PlanarParams {
             lower_mass,
             lower_inertia: lower_mass * lower_length * lower_length / 12.0,
             lower_com: 0.75,
+            joint_limits: JointLimits::default(),
             q0: [
                 0.0,
                 0.6,
@@ -98,5 +105,38 @@ impl Default for PlanarParams {
             stride: 1,
             control: Control::None,
         }
+    }
+}
+
+impl PlanarParams {
+    /// Height (m) of the lowest contact point of the initial configuration
+    /// above the terrain under it (negative when below).
+    pub fn lowest_clearance(&self) -> f64 {
+        let geometry = fbd_kinematics::planar::PlanarGeometry {
+            d: self.side * (std::f64::consts::PI / 6.0).cos(),
+            a: self.upper_length,
+            c: self.lower_length,
+            upper_com: self.upper_com,
+            lower_com: self.lower_com,
+        };
+        let (chains, ix) = fbd_kinematics::planar::PlanarChains::two_leg(&geometry);
+        let mut kin = chains.new_data();
+        chains.eval_positions(&self.q0, &mut kin);
+        let cp = self.contact_points;
+        [(cp.tips, ix.tip), (cp.knees, ix.knee), (cp.hips, ix.hip)]
+            .into_iter()
+            .filter(|(on, _)| *on)
+            .flat_map(|(_, pts)| pts)
+            .map(|p| self.terrain.clearance(kin.pos[p]))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Moves the initial body height `Ry` so that the lowest contact point
+    /// is `height` (m) above the terrain: a drop from that height.
+    pub fn set_drop_height(&mut self, height: f64) {
+        // Exact on flat ground; on other terrains the lowest point's
+        // terrain height changes with nothing but Ry only when it moves
+        // sideways, which a vertical shift does not do.
+        self.q0[1] += height - self.lowest_clearance();
     }
 }

@@ -2,6 +2,29 @@
 //! contact events.
 
 use fbd_contact::StateCode;
+use fbd_kinematics::Joint;
+
+/// The state of a joint limit as written to the output files.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum LimitCode {
+    /// Inside the range.
+    Free,
+    /// At the lower end (`min`).
+    Min,
+    /// At the upper end (`max`).
+    Max,
+}
+
+impl LimitCode {
+    /// `"free"`, `"min"` or `"max"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            LimitCode::Free => "free",
+            LimitCode::Min => "min",
+            LimitCode::Max => "max",
+        }
+    }
+}
 
 /// Most contact points a planar record holds (tips, knees, hips of 2 legs).
 pub const MAX_CONTACTS: usize = 6;
@@ -33,6 +56,11 @@ pub struct StepRecord {
     pub joint_force: [[f64; 2]; MAX_JOINTS],
     /// Joint torques (N·m), same order.
     pub torque: [f64; MAX_JOINTS],
+    /// State of each joint's limit at step k, same order.
+    pub limit: [LimitCode; MAX_JOINTS],
+    /// Moment of each joint's limit stop (N·m, positive towards larger
+    /// joint angles; 0 when free), same order.
+    pub limit_moment: [f64; MAX_JOINTS],
     /// Kinetic energy at k, from central-difference velocities (J).
     pub kinetic: f64,
     /// Gravitational potential energy at k (J).
@@ -58,6 +86,8 @@ impl StepRecord {
             n: [0.0; MAX_CONTACTS],
             joint_force: [[0.0; 2]; MAX_JOINTS],
             torque: [0.0; MAX_JOINTS],
+            limit: [LimitCode::Free; MAX_JOINTS],
+            limit_moment: [0.0; MAX_JOINTS],
             kinetic: 0.0,
             potential: 0.0,
             newton_iterations: 0,
@@ -84,4 +114,51 @@ pub struct Event {
     pub from: StateCode,
     /// New state.
     pub to: StateCode,
+}
+
+/// A joint reaching or leaving an end of its range (a row of `events.csv`
+/// with `point` = `hip_limit` or `knee_limit`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LimitEvent {
+    /// Start of the first step solved in the new state (s).
+    pub t: f64,
+    /// Step index of that step.
+    pub step: usize,
+    /// Index of the joint in the mechanism.
+    pub joint_index: usize,
+    /// Which joint of the leg (θ2: hip, θ3: knee).
+    pub joint: Joint,
+    /// Hexapod leg number (3 or 4).
+    pub leg: usize,
+    /// Previous state.
+    pub from: LimitCode,
+    /// New state.
+    pub to: LimitCode,
+}
+
+impl LimitEvent {
+    /// `"hip_limit"` (θ2), `"knee_limit"` (θ3) or `"theta1_limit"`.
+    pub fn point(&self) -> &'static str {
+        match self.joint {
+            Joint::Theta1 => "theta1_limit",
+            Joint::Theta2 => "hip_limit",
+            Joint::Theta3 => "knee_limit",
+        }
+    }
+}
+
+/// A step that was solved in substeps (a row of `events.csv` with `point`
+/// = `substeps`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RetryEvent {
+    /// Start of the step (s).
+    pub t: f64,
+    /// Step index.
+    pub step: usize,
+    /// Number of substeps of Δt/`substeps` it took (2, 4, 8, …).
+    pub substeps: usize,
+    /// Why the step failed whole: `"newton"` (Newton did not converge),
+    /// `"cycle"` (the contact-state search found no consistent
+    /// combination) or `"non-finite"`.
+    pub cause: &'static str,
 }

@@ -1,7 +1,8 @@
 //! The stepping loop of a whole run.
 
-use crate::record::{Event, StepRecord};
+use crate::record::{Event, LimitEvent, RetryEvent, StepRecord};
 use crate::{Data, Model, SimError, step};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Outcome of [`run`].
@@ -20,6 +21,13 @@ pub struct RunSummary {
     pub events: Vec<Event>,
     /// Why the run stopped early, if it did.
     pub error: Option<SimError>,
+    /// Joint-limit events.
+    pub limit_events: Vec<LimitEvent>,
+    /// Steps that were solved in substeps (see [`crate::step`]).
+    pub retries: Vec<RetryEvent>,
+    /// `true` when the `stop` flag of [`run_until`] ended the run before
+    /// its last step (the steps solved so far are valid).
+    pub interrupted: bool,
 }
 
 impl RunSummary {
@@ -35,12 +43,27 @@ impl RunSummary {
 
 /// Runs `model` from its initial state to the end (or the first error),
 /// handing every `stride`-th record to `on_row`.
-pub fn run(model: &Model, mut on_row: impl FnMut(&StepRecord)) -> RunSummary {
+pub fn run(model: &Model, on_row: impl FnMut(&StepRecord)) -> RunSummary {
+    run_until(model, &AtomicBool::new(false), on_row)
+}
+
+/// [`run`], stopping before the next step once `stop` is set (e.g. by a
+/// signal handler); the summary then says `interrupted`.
+pub fn run_until(
+    model: &Model,
+    stop: &AtomicBool,
+    mut on_row: impl FnMut(&StepRecord),
+) -> RunSummary {
     let mut data = Data::new(model);
     let stride = model.params.stride.max(1);
     let mut wall = 0.0;
     let mut error = None;
+    let mut interrupted = false;
     for k in 0..model.steps {
+        if stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
         let start = Instant::now();
         let result = step(model, &mut data);
         wall += start.elapsed().as_secs_f64();
@@ -63,6 +86,9 @@ pub fn run(model: &Model, mut on_row: impl FnMut(&StepRecord)) -> RunSummary {
         symbolic_factorizations: data.symbolic_factorizations(),
         events: data.events,
         error,
+        limit_events: data.limit_events,
+        retries: data.retries,
+        interrupted,
     }
 }
 

@@ -4,79 +4,164 @@
 //! 2. **joint torques at k**: the controller's torques from `q[k]`, `q[k−1]`
 //!    ([`crate::control`]);
 //! 3. **predictor**: a starting guess for `q[k+1]` (forces from the last step);
-//! 4. **solve**: Newton on the FBD equations with the current contact states;
-//! 5. **contact check**: every point's switching rule on the trial solution
-//!    (touchdowns all at once, other switches one at a time, see
-//!    [`check_contacts`]); any switch → back to 4. A repeated state combination means no
-//!    combination the rules reach is consistent; before giving up, a point
-//!    that flip-flopped between ST1 (it penetrates when free) and ST2 (it
-//!    would pull on the ground when stuck) is tried in ST3, sliding opposite
-//!    to the friction sticking needed — the remaining candidate of Coulomb's
-//!    law ([`slide_flip_flops`]). A cycle after that is an error;
+//! 4. **solve**: Newton on the FBD equations with the current contact and
+//!    joint-limit states;
+//! 5. **state check**: every contact point's switching rule and every joint
+//!    limit's on the trial solution (touchdowns and limit arrivals all at
+//!    once, other switches one at a time, see [`check_states`]); any switch
+//!    → back to 4. A repeated state combination means no combination the
+//!    rules reach is consistent; before giving up, a point that flip-flopped
+//!    between ST1 (it penetrates when free) and ST2 (it would pull on the
+//!    ground when stuck) is tried in ST3, sliding opposite to the friction
+//!    sticking needed — the remaining candidate of Coulomb's law
+//!    ([`slide_flip_flops`]);
 //! 6. **accept**: record, events, and `q[k+1]` becomes the current state.
+//!
+//! **Retry in substeps.** A step that Newton cannot solve, or whose state
+//! search finds no consistent combination (a cycle after the fallback), is
+//! solved again from `q[k]` as 2, 4, 8, … substeps of `Δt/n`, down to
+//! `Δt/`[`Model::max_substeps`], before the run fails. The substeps start
+//! from the velocity of the last step (the previous configuration is taken
+//! at `t_k − Δt/n` on the line `q[k−1] → q[k]`), keep the step's joint
+//! torques, and the next full step continues from `q[k]` and `q[k+1]`: rows
+//! stay on the Δt grid. Each retried step is a [`RetryEvent`].
+//!
+//! **Joint limits** are one-sided, plastic stops (`fbd_dynamics::assemble`):
+//! a free joint whose trial angle crosses an end of its range is held at
+//! that end; a joint at an end is released when the stop's moment would
+//! pull it there instead of pushing it away.
 
 use crate::energy;
-use crate::record::{Event, MAX_CONTACTS, MAX_JOINTS, StepRecord};
+use crate::record::{
+    Event, LimitCode, LimitEvent, MAX_CONTACTS, MAX_JOINTS, RetryEvent, StepRecord,
+};
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
 use fbd_contact::{ContactState, Trial, transition};
-use fbd_dynamics::{ContactEquation, History, advance, evaluate_next, prepare_step};
-use fbd_solver::NewtonSolver;
+use fbd_dynamics::{
+    ContactEquation, History, LimitEquation, LimitState, advance, evaluate_next, prepare_step,
+};
+use fbd_solver::{NewtonSolver, SolverError};
 
-/// Solves step `data.k` and advances the state to `k + 1`.
+/// Why one attempt at a step (whole or in substeps) failed; made into a
+/// [`SimError`] only when every retry has failed (no allocation before).
+#[derive(Clone, Copy, Debug)]
+enum Failure {
+    Newton(SolverError),
+    Cycle { residual: f64 },
+    NonFinite { residual: f64 },
+}
+
+impl Failure {
+    fn cause(self) -> &'static str {
+        match self {
+            Failure::Newton(_) => "newton",
+            Failure::Cycle { .. } => "cycle",
+            Failure::NonFinite { .. } => "non-finite",
+        }
+    }
+}
+
+/// Solves step `data.k` and advances the state to `k + 1`, retrying in
+/// substeps when the whole step cannot be solved (see the module docs).
 pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
-    let mech = &model.mech;
-    let dt = model.dt();
     let k = data.k;
-    let t = k as f64 * dt;
-    let nq = mech.layout().nq;
-
-    // 1–3. Kinematics and torques at k, predictor.
+    let t = k as f64 * model.dt();
+    save_grid(data);
     prepare(model, data);
+    let first = match solve(model, data) {
+        Ok((iterations, trials)) => {
+            let record = make_record(model, data, iterations, trials, model.dt());
+            accept(model, data, t);
+            data.k += 1;
+            return Ok(record);
+        }
+        Err(f) => f,
+    };
+    data.failed_trial.copy_from_slice(&data.trial);
+    data.failed_limits.copy_from_slice(&data.limit_trial);
+    let mut n = 2;
+    while n <= model.max_substeps {
+        match substeps(model, data, n) {
+            Ok(record) => {
+                data.retries.push(RetryEvent {
+                    t,
+                    step: k,
+                    substeps: n,
+                    cause: first.cause(),
+                });
+                data.k += 1;
+                return Ok(record);
+            }
+            Err(_) => {
+                restore_grid(model, data);
+                n *= 2;
+            }
+        }
+    }
+    Err(match first {
+        Failure::Newton(source) => SimError::Newton { step: k, t, source },
+        Failure::Cycle { residual } => SimError::Cycling {
+            step: k,
+            t,
+            states: describe_states(model, &data.failed_trial, &data.failed_limits),
+            residual,
+        },
+        Failure::NonFinite { residual } => SimError::NonFinite {
+            step: k,
+            t,
+            residual,
+        },
+    })
+}
+
+/// Stages 4–5: solves the current (sub)step until its contact and limit
+/// states are consistent. Returns the Newton iterations and the number of
+/// solves.
+fn solve(model: &Model, data: &mut Data) -> Result<(usize, usize), Failure> {
+    let nq = model.mech.layout().nq;
     let mut fallback_used = false;
     let mut newton_iterations = 0;
     let mut trials = 0;
     loop {
         trials += 1;
         let (mut sys, solver, z) = system(model, data);
-        let report = solver
-            .solve(&mut sys, z)
-            .map_err(|source| SimError::Newton { step: k, t, source })?;
+        let report = solver.solve(&mut sys, z).map_err(Failure::Newton)?;
         newton_iterations += report.iterations;
         if data.z.iter().any(|v| !v.is_finite()) {
-            return Err(SimError::NonFinite {
-                step: k,
-                t,
+            return Err(Failure::NonFinite {
                 residual: report.residual,
             });
         }
-        evaluate_next(mech, &mut data.fbd, &data.z[..nq]);
-        if !check_contacts(model, data) {
+        evaluate_next(&model.mech, &mut data.fbd, &data.z[..nq]);
+        if !check_states(model, data) {
             break;
         }
-        let mut key = states_key(&data.trial);
+        let mut key = states_key(data);
         if data.visited.contains(&key) && !fallback_used {
             fallback_used = true;
             if slide_flip_flops(data) {
                 data.visited.clear();
-                key = states_key(&data.trial);
+                key = states_key(data);
             }
         }
         if data.visited.contains(&key) {
-            return Err(SimError::Cycling {
-                step: k,
-                t,
-                states: describe_states(model, &data.trial),
+            return Err(Failure::Cycle {
                 residual: report.residual,
             });
         }
         data.visited.push(key);
     }
     data.newton_iterations += newton_iterations;
+    Ok((newton_iterations, trials))
+}
 
-    // 6. Accept.
-    let record = make_record(model, data, newton_iterations, trials);
+/// Stage 6: events (at time `t`, attributed to step `data.k`), the trial
+/// states become the accepted ones and `q[k+1]` the current configuration.
+fn accept(model: &Model, data: &mut Data, t: f64) {
+    let mech = &model.mech;
+    let k = data.k;
     for c in 0..mech.contacts.len() {
         let (from, to) = (data.states[c].code(), data.trial[c].code());
         if from != to {
@@ -91,13 +176,108 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
             });
         }
     }
+    for (l, &j) in mech.limits.iter().enumerate() {
+        let (from, to) = (
+            limit_code(&data.limit_states[l]),
+            limit_code(&data.limit_trial[l]),
+        );
+        if from != to {
+            data.limit_events.push(LimitEvent {
+                t,
+                step: k,
+                joint_index: j,
+                joint: model.limit_joint[l],
+                leg: model.limit_leg[l],
+                from,
+                to,
+            });
+        }
+    }
     data.states.copy_from_slice(&data.trial);
+    data.limit_states.copy_from_slice(&data.limit_trial);
     std::mem::swap(&mut data.q_prev2, &mut data.q_prev);
     data.q_prev.copy_from_slice(&data.q);
+    let nq = mech.layout().nq;
     data.q.copy_from_slice(&data.z[..nq]);
     advance(mech, &mut data.fbd);
-    data.k += 1;
-    Ok(record)
+}
+
+/// Keeps what a failed attempt may change, to start the retry from it.
+fn save_grid(data: &mut Data) {
+    data.grid_q.copy_from_slice(&data.q);
+    data.grid_q_prev.copy_from_slice(&data.q_prev);
+    data.grid_q_prev2.copy_from_slice(&data.q_prev2);
+    data.grid_states.copy_from_slice(&data.states);
+    data.grid_limits.copy_from_slice(&data.limit_states);
+    data.grid_events = [data.events.len(), data.limit_events.len()];
+}
+
+/// Back to the start of the step after a failed attempt in substeps.
+fn restore_grid(model: &Model, data: &mut Data) {
+    let chains = &model.mech.chains;
+    data.q.copy_from_slice(&data.grid_q);
+    data.q_prev.copy_from_slice(&data.grid_q_prev);
+    data.q_prev2.copy_from_slice(&data.grid_q_prev2);
+    data.states.copy_from_slice(&data.grid_states);
+    data.limit_states.copy_from_slice(&data.grid_limits);
+    data.events.truncate(data.grid_events[0]);
+    data.limit_events.truncate(data.grid_events[1]);
+    chains.eval_positions(&data.grid_q, &mut data.fbd.kin);
+    chains.eval_jacobians(&mut data.fbd.kin);
+    chains.eval_positions(&data.grid_q_prev, &mut data.fbd.kin_prev);
+}
+
+/// Step `data.k` as `n` substeps of `Δt/n` (see the module docs). The
+/// record is that of the first substep (forces at `t_k`), with the
+/// iterations and solves of all of them.
+fn substeps(model: &Model, data: &mut Data, n: usize) -> Result<StepRecord, Failure> {
+    let mech = &model.mech;
+    let nq = mech.layout().nq;
+    let h = model.dt() / n as f64;
+    let k = data.k;
+    let t = k as f64 * model.dt();
+    let mut record = None;
+    for i in 0..n {
+        let history = if k == 0 && i == 0 {
+            History::Initial {
+                qdot: &model.params.qdot0,
+            }
+        } else {
+            History::Previous
+        };
+        if i == 0 && k > 0 {
+            // The previous configuration at t_k − h, on the line q[k−1] → q[k].
+            for j in 0..nq {
+                data.q_prev[j] = data.q[j] - (data.q[j] - data.grid_q_prev[j]) / n as f64;
+            }
+            mech.chains
+                .eval_positions(&data.q_prev, &mut data.fbd.kin_prev);
+        }
+        prepare_step(mech, &mut data.fbd, history, h);
+        for j in 0..nq {
+            data.z[j] = if k == 0 && i == 0 {
+                data.q[j] + h * model.params.qdot0[j]
+            } else {
+                2.0 * data.q[j] - data.q_prev[j]
+            };
+        }
+        start_search(data);
+        let (iterations, trials) = solve(model, data)?;
+        match record.as_mut() {
+            None => record = Some(make_record(model, data, iterations, trials, h)),
+            Some(r) => {
+                r.newton_iterations += iterations;
+                r.state_trials += trials;
+            }
+        }
+        accept(model, data, t + i as f64 * h);
+    }
+    // Back on the grid: the next full step continues from q[k] and q[k+1].
+    data.q_prev.copy_from_slice(&data.grid_q);
+    data.q_prev2.copy_from_slice(&data.grid_q_prev);
+    mech.chains
+        .eval_positions(&data.grid_q, &mut data.fbd.kin_prev);
+    Ok(record.expect("at least two substeps"))
 }
 
 /// The cycle fallback of stage 5: every point that was solved in both ST1
@@ -119,8 +299,8 @@ fn slide_flip_flops(data: &mut Data) -> bool {
 
 /// Stages 1–3 of [`step`]: the per-body constants of step `data.k` and the
 /// predictor of `q[k+1]` in `data.z` (the forces keep the last solution);
-/// the trial contact states start from the accepted ones. Public for
-/// benchmarks, which time the stages one by one.
+/// the trial contact and limit states start from the accepted ones. Public
+/// for benchmarks, which time the stages one by one.
 pub fn prepare(model: &Model, data: &mut Data) {
     let mech = &model.mech;
     let dt = model.dt();
@@ -148,20 +328,34 @@ pub fn prepare(model: &Model, data: &mut Data) {
             _ => 3.0 * (data.q[i] - data.q_prev[i]) + data.q_prev2[i],
         };
     }
+    start_search(data);
+}
+
+/// The state search starts from the accepted states.
+fn start_search(data: &mut Data) {
     data.trial.copy_from_slice(&data.states);
+    data.limit_trial.copy_from_slice(&data.limit_states);
     data.visited.clear();
-    data.visited.push(states_key(&data.trial));
+    let key = states_key(data);
+    data.visited.push(key);
     data.seen.fill(0);
 }
 
-/// Stage 4's inputs for the current trial states (contact equations, row
-/// scales), split from `data`: the step's [`NewtonSystem`](fbd_solver::NewtonSystem),
-/// the solver and the unknowns `z`. Public for benchmarks.
+/// Stage 4's inputs for the current trial states (contact and limit
+/// equations, row scales), split from `data`: the step's
+/// [`NewtonSystem`](fbd_solver::NewtonSystem), the solver and the unknowns
+/// `z`. Public for benchmarks.
 pub fn system<'a>(
     model: &'a Model,
     data: &'a mut Data,
 ) -> (StepSystem<'a>, &'a mut NewtonSolver, &'a mut [f64]) {
     set_contact_equations(model, data);
+    for (eq, &state) in data.fbd.limit.iter_mut().zip(&data.limit_trial) {
+        *eq = LimitEquation {
+            state,
+            regularization: model.contact.regularization,
+        };
+    }
     row_scales(
         &model.mech,
         &data.fbd,
@@ -193,22 +387,28 @@ fn set_contact_equations(model: &Model, data: &mut Data) {
             tangent,
             normal,
             mu_dynamic: model.params.friction.mu_dynamic,
-            regularization: model.contact.regularization
-                + model.contact_compliance[c] * data.fbd.position_gain,
+            regularization: model.contact.regularization + model.contact_bumper[c],
         };
     }
 }
 
+/// A joint whose trial angle is beyond an end by more than this (rad)
+/// reaches the limit: far below any physical scale, above round-off.
+const LIMIT_ANGLE_TOL: f64 = 1e-10;
+
 /// Applies the switching rules to the trial solution; `true` if any point
-/// switched. Every touchdown (ST1 → ST2) is applied at once: a point that
-/// penetrates must carry a force. Of the other switches — lift-off, the
-/// start or end of a slide — only the most violated one is applied before
-/// re-solving, since one of them changes the forces on all the others (at an
-/// impact of several points, switching them all together chases its tail):
-/// lift-offs first (most negative `N`), then slips (largest `|Fa| − μS·N`),
-/// then slide reversals.
-fn check_contacts(model: &Model, data: &mut Data) -> bool {
+/// or joint limit switched. Every touchdown (ST1 → ST2) and every joint
+/// reaching a limit is applied at once: a point that penetrates must carry
+/// a force, a joint past its end must be stopped. Of the other switches —
+/// lift-off, limit release, the start or end of a slide — only the most
+/// violated one is applied before re-solving, since one of them changes
+/// the forces on all the others (at an impact of several points, switching
+/// them all together chases its tail): lift-offs and releases first (most
+/// negative `N`, or stop moment over the length scale), then slips
+/// (largest `|Fa| − μS·N`), then slide reversals.
+fn check_states(model: &Model, data: &mut Data) -> bool {
     let lay = model.mech.layout();
+    let dt = data.fbd.dt;
     let mut touchdown = false;
     let mut best: Option<(usize, ContactState, f64)> = None;
     for (c, spec) in model.mech.contacts.iter().enumerate() {
@@ -219,7 +419,7 @@ fn check_contacts(model: &Model, data: &mut Data) -> bool {
             fa: data.z[lay.contact_fa(c)],
             n: data.z[lay.contact_n(c)],
             tangent: eq.tangent,
-            dt: model.dt(),
+            dt,
         };
         data.seen[c] |= 1 << data.trial[c].key().min(2);
         if matches!(data.trial[c], ContactState::Stick { .. }) {
@@ -261,7 +461,47 @@ fn check_contacts(model: &Model, data: &mut Data) -> bool {
             best = Some((c, next, priority));
         }
     }
+    // Joint limits: arrivals at once, a release competes with lift-offs.
+    let length = model.mech.length_scale();
+    let mut release: Option<(usize, f64)> = None;
+    for (l, &j) in model.mech.limits.iter().enumerate() {
+        let angle = data.z[model.mech.joints[j].q_index];
+        let joint = model.limit_joint[l];
+        match data.limit_trial[l] {
+            LimitState::Free => {
+                let limits = &model.params.joint_limits;
+                let side = limits
+                    .violated(joint, angle - LIMIT_ANGLE_TOL)
+                    .and(limits.violated(joint, angle + LIMIT_ANGLE_TOL));
+                if let Some(side) = side {
+                    data.limit_trial[l] = LimitState::At {
+                        side,
+                        angle: limits.end(joint, side),
+                    };
+                    touchdown = true;
+                }
+            }
+            LimitState::At { side, .. } => {
+                // The stop's moment, as a force at the length scale; it
+                // must push away from the end.
+                let push = side.sign() * data.z[lay.limit_moment(l)] / length;
+                if push < -model.contact.force_tol {
+                    let priority = 2e12 - push;
+                    let beats_contact = best.is_none_or(|b| priority > b.2);
+                    if beats_contact && release.is_none_or(|r| priority > r.1) {
+                        release = Some((l, priority));
+                    }
+                }
+            }
+        }
+    }
     if !touchdown {
+        if let Some((l, priority)) = release
+            && best.is_none_or(|b| priority > b.2)
+        {
+            data.limit_trial[l] = LimitState::Free;
+            return true;
+        }
         let Some((c, next, _)) = best else {
             return false;
         };
@@ -323,19 +563,36 @@ fn rigid_anchors(model: &Model, data: &mut Data) {
     }
 }
 
-fn states_key(states: &[ContactState]) -> u64 {
-    states.iter().fold(0, |k, s| k * 4 + s.key())
+/// The trial states of contacts (4 each, with the slide direction) and
+/// joint limits (3 each) as one number, for cycle detection.
+fn states_key(data: &Data) -> u64 {
+    let k = data.trial.iter().fold(0, |k, s| k * 4 + s.key());
+    data.limit_trial.iter().fold(k, |k, s| k * 3 + s.key())
 }
 
-fn describe_states(model: &Model, states: &[ContactState]) -> String {
-    model
+fn limit_code(s: &LimitState) -> LimitCode {
+    match s.key() {
+        0 => LimitCode::Free,
+        1 => LimitCode::Min,
+        _ => LimitCode::Max,
+    }
+}
+
+fn describe_states(model: &Model, states: &[ContactState], limits: &[LimitState]) -> String {
+    let mut parts: Vec<String> = model
         .mech
         .contacts
         .iter()
         .zip(states)
         .map(|(c, s)| format!("{}={}", c.name, s.code()))
-        .collect::<Vec<_>>()
-        .join(" ")
+        .collect();
+    for (l, s) in limits.iter().enumerate() {
+        if s.is_at() {
+            let j = &model.mech.joints[model.mech.limits[l]];
+            parts.push(format!("{}={}", j.name, limit_code(s).as_str()));
+        }
+    }
+    parts.join(" ")
 }
 
 fn make_record(
@@ -343,6 +600,7 @@ fn make_record(
     data: &Data,
     newton_iterations: usize,
     state_trials: usize,
+    h: f64,
 ) -> StepRecord {
     let mech = &model.mech;
     let lay = mech.layout();
@@ -362,10 +620,16 @@ fn make_record(
         r.joint_force[j] = [data.z[lay.joint_force(j, 0)], data.z[lay.joint_force(j, 1)]];
         r.torque[j] = data.fbd.torque[j];
     }
+    for (l, &j) in mech.limits.iter().enumerate() {
+        if j < MAX_JOINTS {
+            r.limit[j] = limit_code(&data.limit_trial[l]);
+            r.limit_moment[j] = data.z[lay.limit_moment(l)];
+        }
+    }
     r.kinetic = if data.k == 0 {
         energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)
     } else {
-        energy::kinetic_central(mech, &data.fbd.kin_prev, &data.fbd.kin_next, model.dt())
+        energy::kinetic_central(mech, &data.fbd.kin_prev, &data.fbd.kin_next, h)
     };
     r
 }

@@ -72,4 +72,8 @@ pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, extent: f64, scales: &
         scales[row] = s0;
         scales[row + 1] = s1;
     }
+    // A joint-limit row is a moment, free (λ) or at an end (Kθ·δθ).
+    for l in 0..lay.limits {
+        scales[lay.limit_row(l)] = moment;
+    }
 }

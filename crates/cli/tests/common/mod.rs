@@ -12,6 +12,15 @@ pub fn fbd(args: &[&str]) -> Output {
         .expect("the fbd binary runs")
 }
 
+/// Runs the real `fbd` binary with `args` in the working directory `dir`.
+pub fn fbd_in(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_fbd"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("the fbd binary runs")
+}
+
 /// The repository's `examples/` directory.
 pub fn examples() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples")
@@ -44,7 +53,16 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     p
 }
 
-/// The reference failing experiment: the paper's model (contact at the feet
-/// only) run to 1 s. Its body falls through the floor, a leg straightens and
-/// Newton diverges, deterministically at step 49 (t = 0.49 s).
-pub const FAILS_AT_STEP_49: &str = "[time]\nduration = 1.0\n[contact]\npoints = [\"tips\"]\n";
+/// The reference failing experiment: the robot dropped from 20 m with a
+/// time step of 0.2 s, far too large for its links (they swing on a time
+/// scale of 0.21 s). It falls freely, and the step of the landing cannot be
+/// solved: deterministically at step [`FAIL_STEP`] (t = 2.2 s).
+pub const FAILS: &str = "[time]\ndt = 0.2\nduration = 4.0\n[initial]\nposition = [0.0, 20.0]\n";
+
+/// The step at which [`FAILS`] stops.
+pub const FAIL_STEP: usize = 11;
+
+/// `"step 11 (t = 2.2"`: how the error of [`FAILS`] starts.
+pub fn fail_prefix() -> String {
+    format!("step {FAIL_STEP} (t = {:.1}", FAIL_STEP as f64 * 0.2)
+}

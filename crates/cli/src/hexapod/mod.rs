@@ -1,0 +1,474 @@
+//! `fbd run` of a hexapod configuration: the kinematic gait (or a standing
+//! run without `[gait]`), writing `trajectory.csv`, `events.csv`,
+//! `summary.json`, `config.toml`, `gait.svg`, `footprints.svg` and
+//! `joints.svg`.
+
+mod plots;
+
+use std::collections::BTreeMap;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use fbd_sim::gait::{GaitData, GaitEvent, GaitModel, GaitSummary, LEGS, run_gait};
+use serde::Serialize;
+use tempfile::NamedTempFile;
+
+use crate::CliError;
+use crate::config::{Config, HexapodConfig};
+use crate::output;
+use crate::steptime::StepTimes;
+
+pub use plots::{GaitPlotData, footprints_svg, gait_svg, joints_svg};
+
+/// The files a hexapod run writes, in order.
+pub const FILES: [&str; 7] = [
+    "trajectory.csv",
+    "events.csv",
+    "summary.json",
+    "config.toml",
+    "gait.svg",
+    "footprints.svg",
+    "joints.svg",
+];
+
+/// The columns of the hexapod `trajectory.csv`, in order: `t`, the body
+/// pose `rx, ry, rz, phi_x, phi_y, phi_z`, `theta{j}_{n}`, `omega{j}_{n}`,
+/// `alpha{j}_{n}` (joint j = 1..3 of leg n = 1..6, leg by leg),
+/// `foot{n}_x, foot{n}_y, foot{n}_z`, `stance{n}`, `com_x, com_y, com_z`,
+/// `margin`.
+pub fn columns() -> Vec<String> {
+    let mut c: Vec<String> = ["t", "rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
+        .iter()
+        .map(|s| (*s).to_owned())
+        .collect();
+    for q in ["theta", "omega", "alpha"] {
+        for n in 1..=LEGS {
+            for j in 1..=3 {
+                c.push(format!("{q}{j}_{n}"));
+            }
+        }
+    }
+    for n in 1..=LEGS {
+        for a in ["x", "y", "z"] {
+            c.push(format!("foot{n}_{a}"));
+        }
+    }
+    for n in 1..=LEGS {
+        c.push(format!("stance{n}"));
+    }
+    c.extend(["com_x", "com_y", "com_z", "margin"].map(str::to_owned));
+    c
+}
+
+/// Streams the hexapod `trajectory.csv` into a temporary file.
+struct Writer {
+    out: BufWriter<NamedTempFile>,
+    dest: PathBuf,
+    times: StepTimes,
+    error: Option<std::io::Error>,
+    rows: usize,
+}
+
+impl Writer {
+    fn create(dir: &Path, dt: f64) -> Result<Self, CliError> {
+        let tmp = output::temp_in(dir, "trajectory.csv")?;
+        let mut w = Self {
+            out: BufWriter::with_capacity(1 << 16, tmp),
+            dest: dir.join("trajectory.csv"),
+            times: StepTimes::new(dt),
+            error: None,
+            rows: 0,
+        };
+        let header = columns().join(",");
+        if let Err(e) = writeln!(w.out, "{header}") {
+            w.error = Some(e);
+        }
+        Ok(w)
+    }
+
+    fn row(&mut self, d: &GaitData) -> std::io::Result<()> {
+        let mut b = ryu::Buffer::new();
+        let out = &mut self.out;
+        self.times.write(out, d.step, d.t)?;
+        let mut num = |out: &mut BufWriter<NamedTempFile>, v: f64| -> std::io::Result<()> {
+            out.write_all(b",")?;
+            out.write_all(b.format(v).as_bytes())
+        };
+        let body = &d.body;
+        for v in [
+            body.position.x,
+            body.position.y,
+            body.position.z,
+            body.phi.x,
+            body.phi.y,
+            body.phi.z,
+        ] {
+            num(out, v)?;
+        }
+        for l in &d.legs {
+            for v in l.theta {
+                num(out, v)?;
+            }
+        }
+        for l in &d.legs {
+            for v in l.rate {
+                num(out, v)?;
+            }
+        }
+        for l in &d.legs {
+            for v in l.accel {
+                num(out, v)?;
+            }
+        }
+        for l in &d.fk.legs {
+            for v in [l.tip.x, l.tip.y, l.tip.z] {
+                num(out, v)?;
+            }
+        }
+        for s in d.stance() {
+            out.write_all(if s { b",1" } else { b",0" })?;
+        }
+        for v in [d.com.x, d.com.y, d.com.z, d.margin] {
+            num(out, v)?;
+        }
+        out.write_all(b"\n")
+    }
+
+    fn write(&mut self, d: &GaitData) {
+        if self.error.is_none() {
+            match self.row(d) {
+                Ok(()) => self.rows += 1,
+                Err(e) => self.error = Some(e),
+            }
+        }
+    }
+
+    fn finish(self) -> Result<PathBuf, CliError> {
+        if let Some(e) = self.error {
+            return Err(CliError::io(self.dest.display(), &e));
+        }
+        let tmp = self
+            .out
+            .into_inner()
+            .map_err(|e| CliError::io(self.dest.display(), e.error()))?;
+        output::persist(tmp, &self.dest)?;
+        Ok(self.dest)
+    }
+}
+
+/// `events.csv` of a hexapod run: `t, leg, event, margin` (`leg` empty for
+/// the stability events).
+pub fn events_csv(events: &[GaitEvent]) -> String {
+    let mut s = String::from("t,leg,event,margin\n");
+    let mut b = ryu::Buffer::new();
+    for e in events {
+        s.push_str(b.format(e.t));
+        s.push(',');
+        if let Some(l) = e.leg {
+            s.push_str(&l.to_string());
+        }
+        s.push(',');
+        s.push_str(e.kind.as_str());
+        s.push(',');
+        s.push_str(b.format(e.margin));
+        s.push('\n');
+    }
+    s
+}
+
+/// A figure with its time.
+#[derive(Clone, Debug, Serialize)]
+pub struct AtTime {
+    /// The value.
+    pub value: f64,
+    /// When (s).
+    pub t: f64,
+}
+
+/// One event in `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct EventJson {
+    /// Time (s).
+    pub t: f64,
+    /// Leg number (null for stability events).
+    pub leg: Option<usize>,
+    /// `liftoff`, `touchdown`, `margin_low`, `margin_recovered`.
+    pub event: &'static str,
+    /// Stability margin at the event (m).
+    pub margin: Option<f64>,
+}
+
+/// `summary.json` of a hexapod run.
+#[derive(Clone, Debug, Serialize)]
+pub struct HexapodSummary {
+    /// `ok`, `error` or `interrupted`.
+    pub status: &'static str,
+    /// The error message, if any.
+    pub error: Option<String>,
+    /// `hexapod`.
+    pub model: &'static str,
+    /// `walking` or `standing`.
+    pub run: &'static str,
+    /// Steps computed.
+    pub steps: usize,
+    /// Always 0: the kinematic gait solves no equations iteratively.
+    pub newton_iterations: usize,
+    /// Wall time of the stepping loop (s).
+    pub wall_seconds: f64,
+    /// Steps per second of wall time.
+    pub steps_per_second: Option<f64>,
+    /// Time step (s).
+    pub dt: f64,
+    /// Configured duration (s).
+    pub duration: f64,
+    /// Steps planned (rows at `k·Δt`, `k = 0..=steps_planned`).
+    pub steps_planned: usize,
+    /// Rows written to `trajectory.csv`.
+    pub rows_written: usize,
+    /// `output.stride`.
+    pub stride: usize,
+    /// Horizontal path length of the body centre (m).
+    pub distance: f64,
+    /// Net horizontal displacement of the body centre (m).
+    pub displacement: f64,
+    /// Mean horizontal speed (m/s).
+    pub mean_speed: f64,
+    /// Heading change (deg).
+    pub heading_change_deg: f64,
+    /// Smallest stability margin (m) and when.
+    pub min_margin: Option<AtTime>,
+    /// Largest |θ̇| of every joint, `theta{j}_{n}` (rad/s).
+    pub peak_joint_rate: BTreeMap<String, f64>,
+    /// Largest |θ̈| of every joint (rad/s²).
+    pub peak_joint_acceleration: BTreeMap<String, f64>,
+    /// Largest |θ̇| over all joints (rad/s).
+    pub peak_joint_rate_max: f64,
+    /// Largest |θ̈| over all joints (rad/s²).
+    pub peak_joint_acceleration_max: f64,
+    /// Lift-off, touchdown and stability events.
+    pub events: Vec<EventJson>,
+}
+
+fn finite(v: f64) -> Option<f64> {
+    v.is_finite().then_some(v)
+}
+
+fn summary(model: &GaitModel, stride: usize, rows: usize, s: &GaitSummary) -> HexapodSummary {
+    let per_joint = |p: &[[f64; 3]; LEGS]| -> BTreeMap<String, f64> {
+        let mut m = BTreeMap::new();
+        for (n, leg) in p.iter().enumerate() {
+            for (j, v) in leg.iter().enumerate() {
+                m.insert(format!("theta{}_{}", j + 1, n + 1), *v);
+            }
+        }
+        m
+    };
+    let max = |p: &[[f64; 3]; LEGS]| p.iter().flatten().copied().fold(0.0, f64::max);
+    HexapodSummary {
+        status: if s.error.is_some() {
+            "error"
+        } else if s.interrupted {
+            "interrupted"
+        } else {
+            "ok"
+        },
+        error: s.error.as_ref().map(ToString::to_string),
+        model: "hexapod",
+        run: if model.params.walking {
+            "walking"
+        } else {
+            "standing"
+        },
+        steps: s.steps,
+        newton_iterations: 0,
+        wall_seconds: s.wall_seconds,
+        steps_per_second: (s.wall_seconds > 0.0).then(|| s.steps as f64 / s.wall_seconds),
+        dt: model.dt,
+        duration: model.steps as f64 * model.dt,
+        steps_planned: model.steps,
+        rows_written: rows,
+        stride,
+        distance: s.distance,
+        displacement: s.displacement,
+        mean_speed: s.mean_speed(),
+        heading_change_deg: s.heading_change.to_degrees(),
+        min_margin: s
+            .min_margin
+            .and_then(|(v, t)| finite(v).map(|value| AtTime { value, t })),
+        peak_joint_rate: per_joint(&s.peak_rate),
+        peak_joint_acceleration: per_joint(&s.peak_accel),
+        peak_joint_rate_max: max(&s.peak_rate),
+        peak_joint_acceleration_max: max(&s.peak_accel),
+        events: s
+            .events
+            .iter()
+            .map(|e| EventJson {
+                t: e.t,
+                leg: e.leg,
+                event: e.kind.as_str(),
+                margin: finite(e.margin),
+            })
+            .collect(),
+    }
+}
+
+/// What a hexapod run produced.
+pub struct HexapodRun {
+    /// The library's summary.
+    pub run: GaitSummary,
+    /// `summary.json`'s content.
+    pub summary: HexapodSummary,
+    /// The first file that could not be written, if any.
+    pub io_error: Option<CliError>,
+}
+
+/// Runs the hexapod configuration `h` (`config` is the same, for
+/// `config.toml`) and writes every file to `out_dir`, even after a run
+/// error (which is in `run.error`).
+pub fn simulate(
+    h: &HexapodConfig,
+    config: &Config,
+    source: &str,
+    out_dir: &Path,
+    stop: &AtomicBool,
+) -> Result<HexapodRun, CliError> {
+    let model = h.gait_model(source)?;
+    output::prepare_dir(out_dir)?;
+    let stride = h.output.stride.max(1);
+    let mut traj = Writer::create(out_dir, model.dt)?;
+    let mut plot = GaitPlotData::new(&model);
+    let run = run_gait(&model, stop, |d: &GaitData| {
+        if d.step.is_multiple_of(stride) {
+            traj.write(d);
+        }
+        plot.push(d);
+    });
+    let rows = traj.rows;
+    let mut io_error: Option<CliError> = None;
+    let mut keep = |r: Result<PathBuf, CliError>| {
+        if let Err(e) = r
+            && io_error.is_none()
+        {
+            io_error = Some(e);
+        }
+    };
+    keep(traj.finish());
+    keep(output::write_file(
+        out_dir,
+        "events.csv",
+        events_csv(&run.events).as_bytes(),
+    ));
+    let s = summary(&model, stride, rows, &run);
+    let json =
+        serde_json::to_string_pretty(&s).map_err(|e| CliError::Io(format!("summary.json: {e}")));
+    keep(json.and_then(|j| {
+        output::write_file(out_dir, "summary.json", format!("{j}\n").as_bytes())
+    }));
+    keep(output::write_file(
+        out_dir,
+        "config.toml",
+        config.to_toml().as_bytes(),
+    ));
+    for (name, svg) in [
+        ("gait.svg", gait_svg(&plot)),
+        ("footprints.svg", footprints_svg(&plot)),
+        ("joints.svg", joints_svg(&plot)),
+    ] {
+        keep(
+            svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
+                .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
+        );
+    }
+    Ok(HexapodRun {
+        run,
+        summary: s,
+        io_error,
+    })
+}
+
+/// `fbd run` of a hexapod configuration: simulates, writes the files,
+/// prints the stability warnings, distance, speed and minimum margin.
+pub fn run_command(
+    h: &HexapodConfig,
+    config: &Config,
+    source: &str,
+    out_dir: &Path,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let HexapodRun {
+        run,
+        summary,
+        io_error,
+    } = simulate(h, config, source, out_dir, crate::interrupt::flag())?;
+    let mut text = String::new();
+    for e in run.events.iter().filter(|e| e.leg.is_none()) {
+        text.push_str(&format!(
+            "t={} s  stability margin {:.4} m {}\n",
+            fbd_sim::gait::error::fmt_time(e.t),
+            e.margin,
+            if e.kind == fbd_sim::gait::GaitEventKind::MarginLow {
+                "below the warning threshold"
+            } else {
+                "back above the warning threshold"
+            }
+        ));
+    }
+    let liftoffs = run
+        .events
+        .iter()
+        .filter(|e| e.kind == fbd_sim::gait::GaitEventKind::Liftoff)
+        .count();
+    text.push_str(&format!(
+        "{} {} ({} s, {} lift-offs), {:.3} s\n",
+        if run.error.is_some() || run.interrupted {
+            "stopped after"
+        } else {
+            "computed"
+        },
+        output::count(run.steps, "step", "steps"),
+        fbd_sim::gait::error::fmt_time(run.time),
+        liftoffs,
+        run.wall_seconds
+    ));
+    text.push_str(&format!(
+        "distance walked {:.4} m (net {:.4} m, heading change {:.2}°), mean speed {:.4} m/s\n",
+        summary.distance, summary.displacement, summary.heading_change_deg, summary.mean_speed
+    ));
+    match &summary.min_margin {
+        Some(m) => text.push_str(&format!(
+            "minimum stability margin {:.4} m at t = {} s\n",
+            m.value,
+            fbd_sim::gait::error::fmt_time(m.t)
+        )),
+        None => text.push_str("minimum stability margin: no support polygon\n"),
+    }
+    if io_error.is_none() {
+        text.push_str(&format!(
+            "files in {}: {}\n",
+            out_dir.display(),
+            FILES.join(" ")
+        ));
+    }
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(CliError::stdout)?;
+    if let Some(e) = io_error {
+        return Err(e);
+    }
+    if let Some(e) = &run.error {
+        return Err(CliError::Simulation(format!(
+            "{e} ({source}; the steps computed so far are in {})",
+            out_dir.display()
+        )));
+    }
+    if run.interrupted {
+        return Err(CliError::Interrupted(format!(
+            "interrupted after {} steps (t = {} s); the steps computed so far are in {}",
+            run.steps,
+            fbd_sim::gait::error::fmt_time(run.time),
+            out_dir.display()
+        )));
+    }
+    Ok(())
+}

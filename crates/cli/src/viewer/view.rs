@@ -1,0 +1,327 @@
+//! `fbd view DIR`: (re)writes `DIR/viewer.html` of an existing output
+//! folder from `DIR/config.toml`, `DIR/trajectory.csv` and, for the planar
+//! model, `DIR/events.csv`. The page is the one `fbd run` writes.
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use fbd_contact::StateCode;
+use fbd_kinematics::body::LEG_COUNT;
+use fbd_kinematics::hexapod::{HexapodModel, NQ};
+use fbd_kinematics::leg::LegGeometry;
+use fbd_sim::{Event, Model, StepRecord};
+
+use super::hexapod::{HexFrame, HexapodScene};
+use super::planar::PlanarScene;
+use crate::CliError;
+use crate::config::{self, Config, HexapodConfig};
+
+/// The columns of a `trajectory.csv`, by name.
+struct Table {
+    file: PathBuf,
+    columns: HashMap<String, usize>,
+    rows: Vec<csv::StringRecord>,
+}
+
+impl Table {
+    fn read(file: &Path) -> Result<Self, CliError> {
+        let mut reader = csv::Reader::from_path(file)
+            .map_err(|e| CliError::Io(format!("{}: {e}", file.display())))?;
+        let columns = reader
+            .headers()
+            .map_err(|e| CliError::Io(format!("{}: {e}", file.display())))?
+            .iter()
+            .enumerate()
+            .map(|(i, h)| (h.to_owned(), i))
+            .collect();
+        let rows = reader
+            .records()
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(|e| CliError::Io(format!("{}: {e}", file.display())))?;
+        Ok(Self {
+            file: file.to_owned(),
+            columns,
+            rows,
+        })
+    }
+
+    fn column(&self, name: &str) -> Result<usize, CliError> {
+        self.columns.get(name).copied().ok_or_else(|| {
+            CliError::Io(format!(
+                "{}: no column `{name}` (was it written by `fbd run` of this configuration?)",
+                self.file.display()
+            ))
+        })
+    }
+
+    fn number(&self, row: &csv::StringRecord, r: usize, c: usize) -> Result<f64, CliError> {
+        let s = cell(row, c).trim();
+        s.parse::<f64>().map_err(|_| {
+            CliError::Io(format!(
+                "{}: line {}: `{s}` is not a number",
+                self.file.display(),
+                r + 2
+            ))
+        })
+    }
+}
+
+/// Field `c` of `row` (empty when missing).
+fn cell(row: &csv::StringRecord, c: usize) -> &str {
+    row.get(c).unwrap_or("")
+}
+
+fn state(s: &str) -> Option<StateCode> {
+    match s.trim() {
+        "ST1" => Some(StateCode::St1),
+        "ST2" => Some(StateCode::St2),
+        "ST3" => Some(StateCode::St3),
+        _ => None,
+    }
+}
+
+/// Contact columns of a point: `state3, fa3, n3` for the tips (SPEC's
+/// names), `knee3_state, knee3_fa, knee3_n` for the others.
+fn contact_columns(name: &str) -> [String; 3] {
+    match name.strip_prefix("tip") {
+        Some(leg) => [format!("state{leg}"), format!("fa{leg}"), format!("n{leg}")],
+        None => [
+            format!("{name}_state"),
+            format!("{name}_fa"),
+            format!("{name}_n"),
+        ],
+    }
+}
+
+/// The step records of a planar run's `trajectory.csv`.
+fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliError> {
+    let q_cols = [
+        "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4",
+    ]
+    .map(|c| table.column(c));
+    let q_cols: Vec<usize> = q_cols.into_iter().collect::<Result<_, _>>()?;
+    let t_col = table.column("t")?;
+    let contacts: Vec<[usize; 3]> = model
+        .mech
+        .contacts
+        .iter()
+        .map(|c| {
+            let [s, fa, n] = contact_columns(&c.name);
+            Ok([table.column(&s)?, table.column(&fa)?, table.column(&n)?])
+        })
+        .collect::<Result<_, CliError>>()?;
+    let joints: Vec<[usize; 3]> = model
+        .mech
+        .joints
+        .iter()
+        .map(|j| {
+            Ok([
+                table.column(&format!("{}_fx", j.name))?,
+                table.column(&format!("{}_fy", j.name))?,
+                table.column(&format!("tau_{}", j.name))?,
+            ])
+        })
+        .collect::<Result<_, CliError>>()?;
+    let (kin, pot) = (table.column("kinetic")?, table.column("potential")?);
+    let mut out = Vec::with_capacity(table.rows.len());
+    for (r, row) in table.rows.iter().enumerate() {
+        let t = table.number(row, r, t_col)?;
+        let mut rec = StepRecord::zeroed(r, t, contacts.len());
+        for (k, &c) in q_cols.iter().enumerate() {
+            rec.q[k] = table.number(row, r, c)?;
+        }
+        for (c, cols) in contacts.iter().enumerate() {
+            let s = cell(row, cols[0]);
+            rec.state[c] = state(s).ok_or_else(|| {
+                CliError::Io(format!(
+                    "{}: line {}: `{s}` is not a contact state (ST1, ST2 or ST3)",
+                    table.file.display(),
+                    r + 2
+                ))
+            })?;
+            rec.fa[c] = table.number(row, r, cols[1])?;
+            rec.n[c] = table.number(row, r, cols[2])?;
+        }
+        for (j, cols) in joints.iter().enumerate() {
+            rec.joint_force[j] = [
+                table.number(row, r, cols[0])?,
+                table.number(row, r, cols[1])?,
+            ];
+            rec.torque[j] = table.number(row, r, cols[2])?;
+        }
+        rec.kinetic = table.number(row, r, kin)?;
+        rec.potential = table.number(row, r, pot)?;
+        out.push(rec);
+    }
+    Ok(out)
+}
+
+/// The events of `events.csv` (empty when the file is missing).
+fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, CliError> {
+    if !file.exists() {
+        return Ok(Vec::new());
+    }
+    let table = Table::read(file)?;
+    let cols = ["t", "leg", "from", "to", "point"].map(|c| table.column(c));
+    let [t, leg, from, to, point] = cols;
+    let (t, leg, from, to, point) = (t?, leg?, from?, to?, point?);
+    let mut out = Vec::with_capacity(table.rows.len());
+    for (r, row) in table.rows.iter().enumerate() {
+        let bad = |what: &str| {
+            CliError::Io(format!(
+                "{}: line {}: bad `{what}`",
+                table.file.display(),
+                r + 2
+            ))
+        };
+        let n = cell(row, leg).trim();
+        let kind = cell(row, point).trim();
+        // Joint-limit and retried-step rows are not contact events.
+        if kind.ends_with("_limit") || kind == "substeps" {
+            continue;
+        }
+        let name = format!("{kind}{n}");
+        let contact = model
+            .mech
+            .contacts
+            .iter()
+            .position(|c| c.name == name)
+            .ok_or_else(|| bad("point"))?;
+        out.push(Event {
+            t: table.number(row, r, t)?,
+            step: 0,
+            contact,
+            point: model.contact_point[contact],
+            leg: model.contact_leg[contact],
+            from: state(cell(row, from)).ok_or_else(|| bad("from"))?,
+            to: state(cell(row, to)).ok_or_else(|| bad("to"))?,
+        });
+    }
+    Ok(out)
+}
+
+/// The frames of a hexapod run's `trajectory.csv`: `t, rx, ry, rz, phi_x,
+/// phi_y, phi_z, theta{j}_{n}, stance{n}` and, when present, `com_x/y/z`
+/// and `margin`.
+pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
+    let table = Table::read(table_file)?;
+    let t_col = table.column("t")?;
+    let mut q_cols = Vec::with_capacity(NQ);
+    for c in ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"] {
+        q_cols.push(table.column(c)?);
+    }
+    for n in 1..=LEG_COUNT {
+        for j in 1..=3 {
+            q_cols.push(table.column(&format!("theta{j}_{n}"))?);
+        }
+    }
+    let stance: Vec<usize> = (1..=LEG_COUNT)
+        .map(|n| table.column(&format!("stance{n}")))
+        .collect::<Result<_, _>>()?;
+    let com: Option<Vec<usize>> = ["com_x", "com_y", "com_z"]
+        .iter()
+        .map(|c| table.columns.get(*c).copied())
+        .collect();
+    let margin = table.columns.get("margin").copied();
+    let mut out = Vec::with_capacity(table.rows.len());
+    for (r, row) in table.rows.iter().enumerate() {
+        let mut f = HexFrame {
+            t: table.number(row, r, t_col)?,
+            q: [0.0; NQ],
+            stance: [false; LEG_COUNT],
+            com: [f64::NAN; 3],
+            margin: None,
+        };
+        for (k, &c) in q_cols.iter().enumerate() {
+            f.q[k] = table.number(row, r, c)?;
+        }
+        for (leg, &c) in stance.iter().enumerate() {
+            let s = cell(row, c).trim();
+            f.stance[leg] = match s {
+                "1" | "true" | "ST2" | "ST3" => true,
+                "0" | "false" | "ST1" => false,
+                _ => {
+                    return Err(CliError::Io(format!(
+                        "{}: line {}: stance{} = `{s}`: expected 0 or 1",
+                        table.file.display(),
+                        r + 2,
+                        leg + 1
+                    )));
+                }
+            };
+        }
+        if let Some(c) = &com {
+            for k in 0..3 {
+                f.com[k] = table.number(row, r, c[k])?;
+            }
+        } else {
+            f.com = [f.q[0], f.q[1], f.q[2]];
+        }
+        if let Some(c) = margin {
+            let m = table.number(row, r, c)?;
+            f.margin = m.is_finite().then_some(m);
+        }
+        out.push(f);
+    }
+    Ok(out)
+}
+
+/// The geometry of a hexapod configuration.
+pub fn hexapod_model(c: &HexapodConfig) -> HexapodModel {
+    HexapodModel::new(
+        c.body.side,
+        LegGeometry {
+            a: c.leg.upper_length,
+            c: c.leg.lower_length,
+        },
+        c.leg.upper_com,
+        c.leg.lower_com,
+    )
+}
+
+/// Writes `dir/viewer.html` from the files of a finished run; returns its
+/// path.
+pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
+    if !dir.is_dir() {
+        return Err(CliError::Usage(format!(
+            "{}: not a directory (give the output folder of `fbd run`)",
+            dir.display()
+        )));
+    }
+    let config_file = dir.join("config.toml");
+    let config = config::load(&config_file)?;
+    let source = config_file.display().to_string();
+    let traj = dir.join("trajectory.csv");
+    let title = dir.display().to_string();
+    let scene = match &config {
+        Config::Planar(c) => {
+            let model = c.model(&source)?;
+            let table = Table::read(&traj)?;
+            let records = planar_records(&model, &table)?;
+            let events = planar_events(&model, &dir.join("events.csv"))?;
+            let mut scene = PlanarScene::new(&model, records.len(), &title);
+            for r in &records {
+                scene.push(r);
+            }
+            scene.finish(&events)
+        }
+        Config::Hexapod(c) => {
+            c.validate(&source)?;
+            let frames = hexapod_frames(&traj)?;
+            let mut scene =
+                HexapodScene::new(hexapod_model(c), c.terrain.terrain(), frames.len(), &title);
+            for f in &frames {
+                scene.push(f);
+            }
+            scene.finish()
+        }
+    };
+    super::write(dir, &scene)
+}
+
+/// `fbd view DIR`: writes `DIR/viewer.html` and prints its path.
+pub fn view_command(dir: &Path, out: &mut dyn Write) -> Result<(), CliError> {
+    let path = write_from_dir(dir)?;
+    writeln!(out, "{}", path.display()).map_err(CliError::stdout)
+}

@@ -1,0 +1,61 @@
+//! `fbd` without a command is `fbd run` of the built-in experiment: what
+//! `cargo run --release` does on a fresh clone.
+
+mod common;
+
+use common::{fbd_in, s};
+use fbd_cli::output::FILES;
+
+fn check_out(out: &std::path::Path, stdout: &str) {
+    for f in FILES {
+        assert!(out.join(f).is_file(), "{f} missing in {}", out.display());
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(summary["status"], "ok", "{summary}");
+    assert_eq!(summary["steps"], summary["steps_planned"]);
+    // The paper's first event: leg 4 touches down in the step from 0.19 s.
+    assert!(stdout.contains("t=0.19 s  leg 4  ST1 -> ST2"), "{stdout}");
+    let leftovers: Vec<_> = std::fs::read_dir(out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
+
+#[test]
+fn no_arguments_runs_the_default_experiment_into_out() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = fbd_in(dir.path(), &[]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    check_out(&dir.path().join("out"), &stdout);
+    // Nothing else is created in the working directory.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn out_without_a_command_names_the_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("elsewhere");
+    let o = fbd_in(dir.path(), &["--out", s(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    check_out(&out, &String::from_utf8_lossy(&o.stdout));
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn help_still_lists_the_commands() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = fbd_in(dir.path(), &["--help"]);
+    assert!(o.status.success());
+    let h = String::from_utf8_lossy(&o.stdout);
+    for cmd in ["run", "kinematics", "sweep"] {
+        assert!(h.contains(cmd), "{h}");
+    }
+    assert!(
+        !dir.path().join("out").exists(),
+        "--help ran the experiment"
+    );
+}

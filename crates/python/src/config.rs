@@ -1,0 +1,152 @@
+//! A configuration from Python: `None` (the built-in default experiment), a
+//! path (`str` or `os.PathLike`), a TOML string, or a dict with the keys of
+//! the files. Every form goes through [`fbd_scenario::parse_str`]: one
+//! validation for the CLI, Rust and Python.
+
+use std::path::PathBuf;
+
+use fbd_scenario::Config;
+use pyo3::exceptions::PyTypeError;
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyString};
+
+/// A loaded configuration and the name errors and files give it.
+pub struct Loaded {
+    /// The validated configuration.
+    pub config: Config,
+    /// The file name, `<string>`, `<dict>` or `the built-in default`.
+    pub source: String,
+    /// `true` when line and column numbers refer to text the user wrote
+    /// (not for a dict).
+    pub from_text: bool,
+}
+
+/// Name of a configuration given as a TOML string.
+pub const STRING_SOURCE: &str = "<string>";
+/// Name of a configuration given as a dict.
+pub const DICT_SOURCE: &str = "<dict>";
+
+/// `true` when a `str` argument is TOML text rather than a path: it has a
+/// line break, an `=` or a table header, or is empty (the default).
+fn is_toml_text(s: &str) -> bool {
+    s.trim().is_empty() || s.contains('\n') || s.contains('=') || s.trim_start().starts_with('[')
+}
+
+/// A Python value as a TOML value; `key` names it in errors.
+fn to_toml(v: &Bound<'_, PyAny>, key: &str) -> PyResult<toml::Value> {
+    if v.is_instance_of::<PyBool>() {
+        return Ok(toml::Value::Boolean(v.extract()?));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(toml::Value::Integer(v.extract()?));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(toml::Value::Float(v.extract()?));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(toml::Value::String(v.extract()?));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        return Ok(toml::Value::Table(to_table(d, key)?));
+    }
+    // NumPy scalars: integers have __index__, floats __float__.
+    if v.hasattr("__index__")? && !v.hasattr("__len__")? {
+        return Ok(toml::Value::Integer(
+            v.call_method0("__index__")?.extract()?,
+        ));
+    }
+    if v.hasattr("__float__")? && !v.hasattr("__len__")? {
+        return Ok(toml::Value::Float(v.call_method0("__float__")?.extract()?));
+    }
+    if let Ok(items) = v.try_iter() {
+        let mut out = Vec::new();
+        for (i, item) in items.enumerate() {
+            out.push(to_toml(&item?, &format!("{key}[{i}]"))?);
+        }
+        return Ok(toml::Value::Array(out));
+    }
+    Err(PyTypeError::new_err(format!(
+        "{key}: a {} cannot be a configuration value (expected a number, string, bool, list or dict)",
+        v.get_type().name()?
+    )))
+}
+
+fn to_table(d: &Bound<'_, PyDict>, prefix: &str) -> PyResult<toml::Table> {
+    let mut t = toml::Table::new();
+    for (k, v) in d.iter() {
+        let name: String = k.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{}: configuration keys must be strings",
+                if prefix.is_empty() { "<dict>" } else { prefix }
+            ))
+        })?;
+        let key = if prefix.is_empty() {
+            name.clone()
+        } else {
+            format!("{prefix}.{name}")
+        };
+        if v.is_none() {
+            continue;
+        }
+        t.insert(name, to_toml(&v, &key)?);
+    }
+    Ok(t)
+}
+
+/// Loads `config` (None, path, TOML text or dict) and validates it.
+pub fn load(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Loaded> {
+    let Some(obj) = config.filter(|c| !c.is_none()) else {
+        return Ok(Loaded {
+            config: Config::default(),
+            source: "the built-in default".into(),
+            from_text: true,
+        });
+    };
+    let err =
+        |e: fbd_scenario::ConfigError, from_text| crate::errors::config_error(py, &e, from_text);
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let text = toml::to_string(&to_table(d, "")?)
+            .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))?;
+        let config = fbd_scenario::parse_str(&text, DICT_SOURCE, &[]).map_err(|e| err(e, false))?;
+        return Ok(Loaded {
+            config,
+            source: DICT_SOURCE.into(),
+            from_text: false,
+        });
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        let s: String = s.extract()?;
+        if is_toml_text(&s) {
+            let config =
+                fbd_scenario::parse_str(&s, STRING_SOURCE, &[]).map_err(|e| err(e, true))?;
+            return Ok(Loaded {
+                config,
+                source: STRING_SOURCE.into(),
+                from_text: true,
+            });
+        }
+    }
+    let path: PathBuf = obj.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "config: expected a path, a TOML string or a dict, got a {}",
+            obj.get_type()
+                .name()
+                .map(|n| n.to_string())
+                .unwrap_or_default()
+        ))
+    })?;
+    let config = fbd_scenario::load(&path).map_err(|e| err(e, true))?;
+    Ok(Loaded {
+        config,
+        source: path.display().to_string(),
+        from_text: true,
+    })
+}
+
+/// `config_toml(config=None) -> str`: the complete configuration with every
+/// key, as `fbd run` writes it to `config.toml`.
+#[pyfunction]
+#[pyo3(signature = (config=None))]
+pub fn config_toml(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<String> {
+    crate::errors::guard(|| Ok(load(py, config)?.config.to_toml()))
+}

@@ -1,0 +1,49 @@
+"""Shared fixtures: the repository, the `fbd` CLI binary, temporary dirs."""
+
+from __future__ import annotations
+
+import os
+import pathlib
+import shutil
+import subprocess
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+EXAMPLES = ROOT / "examples"
+
+
+def _find_cli() -> pathlib.Path:
+    """The `fbd` binary: $FBD_BIN, else built with cargo (release)."""
+    env = os.environ.get("FBD_BIN")
+    if env:
+        return pathlib.Path(env)
+    target = pathlib.Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+    subprocess.run(
+        ["cargo", "build", "--release", "-q", "-p", "fbd-cli", "--bin", "fbd"],
+        cwd=ROOT,
+        check=True,
+    )
+    return target / "release" / "fbd"
+
+
+@pytest.fixture(scope="session")
+def cli() -> pathlib.Path:
+    path = _find_cli()
+    assert path.is_file(), f"the fbd binary is missing: {path}"
+    return path
+
+
+@pytest.fixture(scope="session")
+def examples() -> pathlib.Path:
+    return EXAMPLES
+
+
+def run_cli(cli: pathlib.Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([str(cli), *args], capture_output=True, text=True)
+
+
+@pytest.fixture
+def tmp(tmp_path: pathlib.Path) -> pathlib.Path:
+    yield tmp_path
+    shutil.rmtree(tmp_path, ignore_errors=True)

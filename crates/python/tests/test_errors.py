@@ -1,0 +1,142 @@
+"""ConfigError names the file, line and key; SimulationError carries the
+step, the time and the partial result; no Rust panic reaches Python."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import fbd
+from conftest import run_cli
+
+# A failing experiment: an explicit PD controller far too stiff for its
+# time step (kp·Δt² ≫ the knee's inertia, no damping) makes the joints
+# oscillate with a growing amplitude until Newton's method fails; in the
+# air, so that no contact logic is involved.
+UNSTABLE_PD = """
+[time]
+duration = 1.0
+[terrain]
+kind = "none"
+[control]
+kind = "pd"
+kp = 5000.0
+kd = 0.0
+[control.leg3]
+target_deg = [1.0, 245.0]
+"""
+
+
+@pytest.mark.parametrize(
+    "config,key",
+    [
+        ({"time": {"dt": -0.01}}, "time.dt"),
+        ({"leg": {"upper_mass": 0.0}}, "leg.upper_mass"),
+        ({"terrain": {"mu_static": 0.2, "mu_dynamic": 0.3}}, "terrain.mu_dynamic"),
+        ("[time]\ndt = -1.0\n", "time.dt"),
+        ({"control": {"kind": "pd", "kp": -1.0}}, "control.kp"),
+    ],
+)
+def test_bad_values_raise_config_error_naming_the_key(config, key):
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.run(config)
+    e = info.value
+    assert e.key == key, str(e)
+    assert key in str(e)
+    assert isinstance(e, ValueError)
+
+
+def test_unknown_key_names_line_and_key():
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.run("[time]\ndt = 0.01\nduraton = 1.0\n")
+    e = info.value
+    assert e.file == "<string>"
+    assert e.line == 3, str(e)
+    assert "duraton" in str(e)
+    assert e.key is not None and e.key.startswith("time"), str(e)
+
+
+def test_syntax_error_in_a_file_names_file_and_line(tmp):
+    bad = tmp / "bad.toml"
+    bad.write_text("[time]\ndt = 0.01\nduration = = 1\n")
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.run(bad)
+    e = info.value
+    assert e.file == str(bad) and e.line == 3
+    assert str(e).startswith(f"{bad}:3:")
+
+
+def test_dict_errors_have_no_line_but_the_key():
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.run({"time": {"dt": "fast"}})
+    assert info.value.file == "<dict>" and info.value.line is None
+    assert info.value.key == "time.dt", str(info.value)
+
+
+def test_missing_file():
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.run("does/not/exist.toml")
+    assert info.value.file == "does/not/exist.toml"
+    assert "no such file" in str(info.value)
+
+
+def test_unconvertible_dict_value_is_a_type_error():
+    with pytest.raises(TypeError, match="time.dt"):
+        fbd.run({"time": {"dt": object()}})
+
+
+def test_hexapod_run_is_a_config_error_naming_model(examples):
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.run(examples / "hexapod_stand.toml")
+    assert info.value.key == "model"
+    with pytest.raises(fbd.ConfigError):
+        fbd.Simulator(examples / "hexapod_stand.toml")
+
+
+def test_simulator_config_errors():
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.Simulator({"time": {"duration": -1.0}})
+    assert info.value.key == "time.duration"
+
+
+def test_failing_run_raises_simulation_error_with_partial_rows():
+    with pytest.raises(fbd.SimulationError) as info:
+        fbd.run(UNSTABLE_PD)
+    e = info.value
+    assert isinstance(e, RuntimeError)
+    assert e.step is not None and 2 <= e.step < 100
+    assert e.time == pytest.approx(e.step * 0.01, abs=1e-12)
+    assert f"step {e.step}" in str(e)
+    r = e.result
+    assert isinstance(r, fbd.Result)
+    # Every step before the failing one, and nothing after.
+    assert r.rows == e.step and r["t"][-1] == pytest.approx((e.step - 1) * 0.01)
+    assert r.error == str(e) and r.summary["status"] == "error"
+    assert r.summary["steps"] == e.step
+    assert np.all(np.isfinite(r["theta3_3"]))
+    # The instability the error stops: the knee's error from its target
+    # grows without bound (explicit PD beyond its stability limit).
+    err = np.abs(r["theta2_3"] - np.radians(1.0))
+    assert err[-1] > 10 * err[1]
+
+
+def test_failing_run_with_out_writes_every_file(cli, tmp):
+    cfg = tmp / "unstable.toml"
+    cfg.write_text(UNSTABLE_PD)
+    with pytest.raises(fbd.SimulationError) as info:
+        fbd.run(cfg, out=tmp / "py")
+    p = run_cli(cli, "run", str(cfg), "--out", str(tmp / "cli"))
+    assert p.returncode == 3
+    for name in ("trajectory.csv", "events.csv"):
+        assert (tmp / "py" / name).read_bytes() == (tmp / "cli" / name).read_bytes()
+    s = json.loads((tmp / "py" / "summary.json").read_text())
+    assert s["status"] == "error" and s["rows_written"] == info.value.result.rows
+
+
+def test_unwritable_out_is_an_os_error(tmp):
+    f = tmp / "file"
+    f.write_text("x")
+    with pytest.raises(OSError, match="not a directory"):
+        fbd.run("[time]\nduration = 0.05\n", out=f)

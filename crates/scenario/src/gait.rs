@@ -1,0 +1,469 @@
+//! `[gait]` of the hexapod model: the kinematic gait (schema, defaults,
+//! validation) and the conversion of a hexapod configuration into a
+//! [`GaitModel`]. Without `[gait]` a hexapod run stands: the initial pose
+//! is held for the duration.
+
+use fbd_contact::Surface;
+use fbd_kinematics::hexapod::HexapodModel;
+use fbd_kinematics::leg::LegGeometry;
+use fbd_sim::gait::{Command, GaitKind, GaitModel, GaitParams, InitialPose, Masses};
+use serde::{Deserialize, Serialize};
+
+use crate::{ConfigError, HexapodConfig};
+
+/// `[gait] kind`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GaitKindConfig {
+    /// β = ½, legs {1, 4, 5} against {2, 3, 6} (default).
+    #[default]
+    Tripod,
+    /// β = ⅔, rear-to-front waves on each side, half a period apart.
+    Ripple,
+    /// β = ⅚, one leg at a time: 5, 3, 1, 6, 4, 2.
+    Wave,
+    /// `duty_factor` and `phases` from the configuration.
+    Custom,
+}
+
+impl GaitKindConfig {
+    fn kind(self) -> GaitKind {
+        match self {
+            GaitKindConfig::Tripod => GaitKind::Tripod,
+            GaitKindConfig::Ripple => GaitKind::Ripple,
+            GaitKindConfig::Wave => GaitKind::Wave,
+            GaitKindConfig::Custom => GaitKind::Custom,
+        }
+    }
+}
+
+/// A commanded speed: a number, or a piecewise-linear profile
+/// `[[t, value], ...]` (t strictly increasing, constant beyond the ends).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a number or a profile [[t, value], ...] of [time, value] pairs"
+)]
+pub enum SpeedConfig {
+    /// A constant.
+    Constant(f64),
+    /// `[[t, value], ...]`.
+    Profile(Vec<[f64; 2]>),
+}
+
+impl Default for SpeedConfig {
+    fn default() -> Self {
+        SpeedConfig::Constant(0.0)
+    }
+}
+
+impl SpeedConfig {
+    fn command(&self, scale: f64) -> Command {
+        match self {
+            SpeedConfig::Constant(v) => Command::Constant(v * scale),
+            SpeedConfig::Profile(p) => {
+                Command::Profile(p.iter().map(|q| [q[0], q[1] * scale]).collect())
+            }
+        }
+    }
+
+    fn check(&self, file: &str, key: &str) -> Result<(), ConfigError> {
+        match self {
+            SpeedConfig::Constant(v) if !v.is_finite() => Err(ConfigError::semantic(
+                file,
+                key,
+                "must be finite",
+                v,
+                "a finite value",
+            )),
+            SpeedConfig::Profile(p) => {
+                if p.is_empty() {
+                    return Err(ConfigError::semantic(
+                        file,
+                        key,
+                        "profile is empty",
+                        "[]",
+                        "at least one [t, value] pair",
+                    ));
+                }
+                for (i, q) in p.iter().enumerate() {
+                    if !(q[0].is_finite() && q[1].is_finite()) {
+                        return Err(ConfigError::semantic(
+                            file,
+                            key,
+                            &format!("point {} must be finite", i + 1),
+                            format!("{q:?}"),
+                            "finite [t, value]",
+                        ));
+                    }
+                    if i > 0 && q[0] <= p[i - 1][0] {
+                        return Err(ConfigError::semantic(
+                            file,
+                            key,
+                            &format!("times must increase strictly (point {})", i + 1),
+                            q[0],
+                            &format!("t > {}", p[i - 1][0]),
+                        ));
+                    }
+                }
+                Ok(())
+            }
+            SpeedConfig::Constant(_) => Ok(()),
+        }
+    }
+}
+
+/// `[gait]`: every key optional; defaults documented per field.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GaitConfig {
+    /// `"tripod"` (default), `"ripple"`, `"wave"` or `"custom"`.
+    pub kind: GaitKindConfig,
+    /// Duty factor β ∈ (0, 1); required with `custom`, fixed by the other
+    /// kinds (½, ⅔, ⅚; may be given only with that value).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub duty_factor: Option<f64>,
+    /// Lift-off phase of legs 1–6, fractions of the period in `[0, 1)`;
+    /// required with `custom`, fixed by the other kinds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[serde(deserialize_with = "crate::fixed::opt")]
+    pub phases: Option<[f64; 6]>,
+    /// Gait period T (s). Default 1 s, or `step_length / |forward_speed|`
+    /// when `step_length` is given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+    /// Stride length (m) per period: an alternative to `period` for a
+    /// constant, non-zero `forward_speed`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step_length: Option<f64>,
+    /// Swing height above the straight lift-off → touchdown line (m).
+    /// Default 0.05.
+    pub swing_height: f64,
+    /// Forward speed (m/s): number or `[[t, v], ...]`. Default 0.
+    pub forward_speed: SpeedConfig,
+    /// Lateral speed to the right (m/s): number or profile. Default 0.
+    pub lateral_speed: SpeedConfig,
+    /// Yaw rate (deg/s, positive turns left): number or profile. Default 0.
+    pub yaw_rate_deg: SpeedConfig,
+    /// Start-up and stop blend time (s). Default 0.5.
+    pub ramp: f64,
+    /// No lift-off from this time on; the body stops here (s). Default
+    /// `time.duration − period`, so that every foot is down at the end.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub walk_time: Option<f64>,
+    /// Body height offset (m). Default 0.
+    pub body_height: f64,
+    /// Body roll offset (deg, positive lowers the right side). Default 0.
+    pub body_roll_deg: f64,
+    /// Body pitch offset (deg, positive raises the front). Default 0.
+    pub body_pitch_deg: f64,
+    /// Lateral sway amplitude (m). Default 0.
+    pub sway: f64,
+    /// The body height follows the terrain under it. Default `true`.
+    pub follow_terrain: bool,
+    /// Warning threshold of the stability margin (m). Default 0.02.
+    pub margin_warning: f64,
+    /// Stop with an error when the margin drops below `margin_warning`.
+    /// Default `false`.
+    pub require_stable: bool,
+}
+
+impl Default for GaitConfig {
+    fn default() -> Self {
+        let p = GaitParams::default();
+        Self {
+            kind: GaitKindConfig::Tripod,
+            duty_factor: None,
+            phases: None,
+            period: None,
+            step_length: None,
+            swing_height: p.swing_height,
+            forward_speed: SpeedConfig::default(),
+            lateral_speed: SpeedConfig::default(),
+            yaw_rate_deg: SpeedConfig::default(),
+            ramp: p.ramp,
+            walk_time: None,
+            body_height: p.height,
+            body_roll_deg: p.roll.to_degrees(),
+            body_pitch_deg: p.pitch.to_degrees(),
+            sway: p.sway,
+            follow_terrain: p.follow_terrain,
+            margin_warning: p.margin_warning,
+            require_stable: p.require_stable,
+        }
+    }
+}
+
+impl GaitConfig {
+    /// Fills the preset's β and phases, the period (from `step_length`) and
+    /// `walk_time`, so that `config.toml` holds every value used.
+    pub fn resolve(&mut self, duration: f64) {
+        if let Some((duty, phases)) = self.kind.kind().preset() {
+            self.duty_factor.get_or_insert(duty);
+            self.phases.get_or_insert(phases);
+        }
+        if self.period.is_none()
+            && let (Some(l), SpeedConfig::Constant(v)) = (self.step_length, &self.forward_speed)
+            && *v != 0.0
+            && l > 0.0
+        {
+            self.period = Some(l / v.abs());
+            self.step_length = None;
+        }
+        if self.step_length.is_none() || self.period.is_some() {
+            let period = *self.period.get_or_insert(GaitParams::default().period);
+            if self.step_length.is_none() {
+                self.walk_time.get_or_insert((duration - period).max(0.0));
+            }
+        }
+    }
+
+    /// Checks every key; errors name `gait.key`.
+    pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        let err = |key: &str, what: &str, got: &dyn std::fmt::Display, expected: &str| {
+            Err(ConfigError::semantic(file, key, what, got, expected))
+        };
+        if let Some(l) = self.step_length {
+            if self.period.is_some() {
+                return err(
+                    "gait.step_length",
+                    "give period or step_length, not both",
+                    &l,
+                    "one of them",
+                );
+            }
+            if !(l.is_finite() && l > 0.0) {
+                return err("gait.step_length", "must be positive", &l, "a finite value > 0");
+            }
+            return err(
+                "gait.step_length",
+                "needs a constant, non-zero forward_speed",
+                &l,
+                "forward_speed = <number ≠ 0>",
+            );
+        }
+        match (self.kind.kind().preset(), self.duty_factor, self.phases) {
+            (None, None, _) => {
+                return err(
+                    "gait.duty_factor",
+                    "is required with kind = \"custom\"",
+                    &"nothing",
+                    "a number in (0, 1)",
+                );
+            }
+            (None, _, None) => {
+                return err(
+                    "gait.phases",
+                    "are required with kind = \"custom\"",
+                    &"nothing",
+                    "6 numbers in [0, 1)",
+                );
+            }
+            (Some((duty, phases)), d, p) => {
+                if d.is_some_and(|d| d != duty) {
+                    return err(
+                        "gait.duty_factor",
+                        "is fixed by the gait kind (use kind = \"custom\" to change it)",
+                        &d.unwrap_or(duty),
+                        &format!("{duty}"),
+                    );
+                }
+                if p.is_some_and(|p| p != phases) {
+                    return err(
+                        "gait.phases",
+                        "are fixed by the gait kind (use kind = \"custom\" to change them)",
+                        &format!("{:?}", p.unwrap_or(phases)),
+                        &format!("{phases:?}"),
+                    );
+                }
+            }
+            _ => {}
+        }
+        if let Some(d) = self.duty_factor
+            && !(d > 0.0 && d < 1.0)
+        {
+            return err(
+                "gait.duty_factor",
+                "must lie strictly between 0 and 1",
+                &d,
+                "0 < duty_factor < 1",
+            );
+        }
+        if let Some(p) = self.phases
+            && let Some(x) = p.iter().find(|x| !(0.0..1.0).contains(*x))
+        {
+            return err(
+                "gait.phases",
+                "must be fractions of the period",
+                x,
+                "values in [0, 1)",
+            );
+        }
+        if let Some(t) = self.period
+            && !(t.is_finite() && t > 0.0)
+        {
+            return err("gait.period", "must be positive", &t, "a finite value > 0");
+        }
+        for (key, v) in [
+            ("gait.swing_height", self.swing_height),
+            ("gait.ramp", self.ramp),
+            ("gait.sway", self.sway),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return err(key, "must be finite and ≥ 0", &v, "a finite value ≥ 0");
+            }
+        }
+        for (key, v) in [
+            ("gait.body_height", self.body_height),
+            ("gait.body_roll_deg", self.body_roll_deg),
+            ("gait.body_pitch_deg", self.body_pitch_deg),
+            ("gait.margin_warning", self.margin_warning),
+        ] {
+            if !v.is_finite() {
+                return err(key, "must be finite", &v, "a finite value");
+            }
+        }
+        if let Some(w) = self.walk_time
+            && !(w.is_finite() && w >= 0.0)
+        {
+            return err("gait.walk_time", "must be finite and ≥ 0", &w, "a value ≥ 0");
+        }
+        self.forward_speed.check(file, "gait.forward_speed")?;
+        self.lateral_speed.check(file, "gait.lateral_speed")?;
+        self.yaw_rate_deg.check(file, "gait.yaw_rate_deg")?;
+        Ok(())
+    }
+
+    /// The library's parameters (SI units, radians); call after
+    /// [`GaitConfig::resolve`].
+    pub fn params(&self) -> GaitParams {
+        let d = GaitParams::default();
+        GaitParams {
+            duty: self.duty_factor.unwrap_or(d.duty),
+            phases: self.phases.unwrap_or(d.phases),
+            period: self.period.unwrap_or(d.period),
+            swing_height: self.swing_height,
+            forward: self.forward_speed.command(1.0),
+            lateral: self.lateral_speed.command(1.0),
+            yaw_rate: self.yaw_rate_deg.command(1f64.to_radians()),
+            ramp: self.ramp,
+            walk_time: self.walk_time.unwrap_or(d.walk_time),
+            height: self.body_height,
+            roll: self.body_roll_deg.to_radians(),
+            pitch: self.body_pitch_deg.to_radians(),
+            sway: self.sway,
+            follow_terrain: self.follow_terrain,
+            margin_warning: self.margin_warning,
+            require_stable: self.require_stable,
+            limits: d.limits,
+            walking: true,
+        }
+    }
+}
+
+impl HexapodConfig {
+    /// The kinematic run of this configuration: the `[gait]`, or a standing
+    /// run without it. Joint limits from `[leg] theta*_deg`.
+    ///
+    /// # Errors
+    /// [`ConfigError::Semantic`] naming the key at fault.
+    pub fn gait_model(&self, file: &str) -> Result<GaitModel, ConfigError> {
+        self.validate(file)?;
+        let kin = HexapodModel::new(
+            self.body.side,
+            LegGeometry {
+                a: self.leg.upper_length,
+                c: self.leg.lower_length,
+            },
+            self.leg.upper_com,
+            self.leg.lower_com,
+        );
+        let mut params = match &self.gait {
+            Some(g) => {
+                let mut g = g.clone();
+                g.resolve(self.time.duration);
+                g.params()
+            }
+            None => GaitParams::standing(),
+        };
+        params.limits = self.leg.joint_limits();
+        let masses = Masses {
+            body: self.body.mass,
+            upper: self.leg.upper_mass,
+            lower: self.leg.lower_mass,
+        };
+        let initial = InitialPose {
+            position: self.initial.position,
+            phi: self.phi_rad(),
+            joints: self.joints_rad(),
+        };
+        GaitModel::new(
+            kin,
+            params,
+            Surface::new(self.terrain.terrain(), 0.0),
+            masses,
+            self.time.dt,
+            self.time.duration,
+            initial,
+        )
+        .map_err(|e| ConfigError::Semantic {
+            file: file.to_owned(),
+            message: e.to_string(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Config, parse_str};
+
+    fn parse(text: &str) -> Result<Config, String> {
+        parse_str(text, "g.toml", &[]).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn gait_round_trips_and_fills_defaults() {
+        let text = "model = \"hexapod\"\n[time]\nduration = 5.0\n[gait]\nkind = \"wave\"\nforward_speed = [[0.0, 0.0], [2.0, 0.1]]\nyaw_rate_deg = 5\n";
+        let c = parse(text).unwrap();
+        let Config::Hexapod(h) = &c else { panic!() };
+        let g = h.gait.as_ref().unwrap();
+        assert_eq!(g.duty_factor, Some(5.0 / 6.0));
+        assert_eq!(g.period, Some(1.0));
+        assert_eq!(g.walk_time, Some(4.0));
+        let again = parse(&c.to_toml()).unwrap();
+        assert_eq!(c, again);
+    }
+
+    #[test]
+    fn bad_gait_keys_are_named() {
+        let e = parse("model = \"hexapod\"\n[gait]\nkind = \"trot\"\n").unwrap_err();
+        assert!(e.starts_with("g.toml:3:8: gait.kind"), "{e}");
+        let e = parse("model = \"hexapod\"\n[gait]\nduty = 0.5\n").unwrap_err();
+        assert!(e.starts_with("g.toml:3:1: ") && e.contains("duty"), "{e}");
+        let e = parse("model = \"hexapod\"\n[gait]\nkind = \"custom\"\nduty_factor = 0.6\n")
+            .unwrap_err();
+        assert!(e.contains("gait.phases: are required"), "{e}");
+        let e = parse("model = \"hexapod\"\n[gait]\nduty_factor = 0.6\n").unwrap_err();
+        assert!(e.contains("gait.duty_factor: is fixed"), "{e}");
+        let e = parse("model = \"hexapod\"\n[gait]\nperiod = -1\n").unwrap_err();
+        assert!(e.contains("gait.period: must be positive (got -1"), "{e}");
+        let e = parse("model = \"hexapod\"\n[gait]\nforward_speed = [[1.0, 0.1], [0.5, 0.2]]\n")
+            .unwrap_err();
+        assert!(e.contains("gait.forward_speed: times must increase"), "{e}");
+        let e = parse("model = \"hexapod\"\n[gait]\nforward_speed = \"fast\"\n").unwrap_err();
+        assert!(e.contains("gait.forward_speed") && e.contains("profile"), "{e}");
+        let e = parse("[gait]\nkind = \"tripod\"\n").unwrap_err();
+        assert!(e.contains("gait"), "{e}");
+    }
+
+    #[test]
+    fn step_length_sets_the_period() {
+        let c = parse(
+            "model = \"hexapod\"\n[time]\nduration = 3.0\n[gait]\nstep_length = 0.2\nforward_speed = 0.1\n",
+        )
+        .unwrap();
+        let Config::Hexapod(h) = &c else { panic!() };
+        let g = h.gait.as_ref().unwrap();
+        assert_eq!((g.period, g.step_length, g.walk_time), (Some(2.0), None, Some(1.0)));
+    }
+}

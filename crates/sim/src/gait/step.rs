@@ -1,0 +1,94 @@
+//! One kinematic step of all six legs: gait phase, footholds, swing path,
+//! body state, inverse kinematics with rates and accelerations, forward
+//! kinematics, centre of mass and stability margin. No allocation.
+
+use fbd_kinematics::hexapod::{HexapodConfig, forward};
+use fbd_kinematics::nalgebra::Vector3;
+use fbd_kinematics::pose::BodyPose;
+
+use super::error::GaitError;
+use super::foothold::foothold;
+use super::ik::solve_leg;
+use super::model::{GaitData, GaitModel};
+use super::params::LEGS;
+use super::schedule::{LegPhase, phase_with};
+use super::stability::{centre_of_mass, margin};
+use super::swing::swing;
+
+/// The foot of leg `leg` after swing `k` (`None`: the initial foothold).
+#[inline]
+pub fn anchor(model: &GaitModel, leg: usize, k: Option<usize>) -> Vector3<f64> {
+    match k {
+        None => model.initial_feet[leg],
+        Some(k) => foothold(
+            &model.params,
+            &model.plan,
+            &model.surface,
+            model.initial.phi[1],
+            model.neutral[leg],
+            leg,
+            k,
+        ),
+    }
+}
+
+/// Computes step `k` (time `k·Δt`) into `data`. `data` must hold the
+/// previous step's joint angles (or the initial ones), which the angle
+/// branches stay near.
+///
+/// # Errors
+/// A [`GaitError`] naming the leg and the time when a foot target is out of
+/// reach, a leg is singular or a joint passes its limit.
+pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), GaitError> {
+    let t = model.time(k);
+    let p = &model.params;
+    let planar = model.plan.planar_at_step(k);
+    let body = model.plan.state(t, &planar);
+    let zero = Vector3::zeros();
+    let mut support = [[0.0; 2]; LEGS];
+    let mut n_support = 0;
+    for leg in 0..LEGS {
+        let phase = phase_with(p, leg, model.last_swing[leg], t);
+        let (foot, vel, acc) = match phase {
+            LegPhase::Stance { last } => (anchor(model, leg, last), zero, zero),
+            LegPhase::Swing { k: s, u } => {
+                let from = anchor(model, leg, s.checked_sub(1));
+                let to = anchor(model, leg, Some(s));
+                swing(&from, &to, p.swing_height, p.swing_time(), u)
+            }
+        };
+        if phase.is_stance() {
+            support[n_support] = [foot.x, foot.z];
+            n_support += 1;
+        }
+        data.legs[leg] = solve_leg(
+            &model.kin,
+            &p.limits,
+            leg,
+            t,
+            &body,
+            (&foot, &vel, &acc),
+            &data.legs[leg].theta,
+            model.branches[leg],
+        )?;
+        data.phases[leg] = phase;
+        data.feet[leg] = foot;
+        data.foot_velocity[leg] = vel;
+        data.foot_acceleration[leg] = acc;
+    }
+    let pose = BodyPose {
+        position: body.position,
+        phi: body.phi,
+    };
+    let cfg = HexapodConfig {
+        pose,
+        joints: data.legs.map(|l| l.theta),
+    };
+    forward(&model.kin, &cfg, &mut data.fk);
+    data.com = centre_of_mass(&model.masses, &data.fk);
+    data.margin = margin(&support[..n_support], [data.com.x, data.com.z]);
+    data.body = body;
+    data.step = k;
+    data.t = t;
+    Ok(())
+}

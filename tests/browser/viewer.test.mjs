@@ -1,0 +1,260 @@
+// Opens fbd's viewer.html in headless Chromium (Debian's /usr/bin/chromium,
+// driven by playwright-core) and checks what it draws against the run's
+// trajectory.csv. Run by scripts/test-browser.sh, which makes the runs:
+//
+//   FBD_PLANAR_DIR   output folder of `fbd run` (the default experiment)
+//   FBD_HEXAPOD_DIR  output folder of a hexapod run
+//   FBD_SCREENSHOT_DIR  where viewer.png / viewer_hexapod.png are saved
+//                       (optional)
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { readFileSync, existsSync } from 'node:fs';
+import { join } from 'node:path';
+import { pathToFileURL } from 'node:url';
+import { chromium } from 'playwright-core';
+
+const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
+// No network on the test machines: Chromium's background connections are
+// switched off; WebGL runs on SwiftShader (software).
+const ARGS = [
+  '--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync',
+  '--enable-unsafe-swiftshader',
+];
+const VIEWPORT = { width: 1280, height: 860 };
+
+/** A CSV file (no quoting in fbd's files) as { header, rows, col(name) }. */
+function readCsv(file) {
+  const lines = readFileSync(file, 'utf8').trim().split('\n');
+  const header = lines[0].split(',');
+  const rows = lines.slice(1).map((l) => l.split(','));
+  const index = new Map(header.map((h, i) => [h, i]));
+  const col = (name) => {
+    assert.ok(index.has(name), `${file}: no column ${name}`);
+    return index.get(name);
+  };
+  return { header, rows, col };
+}
+
+let browser;
+before(async () => {
+  assert.ok(existsSync(CHROMIUM), `${CHROMIUM} is missing: apt-get install chromium`);
+  browser = await chromium.launch({ executablePath: CHROMIUM, args: ARGS });
+});
+after(async () => {
+  await browser?.close();
+});
+
+/** Opens dir/viewer.html; every request other than the page is recorded
+ *  and refused, every console error and page error recorded. */
+async function open(dir) {
+  const file = join(dir, 'viewer.html');
+  assert.ok(existsSync(file), `${file} was not written`);
+  const url = pathToFileURL(file).href;
+  const context = await browser.newContext({ viewport: VIEWPORT, offline: true });
+  const page = await context.newPage();
+  const requests = [];
+  const errors = [];
+  await context.route('**/*', (route) => {
+    const u = route.request().url();
+    if (u === url) return route.continue();
+    requests.push(u);
+    return route.abort();
+  });
+  page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
+  page.on('pageerror', (e) => errors.push(e.message));
+  await page.goto(url);
+  await page.waitForFunction(() => window.fbdViewer !== undefined, null, { timeout: 30000 });
+  return { page, context, requests, errors };
+}
+
+/** Keeps the 3D view's pixels (read back from the WebGL canvas) in the
+ *  page under `name`; the comparisons below run in the page too. */
+async function snap(page, name) {
+  await page.evaluate((name) => {
+    const c = document.getElementById('canvas3d');
+    const g = Object.assign(document.createElement('canvas'), { width: c.width, height: c.height }).getContext('2d', { willReadFrequently: true });
+    g.drawImage(c, 0, 0);
+    window.__snaps = window.__snaps || {};
+    window.__snaps[name] = { img: g.getImageData(0, 0, c.width, c.height), ratio: c.width / c.clientWidth };
+  }, name);
+}
+
+/** Share of pixels that differ between two snaps. */
+function difference(page, a, b) {
+  return page.evaluate(([a, b]) => {
+    const x = window.__snaps[a].img, y = window.__snaps[b].img;
+    let n = 0;
+    for (let i = 0; i < x.data.length; i += 4) {
+      if (Math.abs(x.data[i] - y.data[i]) + Math.abs(x.data[i + 1] - y.data[i + 1]) + Math.abs(x.data[i + 2] - y.data[i + 2]) > 30) n++;
+    }
+    return n / (x.width * x.height);
+  }, [a, b]);
+}
+
+/** Darkest luma in a 7×7 square around each CSS pixel of `points`. */
+function darkest(page, name, points) {
+  return page.evaluate(([name, points]) => {
+    const { img, ratio } = window.__snaps[name];
+    return points.map((p) => {
+      let min = 255;
+      const cx = Math.round(p.x * ratio), cy = Math.round(p.y * ratio);
+      for (let j = cy - 3; j <= cy + 3; j++) {
+        for (let i = cx - 3; i <= cx + 3; i++) {
+          if (i < 0 || j < 0 || i >= img.width || j >= img.height) continue;
+          const k = 4 * (j * img.width + i);
+          min = Math.min(min, 0.299 * img.data[k] + 0.587 * img.data[k + 1] + 0.114 * img.data[k + 2]);
+        }
+      }
+      return min;
+    });
+  }, [name, points]);
+}
+
+const seek = (page, i) => page.evaluate((i) => {
+  window.fbdViewer.seek(i);
+  return { frame: window.fbdViewer.frame, row: window.fbdViewer.row[i], world: window.fbdViewer.worldPoints(), screen: window.fbdViewer.screenPoints() };
+}, i);
+
+/** The checks common to both models; `expect(row)` gives the CSV position
+ *  of named points, `dark` the names of points drawn in the dark body colour. */
+async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
+  const csv = readCsv(join(dir, 'trajectory.csv'));
+  const { page, context, requests, errors } = await open(dir);
+  try {
+    const v = await page.evaluate(() => ({ n: window.fbdViewer.frameCount, rows: window.fbdViewer.rows, row: window.fbdViewer.row }));
+
+    await t.test('frame count equals the rows of trajectory.csv', () => {
+      assert.equal(v.rows, csv.rows.length);
+      if (csv.rows.length <= 2000) {
+        assert.equal(v.n, csv.rows.length);
+        assert.deepEqual(v.row, csv.rows.map((_, i) => i));
+      } else {
+        assert.ok(v.n <= 2000, `${v.n} frames`);
+      }
+    });
+
+    const frames = [...new Set([0, Math.floor(v.n / 3), Math.floor(2 * v.n / 3), v.n - 1])];
+    for (const i of frames) {
+      await t.test(`frame ${i}: points drawn where trajectory.csv puts them`, async () => {
+        const s = await seek(page, i);
+        assert.equal(s.frame, i);
+        const row = csv.rows[s.row];
+        const world = new Map(s.world.map((p) => [p.name, p]));
+        for (const [name, want] of Object.entries(expect(row, csv))) {
+          const got = world.get(name);
+          assert.ok(got, `no drawn point ${name}`);
+          ['x', 'y', 'z'].forEach((k, a) => {
+            if (want[a] === undefined) return;
+            assert.ok(Math.abs(got[k] - want[a]) < 2e-6, `frame ${i} ${name}.${k}: drawn ${got[k]}, trajectory.csv ${want[a]}`);
+          });
+        }
+        // On screen: inside the view, and the dark links' points are drawn
+        // (a dark pixel next to each).
+        const box = await page.evaluate(() => { const c = document.getElementById('canvas3d'); return { w: c.clientWidth, h: c.clientHeight }; });
+        for (const p of s.screen) {
+          assert.ok(p.x >= 0 && p.x <= box.w && p.y >= 0 && p.y <= box.h, `frame ${i} ${p.name} off screen at (${p.x}, ${p.y})`);
+        }
+        await snap(page, 'frame');
+        const marked = s.screen.filter((p) => dark.includes(p.name));
+        const luma = await darkest(page, 'frame', marked);
+        marked.forEach((p, k) => {
+          assert.ok(luma[k] < 110, `frame ${i}: nothing dark drawn at ${p.name} (${p.x.toFixed(1)}, ${p.y.toFixed(1)}), darkest luma ${luma[k].toFixed(0)}`);
+        });
+      });
+    }
+
+    await t.test('seeking changes the picture', async () => {
+      await seek(page, 0);
+      await snap(page, 'first');
+      await seek(page, v.n - 1);
+      await snap(page, 'last');
+      const d = await difference(page, 'first', 'last');
+      assert.ok(d > 0.005, `only ${(100 * d).toFixed(3)} % of the pixels changed`);
+    });
+
+    await t.test('play advances the frames and changes the picture', async () => {
+      await seek(page, 0);
+      await snap(page, 'before');
+      await page.click('#play');
+      await page.waitForFunction(() => window.fbdViewer.frame >= 10, null, { timeout: 20000 });
+      await page.click('#play');
+      const state = await page.evaluate(() => ({ frame: window.fbdViewer.frame, playing: window.fbdViewer.playing }));
+      assert.equal(state.playing, false);
+      assert.ok(state.frame >= 10);
+      await snap(page, 'after');
+      assert.ok(await difference(page, 'before', 'after') > 0.001, 'the picture did not change while playing');
+    });
+
+    await t.test('clicking a time-series panel seeks there', async () => {
+      await seek(page, 0);
+      const panel = page.locator('.panel canvas').first();
+      const box = await panel.boundingBox();
+      // Plot area: 52 px from the left, 8 px from the right (viewer.js).
+      const x = 52 + 0.75 * (box.width - 60);
+      await panel.click({ position: { x, y: box.height / 2 } });
+      const got = await page.evaluate(() => ({ f: window.fbdViewer.frame, t: window.fbdViewer.times }));
+      const want = got.t[0] + 0.75 * (got.t[got.t.length - 1] - got.t[0]);
+      assert.ok(Math.abs(got.t[got.f] - want) <= 0.02 * (got.t[got.t.length - 1] - got.t[0]) + 1e-9, `seeked to t = ${got.t[got.f]}, expected about ${want}`);
+    });
+
+    if (screenshot) {
+      await seek(page, shotFrame(v));
+      await page.screenshot({ path: screenshot, fullPage: true });
+    }
+
+    await t.test('no console error and no network request', () => {
+      assert.deepEqual(errors, []);
+      assert.deepEqual(requests, []);
+    });
+  } finally {
+    await context.close();
+  }
+}
+
+const num = (row, csv, name) => Number(row[csv.col(name)]);
+const shots = process.env.FBD_SCREENSHOT_DIR;
+
+test('planar run (the paper\'s fall)', async (t) => {
+  const dir = process.env.FBD_PLANAR_DIR;
+  assert.ok(dir, 'FBD_PLANAR_DIR is not set (run scripts/test-browser.sh)');
+  const events = readCsv(join(dir, 'events.csv'));
+  await checkRun(t, dir, {
+    expect: (row, csv) => ({
+      body: [num(row, csv, 'rx'), num(row, csv, 'ry'), 0],
+      tip3: [num(row, csv, 'tip3_x'), num(row, csv, 'tip3_y'), 0],
+      tip4: [num(row, csv, 'tip4_x'), num(row, csv, 'tip4_y'), 0],
+    }),
+    dark: ['body'],
+    screenshot: shots && join(shots, 'viewer.png'),
+    // At rest on feet and hips: the weight on the contact-force arrows.
+    shotFrame: (v) => v.n - 1,
+  });
+  await t.test('every contact event is marked', async () => {
+    // The events are read back in the test's own browser page below.
+    const { page, context } = await open(dir);
+    try {
+      const marks = await page.evaluate(() => window.fbdViewer.events.map((e) => e.t));
+      // Contact events only (not a joint reaching a limit, nor substeps).
+      const contact = events.rows.filter((r) => /^ST[123]$/.test(r[events.col('from')]));
+      assert.deepEqual(marks, contact.map((r) => Number(r[events.col('t')])));
+    } finally {
+      await context.close();
+    }
+  });
+});
+
+test('hexapod run', async (t) => {
+  const dir = process.env.FBD_HEXAPOD_DIR;
+  assert.ok(dir, 'FBD_HEXAPOD_DIR is not set (run scripts/test-browser.sh)');
+  await checkRun(t, dir, {
+    expect: (row, csv) => {
+      const e = { body: [num(row, csv, 'rx'), num(row, csv, 'ry'), num(row, csv, 'rz')] };
+      for (let n = 1; n <= 6; n++) e[`foot${n}`] = ['x', 'y', 'z'].map((a) => num(row, csv, `foot${n}_${a}`));
+      return e;
+    },
+    dark: ['knee1', 'knee2', 'knee3', 'knee4', 'knee5', 'knee6'],
+    screenshot: shots && join(shots, 'viewer_hexapod.png'),
+    shotFrame: (v) => Math.floor(v.n / 3),
+  });
+});

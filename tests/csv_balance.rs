@@ -26,7 +26,7 @@ fn run_cli(config: Option<&str>, dir: &Path) {
     );
 }
 
-/// Reads `trajectory.csv` into records, using only the SPEC columns, the
+/// Reads `trajectory.csv` into records, using only the contract's columns, the
 /// `<point>_state, <point>_fa, <point>_n` columns of the extra contact points
 /// of `model` (in its contact order) and the torque columns.
 fn read_rows(path: &Path, model: &Model) -> Vec<StepRecord> {
@@ -77,6 +77,7 @@ fn read_rows(path: &Path, model: &Model) -> Vec<StepRecord> {
                     f(&rec, &format!("{name}_fy")),
                 ];
                 r.torque[j] = f(&rec, &format!("tau_{name}"));
+                r.limit_moment[j] = f(&rec, &format!("stop_{name}"));
             }
             r
         })

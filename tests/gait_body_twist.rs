@@ -24,7 +24,11 @@ fn displacement_over_a_period_is_the_integrated_twist() {
     // One period T = 1 s from t = 1 s: rows 100 and 200.
     let (a, b) = (&rows[100], &rows[200]);
     let (psi0, psi1) = (a.body.phi.y, b.body.phi.y);
-    assert!((psi1 - psi0 - w).abs() < 1e-12, "heading change {}", psi1 - psi0);
+    assert!(
+        (psi1 - psi0 - w).abs() < 1e-12,
+        "heading change {}",
+        psi1 - psi0
+    );
     // ẋ = −v_f·sinψ + v_l·cosψ, ż = −v_f·cosψ − v_l·sinψ integrated.
     let dx = (vf * (psi1.cos() - psi0.cos()) + vl * (psi1.sin() - psi0.sin())) / w;
     let dz = (-vf * (psi1.sin() - psi0.sin()) + vl * (psi1.cos() - psi0.cos())) / w;

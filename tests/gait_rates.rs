@@ -22,15 +22,21 @@ fn worst(dt: f64) -> (f64, f64) {
     let m = model(params, dt, 3.5);
     let (rows, _) = run_ok(&m);
     let (mut rate_err, mut acc_err) = (0.0f64, 0.0f64);
+    // Central differences of the rates are O(Δt²) only where the jerk is
+    // continuous: skip the windows that straddle a lift-off or touchdown
+    // (the swing curve's jerk starts and stops there) and the ends of the
+    // start-up and stop blends (0.5 s, 2.5 s, 3 s).
+    let kinks = [0.5, 2.5, 3.0];
     for w in rows.windows(3) {
+        let straddles =
+            w[0].stance() != w[2].stance() || kinks.iter().any(|k| (w[1].t - k).abs() < 1.5 * dt);
         for leg in 0..6 {
+            if straddles {
+                continue;
+            }
             for j in 0..3 {
                 let fd = (w[2].legs[leg].theta[j] - w[0].legs[leg].theta[j]) / (2.0 * dt);
-                let e = (fd - w[1].legs[leg].rate[j]).abs();
-                if e > rate_err && std::env::var("GAIT_DEBUG").is_ok() {
-                    eprintln!("t {} leg {} j {} err {e:e} phase {:?}", w[1].t, leg + 1, j + 1, w[1].phases[leg]);
-                }
-                rate_err = rate_err.max(e);
+                rate_err = rate_err.max((fd - w[1].legs[leg].rate[j]).abs());
                 let fa = (w[2].legs[leg].rate[j] - w[0].legs[leg].rate[j]) / (2.0 * dt);
                 acc_err = acc_err.max((fa - w[1].legs[leg].accel[j]).abs());
             }
@@ -43,7 +49,12 @@ fn worst(dt: f64) -> (f64, f64) {
 fn rates_and_accelerations_are_second_order_consistent() {
     let (r1, a1) = worst(0.004);
     let (r2, a2) = worst(0.002);
-    assert!(r1 < 1e-3 && a1 < 0.05, "Δt = 0.004: rate error {r1:e}, acceleration error {a1:e}");
+    // The swing's jerk (≈ 10³ rad/s³ with a third-of-a-second swing) sets
+    // the size: Δt²/6·jerk ≈ 3e-3 rad/s at Δt = 4 ms.
+    assert!(
+        r1 < 2e-2 && a1 < 1.0,
+        "Δt = 0.004: rate error {r1:e}, acceleration error {a1:e}"
+    );
     let (rr, ra) = (r1 / r2, a1 / a2);
     assert!(
         (3.5..4.5).contains(&rr),

@@ -48,7 +48,11 @@ fn symmetric_tripod_stance_margin_is_the_inradius() {
         rho / 2.0
     );
     // The centre of mass is on the body's axis when every leg is alike.
-    assert!((rows[0].margin - rho / 2.0).abs() < 1e-12, "{}", rows[0].margin);
+    assert!(
+        (rows[0].margin - rho / 2.0).abs() < 1e-12,
+        "{}",
+        rows[0].margin
+    );
 }
 
 #[test]
@@ -58,7 +62,10 @@ fn tripod_is_stable_at_half_duty_and_not_below() {
     let (rows, sum) = run_ok(&model(walk(0.5, s), 0.01, 5.0));
     let min = sum.min_margin.unwrap().0;
     let hand = rho / 2.0 - 0.5 * s * 60f64.to_radians().sin();
-    assert!(rows.iter().all(|r| r.stance().iter().filter(|x| **x).count() >= 3));
+    assert!(
+        rows.iter()
+            .all(|r| r.stance().iter().filter(|x| **x).count() >= 3)
+    );
     assert!(
         (min - hand).abs() < 0.01,
         "β = ½: min margin {min} vs hand {hand}"

@@ -1,4 +1,4 @@
-//! Property tests of `fbd-kinematics`: the SPEC §1.4 test vector through the
+//! Property tests of `fbd-kinematics`: the docs/reference.md test vector through the
 //! 3D model, planar ≡ hexapod restricted to the plane, FK/IK round trips,
 //! proper rotations, analytic Jacobians against finite differences, errors.
 
@@ -158,7 +158,7 @@ fn error_cases() {
 proptest! {
     #![proptest_config(fixed_config(256, 0x6b69_6e65_6d61_7431))]
 
-    /// SPEC §1.4: the planar model is the hexapod restricted to legs 3 and 4,
+    /// docs/reference.md: the planar model is the hexapod restricted to legs 3 and 4,
     /// θ1 = 0, φx = φy = 0, Rz = 0 — every point, and the Jacobians.
     #[test]
     fn planar_equals_restricted_hexapod(

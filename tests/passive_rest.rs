@@ -49,7 +49,25 @@ fn the_passive_experiment_runs_to_rest() {
             .any(|e| format!("{}{}", e.point, e.leg) == name && e.from == StateCode::St1)
     };
     assert!(touched("hip3") && touched("hip4"), "the body never landed");
-    assert!(touched("knee3") || touched("knee4"), "no knee touched down");
+    // The joint limits keep the legs from folding flat: a hip stops at its
+    // limit, no knee reaches the ground, every angle stays in its range.
+    assert!(!summary.limit_events.is_empty(), "no joint reached a limit");
+    assert!(
+        !touched("knee3") && !touched("knee4"),
+        "a knee touched down"
+    );
+    let l = &p.joint_limits;
+    for r in &rows {
+        for (i, range) in [l.theta2, l.theta3, l.theta2, l.theta3].iter().enumerate() {
+            let a = r.q[3 + i];
+            assert!(
+                a >= range[0] - 1e-9 && a <= range[1] + 1e-9,
+                "t = {}: joint angle q[{}] = {a} outside {range:?}",
+                r.t,
+                3 + i
+            );
+        }
+    }
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");
 }

@@ -2,7 +2,7 @@
 """The fbd planar model in MuJoCo, timed with `mujoco.rollout` on one thread.
 
 Same robot as fbd's default experiment (`fbd_sim::PlanarParams::default()`,
-SPEC §1.4), written in fbd's inertial frame (X horizontal, Y up, joints
+docs/reference.md), written in fbd's inertial frame (X horizontal, Y up, joints
 about Z):
 
 * central body: 10 kg, I = 0.3 kg·m² about Z, joints slide X, slide Y,
@@ -12,7 +12,7 @@ about Z):
   I = m·a²/12; lower links: c = 0.42 m, 1.1 kg, centre of mass at 0.75·c
   from the knee, I = m·c²/12. (MuJoCo needs a full inertia: the diagonal is
   (I, I, I); only Izz matters, the motion is planar.)
-* joint axes: leg 3's hip and knee +Z, leg 4's −Z (SPEC §1.4); the joint
+* joint axes: leg 3's hip and knee +Z, leg 4's −Z (docs/reference.md); the joint
   reference (qpos = 0) is θ2 = θ3 = 0, so qpos equals fbd's θ2, θ3;
 * no joint damping, armature, limits or actuators (passive joints);
 * feet: spheres of radius 5 mm centred on the tips; they are the only

@@ -5,7 +5,7 @@
 //!
 //! * **flight** — no terrain (every tip ST1), falling from the default pose;
 //! * **stick** — both tips on flat ground at t = 0 (legs θ = (0°, 250°), Ry
-//!   chosen so that both tips are at y = 0 within 1e-9, SPEC §3), μS huge:
+//!   chosen so that both tips are at y = 0 within 1e-9, docs/reference.md), μS huge:
 //!   both tips ST2 while the passive robot collapses;
 //! * **slide** — the same pose with μS = μD = 0 and a horizontal body
 //!   velocity of 0.5 m/s: both tips ST3.

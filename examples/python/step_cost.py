@@ -1,5 +1,7 @@
 """The binding's own cost per step: `Simulator.step()` called from Python
-minus the time of the Rust step itself.
+minus the time of the Rust step itself, and measured directly as the cost
+of `sim.step(steps=0)` — the whole call (arguments, torques, releasing and
+re-taking the GIL) without the physics.
 
 The robot flies (no terrain), so a step is the cheapest the simulator has
 (≈ 0.5 µs) and the binding's share is as large as it gets. The Rust time
@@ -61,15 +63,37 @@ def main() -> None:
     def batched(sim, n):
         sim.step(steps=n)
 
+    def empty(sim, n):
+        step = sim.step
+        for _ in range(n):
+            step(steps=0)
+
+    def empty_tau(sim, n):
+        step = sim.step
+        for _ in range(n):
+            step(tau, steps=0)
+
+    def read_state(sim, n):
+        for _ in range(n):
+            sim.q
+            sim.qdot
+
     rows = [
         ("sim.step()", loop(plain)),
         ("sim.step(tau)  (NumPy array of 4)", loop(with_torques)),
         ("PD loop: q, qdot, NumPy arithmetic, sim.step(tau)", loop(pd)),
         ("sim.step(steps=n)  (one call)", loop(batched)),
     ]
+    direct = [
+        ("sim.step(steps=0)  (the call without physics)", loop(empty)),
+        ("sim.step(tau, steps=0)", loop(empty_tau)),
+        ("sim.q and sim.qdot  (two new arrays)", loop(read_state)),
+    ]
     print(f"Rust step alone (fbd.run wall_seconds/steps): {rust * 1e6:.3f} µs")
     for name, per in rows:
-        print(f"{name:52s} {per * 1e6:7.3f} µs/step, binding {max(per - rust, 0.0) * 1e6:7.3f} µs")
+        print(f"{name:52s} {per * 1e6:7.3f} µs/step, minus Rust {(per - rust) * 1e6:7.3f} µs")
+    for name, per in direct:
+        print(f"{name:52s} {per * 1e6:7.3f} µs/call")
 
 
 if __name__ == "__main__":

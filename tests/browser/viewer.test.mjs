@@ -178,10 +178,18 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
       await snap(page, 'before');
       await page.click('#play');
       await page.waitForFunction(() => window.fbdViewer.frame >= 10, null, { timeout: 20000 });
-      await page.click('#play');
-      const state = await page.evaluate(() => ({ frame: window.fbdViewer.frame, playing: window.fbdViewer.playing }));
+      // Pause (the run may already have played to its end on a busy machine).
+      const state = await page.evaluate(() => {
+        window.fbdViewer.pause();
+        return { frame: window.fbdViewer.frame, playing: window.fbdViewer.playing };
+      });
       assert.equal(state.playing, false);
       assert.ok(state.frame >= 10);
+      const still = await page.evaluate(() => new Promise((done) => {
+        const f = window.fbdViewer.frame;
+        setTimeout(() => done(window.fbdViewer.frame === f), 300);
+      }));
+      assert.ok(still, 'the frame changed while paused');
       await snap(page, 'after');
       assert.ok(await difference(page, 'before', 'after') > 0.001, 'the picture did not change while playing');
     });
@@ -197,6 +205,18 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
       const want = got.t[0] + 0.75 * (got.t[got.t.length - 1] - got.t[0]);
       assert.ok(Math.abs(got.t[got.f] - want) <= 0.02 * (got.t[got.t.length - 1] - got.t[0]) + 1e-9, `seeked to t = ${got.t[got.f]}, expected about ${want}`);
     });
+
+    if (await page.isVisible('#show-joint')) {
+      await t.test('the joint-force arrows toggle', async () => {
+        await seek(page, v.n - 1);
+        await snap(page, 'without');
+        await page.check('#show-joint');
+        await snap(page, 'with');
+        await page.uncheck('#show-joint');
+        const d = await difference(page, 'without', 'with');
+        assert.ok(d > 0.0002, `the joint-force arrows changed only ${d}`);
+      });
+    }
 
     if (screenshot) {
       await seek(page, shotFrame(v));

@@ -5,9 +5,7 @@ use std::sync::atomic::AtomicBool;
 
 use fbd_contact::Surface;
 use fbd_kinematics::hexapod::HexapodModel;
-use fbd_sim::gait::{
-    GaitData, GaitModel, GaitParams, GaitSummary, InitialPose, Masses, run_gait,
-};
+use fbd_sim::gait::{GaitData, GaitModel, GaitParams, GaitSummary, InitialPose, Masses, run_gait};
 
 /// The paper's geometry, default masses, flat ground, the default stance.
 pub fn model(params: GaitParams, dt: f64, duration: f64) -> GaitModel {

@@ -125,7 +125,8 @@ pub fn worst_body_imbalance(model: &Model, rows: &[StepRecord]) -> (f64, String)
         };
         for (j, spec) in mech.joints.iter().enumerate() {
             let f = cur.joint_force[j];
-            let tz = spec.axis_z * cur.torque[j];
+            // Joint torque and the moment of the joint-limit stop.
+            let tz = spec.axis_z * (cur.torque[j] + cur.limit_moment[j]);
             apply(spec.child, pts[spec.point], f, tz);
             apply(spec.parent, pts[spec.point], [-f[0], -f[1]], -tz);
         }

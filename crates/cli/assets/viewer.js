@@ -149,9 +149,38 @@
     scene.add(line);
     return line;
   });
-  // Terrain: the profile y = ϱ(x), drawn as a line with a shaded area below
-  // (planar) or extruded along Z (hexapod).
-  if (S.terrain.kind === 'profile' && S.terrain.xy.length >= 4) {
+  // Terrain: the heights y = ϱ(x, z) on a grid (hexapod), or the profile
+  // y = ϱ(x), drawn as a line with a shaded area below (planar) or extruded
+  // along Z.
+  if (S.terrain.kind === 'grid') {
+    const { x0, x1, z0, z1, n, y } = S.terrain;
+    const pos = [], idx = [];
+    for (let j = 0; j < n; j++) {
+      for (let i = 0; i < n; i++) pos.push(x0 + (x1 - x0) * i / (n - 1), y[j * n + i], z0 + (z1 - z0) * j / (n - 1));
+    }
+    for (let j = 0; j + 1 < n; j++) {
+      for (let i = 0; i + 1 < n; i++) {
+        const a = j * n + i;
+        idx.push(a, a + n, a + 1, a + 1, a + n, a + n + 1);
+      }
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+    g.setIndex(idx);
+    g.computeVertexNormals();
+    scene.add(new THREE.Mesh(g, new THREE.MeshLambertMaterial({ color: 0xe8e0d0, side: THREE.DoubleSide, polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 })));
+    // Grid lines every 5 samples, to see the slope and the motion.
+    const lines = [];
+    for (let k = 0; k < n; k += 5) {
+      for (let m = 0; m + 1 < n; m++) {
+        lines.push(pos[3 * (k * n + m)], pos[3 * (k * n + m) + 1], pos[3 * (k * n + m) + 2], pos[3 * (k * n + m + 1)], pos[3 * (k * n + m + 1) + 1], pos[3 * (k * n + m + 1) + 2]);
+        lines.push(pos[3 * (m * n + k)], pos[3 * (m * n + k) + 1], pos[3 * (m * n + k) + 2], pos[3 * ((m + 1) * n + k)], pos[3 * ((m + 1) * n + k) + 1], pos[3 * ((m + 1) * n + k) + 2]);
+      }
+    }
+    const lg = new THREE.BufferGeometry();
+    lg.setAttribute('position', new THREE.Float32BufferAttribute(lines, 3));
+    scene.add(new THREE.LineSegments(lg, new THREE.LineBasicMaterial({ color: 0xc8bca8 })));
+  } else if (S.terrain.kind === 'profile' && S.terrain.xy.length >= 4) {
     const xy = S.terrain.xy;
     const m = xy.length / 2;
     const depth = planar ? 0 : Math.max(2 * size, 2);
@@ -282,7 +311,7 @@
     }
     const c = new THREE.Vector3(S.com[f][0], S.com[f][1], S.com[f][2]);
     com.position.copy(c);
-    const ground = groundBelow(c.x);
+    const ground = groundBelow(c.x, c.z);
     comLine.geometry.setFromPoints([c, new THREE.Vector3(c.x, ground, c.z)]);
     comLine.computeLineDistances();
     // Support polygon: the stance feet in their order around the body.
@@ -295,7 +324,13 @@
     for (const t of trails) { t.visible = showTrails.checked; t.geometry.setDrawRange(0, f + 1); }
   }
 
-  function groundBelow(x) {
+  function groundBelow(x, z) {
+    if (S.terrain.kind === 'grid') {
+      const { x0, x1, z0, z1, n, y } = S.terrain;
+      const i = Math.max(0, Math.min(n - 1, Math.round((x - x0) / (x1 - x0) * (n - 1))));
+      const j = Math.max(0, Math.min(n - 1, Math.round((z - z0) / (z1 - z0) * (n - 1))));
+      return y[j * n + i];
+    }
     const xy = S.terrain.xy;
     if (!xy || xy.length < 4) return bbox.min[1];
     for (let i = 2; i < xy.length; i += 2) {

@@ -37,8 +37,9 @@ pub struct Cli {
 /// The subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Simulate a configuration and write trajectory.csv, events.csv,
-    /// summary.json, config.toml, tips.svg, forces.svg and stance.svg.
+    /// Simulate a configuration (default: the built-in experiment) and
+    /// write trajectory.csv, events.csv, summary.json, config.toml, the
+    /// plots and viewer.html to DIR.
     Run(RunArgs),
     /// Print the inertial hip, knee and tip of every leg at the
     /// configuration's initial state, as JSON.

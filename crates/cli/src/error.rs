@@ -1,6 +1,6 @@
 //! The top-level error of a command and its exit status.
 
-use crate::config::ConfigError;
+use crate::config::{ConfigError, os_message};
 
 /// Why a command failed. Displays as one line (without the `error: `
 /// prefix the binary adds).
@@ -51,9 +51,10 @@ impl CliError {
         matches!(self, CliError::BrokenPipe)
     }
 
-    /// Wraps an I/O error on `what` (a path or "stdout").
+    /// Wraps an I/O error on `what` (a path or "stdout"):
+    /// `out/summary.json: permission denied`.
     pub fn io(what: impl std::fmt::Display, e: &std::io::Error) -> Self {
-        CliError::Io(format!("{what}: {e}"))
+        CliError::Io(format!("{what}: {}", os_message(e)))
     }
 
     /// Maps a failed write to stdout.
@@ -63,5 +64,22 @@ impl CliError {
         } else {
             CliError::io("stdout", &e)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn os_messages_read_like_the_others() {
+        let e = std::io::Error::from_raw_os_error(2);
+        assert_eq!(os_message(&e), "no such file or directory");
+        let e = std::io::Error::other("Broken thing");
+        assert_eq!(os_message(&e), "broken thing");
+        assert_eq!(
+            CliError::io("out/x", &std::io::Error::from_raw_os_error(13)).to_string(),
+            "out/x: permission denied"
+        );
     }
 }

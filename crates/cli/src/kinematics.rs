@@ -1,5 +1,5 @@
 //! `fbd kinematics CONFIG`: hip, knee and tip of every leg at the initial
-//! state, inertial frame, as JSON (SPEC §5).
+//! state, inertial frame, as JSON (docs/reference.md, "Command line").
 
 use std::io::Write;
 use std::path::Path;

@@ -1,6 +1,6 @@
 //! # fbd-cli
 //!
-//! The command-line front end of the simulator (SPEC §4–§6): the TOML
+//! The command-line front end of the simulator (docs/reference.md): the TOML
 //! configuration ([`config`]), the `fbd run` command writing
 //! `trajectory.csv`, `events.csv`, `summary.json`, `config.toml` and the
 //! plots ([`run`], [`output`], [`plot`]), and `fbd kinematics`

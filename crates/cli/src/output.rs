@@ -1,4 +1,4 @@
-//! The files of `fbd run` (SPEC §6): every file is written to a temporary
+//! The files of `fbd run` (docs/reference.md): every file is written to a temporary
 //! file in the output directory and renamed into place, so that it appears
 //! completely or not at all.
 //!
@@ -16,7 +16,8 @@ use crate::CliError;
 use crate::steptime::StepTimes;
 
 /// Names of the files `fbd run` writes, in the order they are written.
-pub const FILES: [&str; 7] = [
+/// (`torques.svg` is written too when a joint is actuated.)
+pub const FILES: [&str; 10] = [
     "trajectory.csv",
     "events.csv",
     "summary.json",
@@ -24,9 +25,12 @@ pub const FILES: [&str; 7] = [
     "tips.svg",
     "forces.svg",
     "stance.svg",
+    "joints.svg",
+    "energy.svg",
+    "viewer.html",
 ];
 
-/// The columns of SPEC §6, in order; extras follow (see
+/// The contract's trajectory columns, in order; extras follow (see
 /// [`trajectory_columns`]).
 pub const SPEC_COLUMNS: [&str; 26] = [
     "t", "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4", "tip3_x", "tip3_y",
@@ -34,8 +38,10 @@ pub const SPEC_COLUMNS: [&str; 26] = [
     "knee3_fx", "knee3_fy", "hip4_fx", "hip4_fy", "knee4_fx", "knee4_fy",
 ];
 
-/// Columns after the contact-point triples.
-pub const TAIL_COLUMNS: [&str; 8] = [
+/// Columns after the contact-point triples; `stop_*` are the moments of
+/// the joint-limit stops (N·m, like the torques positive towards larger
+/// joint angles; 0 while the joint is inside its range).
+pub const TAIL_COLUMNS: [&str; 12] = [
     "tau_hip3",
     "tau_knee3",
     "tau_hip4",
@@ -44,6 +50,10 @@ pub const TAIL_COLUMNS: [&str; 8] = [
     "potential",
     "energy",
     "newton_iterations",
+    "stop_hip3",
+    "stop_knee3",
+    "stop_hip4",
+    "stop_knee4",
 ];
 
 /// A new temporary file in `dir`, readable like an ordinary file once
@@ -104,7 +114,7 @@ pub fn prepare_dir(dir: &Path) -> Result<(), CliError> {
 }
 
 /// The trajectory columns for a model whose contact points are named
-/// `contacts` (e.g. `["tip3", "tip4", "knee3", "knee4"]`): SPEC §6's list,
+/// `contacts` (e.g. `["tip3", "tip4", "knee3", "knee4"]`): the contract's list,
 /// then `<name>_state, <name>_fa, <name>_n` for every contact point that is
 /// not a tip, then [`TAIL_COLUMNS`].
 pub fn trajectory_columns(contacts: &[String]) -> Vec<String> {
@@ -231,6 +241,9 @@ impl TrajectoryWriter {
         self.f(r.potential)?;
         self.f(r.kinetic + r.potential)?;
         write!(self.out, ",{}", r.newton_iterations)?;
+        for &m in &r.limit_moment {
+            self.f(m)?;
+        }
         self.out.write_all(b"\n")
     }
 
@@ -323,17 +336,27 @@ impl EventJson {
 /// in time order (contact events first at equal times), with the step and
 /// floating-point time of each.
 pub fn run_events(run: &RunSummary, times: &StepTimes) -> Vec<(usize, f64, EventJson)> {
-    let mut all: Vec<(usize, f64, EventJson)> = run
-        .events
+    merge_events(&run.events, &run.limit_events, &run.retries, times)
+}
+
+/// [`run_events`] of the event lists themselves (e.g. a
+/// [`fbd_sim::Data`]'s during a run stepped from outside).
+pub fn merge_events(
+    events: &[Event],
+    limit_events: &[LimitEvent],
+    retries: &[RetryEvent],
+    times: &StepTimes,
+) -> Vec<(usize, f64, EventJson)> {
+    let mut all: Vec<(usize, f64, EventJson)> = events
         .iter()
         .map(|e| (e.step, e.t, EventJson::new(e, times)))
         .chain(
-            run.limit_events
+            limit_events
                 .iter()
                 .map(|e| (e.step, e.t, EventJson::limit(e, times))),
         )
         .chain(
-            run.retries
+            retries
                 .iter()
                 .map(|e| (e.step, e.t, EventJson::retry(e, times))),
         )
@@ -401,6 +424,9 @@ pub struct Summary {
     /// Steps that could not be solved whole and were solved in substeps
     /// of Δt/2, Δt/4, … (each is a `substeps` event).
     pub retried_steps: usize,
+    /// State searches that found no consistent combination and were closed
+    /// by the combination that violates the contact and limit laws least.
+    pub resolved_cycles: usize,
     /// `"planar"`.
     pub model: &'static str,
     /// Time step (s).

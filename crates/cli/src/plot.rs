@@ -330,11 +330,13 @@ const PALETTE: [RGBColor; 8] = [
 ];
 /// Dash pattern of dashed curves and of event lines (px).
 const DASH: &str = "9 5";
+/// Dash length of interleaved dashed curves (px).
+const DASH_ON: usize = 7;
 const EVENT_DASH: &str = "4 4";
 /// Samples of the terrain profile drawn in `stance.svg`.
 const TERRAIN_SAMPLES: usize = 400;
 /// Width of the legend column beside a chart (px).
-const LEGEND_WIDTH: u32 = 190;
+pub(crate) const LEGEND_WIDTH: u32 = 190;
 
 /// The legend box every chart draws, upper right.
 pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a>(
@@ -388,10 +390,13 @@ pub(crate) fn range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64)
 
 /// How a curve is drawn.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Style {
-    color: RGBColor,
-    width: u32,
-    dashed: bool,
+pub(crate) struct Style {
+    /// Colour.
+    pub color: RGBColor,
+    /// Stroke width (px).
+    pub width: u32,
+    /// Dashed (`stroke-dasharray`, see [`dash`]).
+    pub dashed: bool,
 }
 
 /// The SVG attribute text plotters writes for a stroke of `color`, `width`.
@@ -412,13 +417,15 @@ fn dash(svg: &mut String, color: RGBColor, width: u32, pattern: &str) {
 }
 
 /// A legend entry in the column beside the chart.
-struct Entry {
-    label: String,
-    style: Style,
+pub(crate) struct Entry {
+    /// Text.
+    pub label: String,
+    /// Its line sample.
+    pub style: Style,
 }
 
 /// Draws the legend entries in `area`, top-down.
-fn side_legend<DB: DrawingBackend>(
+pub(crate) fn side_legend<DB: DrawingBackend>(
     area: &DrawingArea<DB, plotters::coord::Shift>,
     entries: &[Entry],
 ) -> PlotResult<()> {
@@ -440,19 +447,33 @@ fn side_legend<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Draws `pts` as one polyline per run of finite points.
+/// Draws `pts` as one polyline per run of finite points, without the
+/// points that change nothing on screen: one landing on the pixel of the
+/// previous point kept, or inside a horizontal stretch.
 fn draw_trace<'a, DB: DrawingBackend + 'a>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     pts: &[(f64, f64)],
     style: Style,
 ) -> PlotResult<()> {
     for run in pts.split(|p| !(p.0.is_finite() && p.1.is_finite())) {
-        if run.is_empty() {
+        let mut kept: Vec<((f64, f64), (i32, i32))> = Vec::with_capacity(run.len());
+        for &p in run {
+            let px = chart.backend_coord(&p);
+            match kept.as_slice() {
+                [.., (_, last)] if *last == px => continue,
+                [.., (_, a), (_, b)] if a.1 == b.1 && b.1 == px.1 => {
+                    let n = kept.len();
+                    kept[n - 1] = (p, px);
+                }
+                _ => kept.push((p, px)),
+            }
+        }
+        if kept.is_empty() {
             continue;
         }
         chart
             .draw_series(LineSeries::new(
-                run.iter().copied(),
+                kept.into_iter().map(|k| k.0),
                 style.color.stroke_width(style.width),
             ))
             .map_err(err)?;
@@ -582,8 +603,21 @@ fn time_chart(
         side_legend(&right, &entries)?;
         root.present().map_err(err)?;
     }
-    for (_, s) in series.iter().filter(|s| s.1.dashed) {
-        dash(&mut buf, s.color, s.width, DASH);
+    // Dashed curves interleave their dashes (a dash of each in turn), so
+    // that coinciding dashed curves all show.
+    let dashed: Vec<Style> = series.iter().filter(|s| s.1.dashed).map(|s| s.1).collect();
+    let phases = dashed.len().clamp(1, 3);
+    for (j, s) in dashed.iter().enumerate() {
+        let pattern = if phases == 1 {
+            DASH.to_owned()
+        } else {
+            format!(
+                "{DASH_ON} {}\" stroke-dashoffset=\"{}",
+                DASH_ON * (phases - 1),
+                DASH_ON * (j % phases)
+            )
+        };
+        dash(&mut buf, s.color, s.width, &pattern);
     }
     dash(&mut buf, EVENT, 1, EVENT_DASH);
     Ok(buf)
@@ -928,6 +962,78 @@ mod tests {
         );
         assert_eq!(pts.first().map(|p| p.0), Some(0.0));
         assert_eq!(pts.last().map(|p| p.0), Some(steps as f64 * 1e-5));
+    }
+
+    #[test]
+    fn plots_of_a_600000_step_run_stay_small() {
+        let names: Vec<String> = ["tip3", "tip4"].map(str::to_owned).to_vec();
+        let steps = 600_000;
+        let dt = 1e-5;
+        let mut rec = PlotRecorder::new(&names, (steps - 1) as f64 * dt);
+        let mut r = StepRecord::zeroed(0, 0.0, 2);
+        for k in 0..steps {
+            let t = k as f64 * dt;
+            r.step = k;
+            r.t = t;
+            let w = (t * 300.0).sin();
+            r.point[0] = [0.1 * w, 0.2 + 0.01 * (t * 7000.0).sin()];
+            r.point[1] = [-0.1 * w, 0.2 - 0.01 * w];
+            r.q[3] = w;
+            r.n[0] = 50.0 + 20.0 * w;
+            r.fa[0] = 5.0 * w;
+            r.state[0] = StateCode::St2;
+            r.kinetic = w * w;
+            r.potential = 1.0 - w * w;
+            rec.push(&r);
+        }
+        let d = rec.finish(&[], Vec::new(), None);
+        for (name, svg) in [
+            ("tips.svg", tips_svg(&d)),
+            ("forces.svg", forces_svg(&d)),
+            ("joints.svg", joints_svg(&d)),
+            ("energy.svg", energy_svg(&d)),
+        ] {
+            let len = svg.unwrap().len();
+            assert!(len < 300_000, "{name}: {len} bytes");
+        }
+        // Only the point that touched is in forces.svg.
+        assert_eq!(d.normal.len(), 1);
+        assert_eq!(d.normal[0].label, "n tip3");
+        assert!(torques_svg(&d).is_none());
+    }
+
+    #[test]
+    fn event_lines_are_labelled() {
+        let trace = Trace {
+            label: "a".into(),
+            pts: vec![(0.0, 0.0), (1.0, 1.0)],
+        };
+        let style = Style {
+            color: LEG3,
+            width: 2,
+            dashed: false,
+        };
+        let events = [
+            EventMark {
+                t: 0.2,
+                label: "4 tip ST2".into(),
+            },
+            EventMark {
+                t: 0.7,
+                label: "3 hip ST3".into(),
+            },
+        ];
+        let svg = time_chart("t", "y (m)", &[(&trace, style)], &events, (0.0, 1.0)).unwrap();
+        assert!(
+            svg.contains("4 tip ST2") && svg.contains("3 hip ST3"),
+            "{svg}"
+        );
+        let attr = format!(
+            "{} stroke-dasharray=\"{EVENT_DASH}\"",
+            stroke_attr(EVENT, 1)
+        );
+        // Two event lines and the legend sample.
+        assert_eq!(svg.matches(&attr).count(), 3);
     }
 
     #[test]

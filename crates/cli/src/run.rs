@@ -1,4 +1,4 @@
-//! `fbd run [CONFIG] [--out DIR]`: simulate and write the files of SPEC §6.
+//! `fbd run [CONFIG] [--out DIR]`: simulate and write the files (docs/reference.md).
 
 use std::collections::BTreeMap;
 use std::io::Write;
@@ -10,10 +10,10 @@ use fbd_sim::{Model, RunSummary, StepRecord};
 
 use crate::CliError;
 use crate::config::{self, Config};
-use crate::output::{self, Energy, PeakForce, Summary, TrajectoryWriter};
+use crate::output::{self, Energy, EventJson, PeakForce, Summary, TrajectoryWriter};
 use crate::plot::{self, PlotData, PlotRecorder, Stance};
-use crate::viewer::{self, planar::PlanarScene};
 use crate::steptime::StepTimes;
+use crate::viewer::{self, planar::PlanarScene};
 
 /// Snapshot intervals of `stance.svg` (one more snapshot than this).
 const STANCE_INTERVALS: usize = 10;
@@ -87,11 +87,9 @@ impl Collector {
                 tip: p(ix.tip),
             });
         }
-        let plot = self.plot.finish(
-            &run.events,
-            stances,
-            Some(model.params.terrain.clone()),
-        );
+        let plot = self
+            .plot
+            .finish(&run.events, stances, Some(model.params.terrain.clone()));
         (plot, self.last, self.peak_contact, self.peak_joint)
     }
 }
@@ -153,6 +151,7 @@ fn summary(
             .map(|e| e.2)
             .collect(),
         retried_steps: run.retries.len(),
+        resolved_cycles: run.resolved_cycles,
         model: "planar",
         dt: model.params.dt,
         duration: model.params.duration,
@@ -178,22 +177,19 @@ fn summary(
     }
 }
 
-/// One line per event: `t=0.19 s  leg 4  ST1 -> ST2` (the point is named
-/// when it is not the tip; the time is the decimal of k·Δt).
-pub fn event_line(e: &fbd_sim::Event, times: &StepTimes) -> String {
-    let kind = e.point;
-    let point = if kind == "tip" {
+/// One line per event of `events.csv` ([`output::run_events`]):
+/// `t=0.19 s  leg 4  ST1 -> ST2`. The point is named when it is not the
+/// tip (`leg 4  hip_limit  free -> min`); an event of no leg (a retried
+/// step) reads `t=0.5 s  substeps  1 -> 4`. `t` is the time as written in
+/// `events.csv` (the decimal of k·Δt).
+pub fn event_line(t: &str, e: &EventJson) -> String {
+    let point = if e.point == "tip" {
         String::new()
     } else {
-        format!("{kind}  ")
+        format!("{}  ", e.point)
     };
-    format!(
-        "t={} s  leg {}  {point}{} -> {}",
-        times.string(e.step, e.t),
-        e.leg,
-        e.from.as_str(),
-        e.to.as_str()
-    )
+    let leg = e.leg.map(|l| format!("leg {l}  ")).unwrap_or_default();
+    format!("t={t} s  {leg}{point}{} -> {}", e.from, e.to)
 }
 
 /// What [`simulate`] produced.
@@ -249,7 +245,7 @@ pub fn simulate(
     let mut rows = 0;
     // viewer.html: one frame per trajectory row (decimated when long).
     let mut view = out_dir
-        .map(|d| PlanarScene::new(&model, model.steps.div_ceil(stride), &d.display().to_string()));
+        .map(|d| PlanarScene::new(&model, model.steps.div_ceil(stride), &viewer::title_of(d)));
     let run = fbd_sim::run_until(&every_step, stop, |r: &StepRecord| {
         if r.step.is_multiple_of(stride) {
             if let Some(t) = traj.as_mut() {
@@ -360,8 +356,8 @@ pub fn run_command(
 
     let mut text = String::new();
     let times = StepTimes::new(summary.dt);
-    for e in &run.events {
-        text.push_str(&event_line(e, &times));
+    for (step, t, e) in output::run_events(&run, &times) {
+        text.push_str(&event_line(&times.string(step, t), &e));
         text.push('\n');
     }
     text.push_str(&format!(
@@ -372,7 +368,11 @@ pub fn run_command(
             "solved"
         },
         output::count(run.steps, "step", "steps"),
-        output::count(run.newton_iterations, "Newton iteration", "Newton iterations"),
+        output::count(
+            run.newton_iterations,
+            "Newton iteration",
+            "Newton iterations"
+        ),
         run.wall_seconds
     ));
     if io_error.is_none() {

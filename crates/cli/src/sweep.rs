@@ -23,16 +23,16 @@
 use std::collections::BTreeMap;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use clap::{Args, Subcommand};
 use serde::{Deserialize, Serialize};
 
 use crate::CliError;
-use crate::output::count;
 use crate::config::{self, Config, Override};
+use crate::output::count;
 
 /// The fixed columns of `index.csv` after `run, status` and the varied
 /// keys.
@@ -592,12 +592,10 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         Some(b) => {
             let p = path.parent().unwrap_or(Path::new("")).join(b);
             let t = config::read_text(&p).map_err(|e| match e {
-                config::ConfigError::Unreadable { file, what } => {
-                    config::ConfigError::Unreadable {
-                        file,
-                        what: format!("{what} (the base of {name})"),
-                    }
-                }
+                config::ConfigError::Unreadable { file, what } => config::ConfigError::Unreadable {
+                    file,
+                    what: format!("{what} (the base of {name})"),
+                },
                 other => other,
             })?;
             // Record the resolved base so sweep.json is self-describing.
@@ -723,7 +721,11 @@ fn run_one(dir: &Path, config: &Config, run: usize, values: Vec<String>) -> Row 
     if dir.exists()
         && let Err(e) = std::fs::remove_dir_all(dir)
     {
-        return fail(format!("{}: cannot clear: {e}", dir.display()));
+        return fail(format!(
+            "{}: cannot clear: {}",
+            dir.display(),
+            config::os_message(&e)
+        ));
     }
     if let Err(e) = crate::output::prepare_dir(dir)
         .and_then(|()| crate::output::write_file(dir, "config.toml", config.to_toml().as_bytes()))
@@ -754,7 +756,11 @@ fn run_one(dir: &Path, config: &Config, run: usize, values: Vec<String>) -> Row 
         None => fail(err.unwrap_or_else(|| "summary.json missing".into())),
     };
     if let Err(e) = std::fs::write(dir.join(DONE), b"") {
-        return fail(format!("{}: {e}", dir.join(DONE).display()));
+        return fail(format!(
+            "{}: {}",
+            dir.join(DONE).display(),
+            config::os_message(&e)
+        ));
     }
     row
 }

@@ -9,7 +9,7 @@
 
 use plotters::prelude::*;
 
-use crate::plot::{draw_legend, err, legend_line, range, tick};
+use crate::plot::{Entry, LEGEND_WIDTH, Style, err, range, side_legend, tick};
 use crate::sweep::Row;
 
 const PALETTE: [RGBColor; 8] = [
@@ -61,6 +61,28 @@ fn numeric_view(key: &str, k: usize, rows: &[Row]) -> Option<(String, Vec<f64>)>
     }
 }
 
+/// The unit of a configuration key, from its last component (`None` when
+/// it has none or is unknown).
+fn key_unit(key: &str) -> Option<&'static str> {
+    let last = key.rsplit('.').next().unwrap_or(key);
+    Some(match last {
+        "omega_deg" | "rate_deg" => "°/s",
+        l if l.ends_with("_deg") => "°",
+        "dt" | "duration" => "s",
+        "mu_static" | "mu_dynamic" | "upper_com" | "lower_com" => "dimensionless",
+        "position" | "side" | "height" | "amplitude" | "wavelength" | "step_height" => "m",
+        l if l.ends_with("_length") => "m",
+        "velocity" => "m/s",
+        "gravity" => "m/s²",
+        l if l.ends_with("mass") => "kg",
+        l if l.ends_with("inertia") => "kg·m²",
+        "kp" => "N·m/rad",
+        "kd" => "N·m·s/rad",
+        "stride" => "steps",
+        _ => return None,
+    })
+}
+
 /// The SVG, or why there is none (no numeric key, no value to plot).
 pub fn sweep_svg(keys: &[String], rows: &[Row], column: &str) -> Result<String, String> {
     if rows.is_empty() {
@@ -103,13 +125,21 @@ pub fn sweep_svg(keys: &[String], rows: &[Row], column: &str) -> Result<String, 
             format!("{c} (s)")
         }
         c if c.starts_with("peak") => format!("{c} (N)"),
+        "steps" => "steps solved".to_owned(),
         c => c.to_owned(),
+    };
+    let x_desc = match key_unit(&keys[xk]) {
+        Some(u) => format!("{x_label} ({u})"),
+        None => x_label.clone(),
     };
     let mut buf = String::new();
     {
-        let root = SVGBackend::with_string(&mut buf, (960, 540)).into_drawing_area();
+        let labelled = groups.len() > 1 || !groups[0].0.is_empty();
+        let legend_width = if labelled { 2 * LEGEND_WIDTH } else { 0 };
+        let root = SVGBackend::with_string(&mut buf, (960 + legend_width, 540)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let mut chart = ChartBuilder::on(&root)
+        let (left, right) = root.split_horizontally(960);
+        let mut chart = ChartBuilder::on(&left)
             .caption(format!("{y_desc} vs {x_label}"), ("sans-serif", 22))
             .margin(14)
             .x_label_area_size(48)
@@ -118,30 +148,51 @@ pub fn sweep_svg(keys: &[String], rows: &[Row], column: &str) -> Result<String, 
             .map_err(err)?;
         chart
             .configure_mesh()
-            .x_desc(x_label.as_str())
+            .x_desc(x_desc.as_str())
             .y_desc(y_desc.as_str())
             .x_label_formatter(&tick)
             .y_label_formatter(&tick)
             .light_line_style(WHITE.mix(0.0))
             .draw()
             .map_err(err)?;
-        let labelled = groups.len() > 1 || !groups[0].0.is_empty();
+        let mut entries = Vec::new();
         for (i, (label, pts)) in groups.iter().enumerate() {
             let color = PALETTE[i % PALETTE.len()];
-            let s = chart
+            chart
                 .draw_series(LineSeries::new(pts.iter().copied(), color.stroke_width(2)))
                 .map_err(err)?;
-            if labelled {
-                s.label(label.as_str()).legend(legend_line(color, 2));
-            }
+            entries.push(Entry {
+                label: label.clone(),
+                style: Style {
+                    color,
+                    width: 2,
+                    dashed: false,
+                },
+            });
             chart
                 .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
                 .map_err(err)?;
         }
         if labelled {
-            draw_legend(&mut chart)?;
+            side_legend(&right, &entries)?;
         }
         root.present().map_err(err)?;
     }
     Ok(buf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_carry_their_units() {
+        assert_eq!(key_unit("terrain.mu_static"), Some("dimensionless"));
+        assert_eq!(key_unit("initial.position"), Some("m"));
+        assert_eq!(key_unit("initial.leg3.theta_deg"), Some("°"));
+        assert_eq!(key_unit("initial.omega_deg"), Some("°/s"));
+        assert_eq!(key_unit("body.mass"), Some("kg"));
+        assert_eq!(key_unit("time.dt"), Some("s"));
+        assert_eq!(key_unit("output.name"), None);
+    }
 }

@@ -16,6 +16,19 @@ fn check_out(out: &std::path::Path, stdout: &str) {
     assert_eq!(summary["steps"], summary["steps_planned"]);
     // The paper's first event: leg 4 touches down in the step from 0.19 s.
     assert!(stdout.contains("t=0.19 s  leg 4  ST1 -> ST2"), "{stdout}");
+    // Times are the decimal of k·Δt: row k of the 0.01 s run is k/100
+    // (`0.35`, never `0.35000000000000003`), in events.csv too.
+    let traj = std::fs::read_to_string(out.join("trajectory.csv")).unwrap();
+    for (k, row) in traj.lines().skip(1).enumerate() {
+        let t = row.split(',').next().unwrap();
+        assert_eq!(t, format!("{:?}", k as f64 / 100.0), "row {k}");
+    }
+    let events = std::fs::read_to_string(out.join("events.csv")).unwrap();
+    for row in events.lines().skip(1) {
+        let t = row.split(',').next().unwrap();
+        let hundredths = (t.parse::<f64>().unwrap() * 100.0).round();
+        assert_eq!(t, format!("{:?}", hundredths / 100.0), "{row}");
+    }
     let leftovers: Vec<_> = std::fs::read_dir(out)
         .unwrap()
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())

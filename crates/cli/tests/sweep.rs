@@ -246,13 +246,15 @@ fn jobs_1_and_2_give_identical_runs_equal_to_fbd_run() {
 #[test]
 fn a_failing_run_is_isolated() {
     let t = tempfile::tempdir().unwrap();
-    let f = sweep_file(
-        t.path(),
-        "f.toml",
-        // Dropped from 20 m with Δt = 0.2 s, the landing step fails (step
-        // 11); stopped before the landing, it does not.
-        "mode = \"zip\"\n[vary]\n\"time.duration\" = [1.0, 4.0, 0.6]\n\"time.dt\" = [0.2, 0.2, 0.2]\n\"initial.position\" = [[0.0, 20.0], [0.0, 20.0], [0.0, 20.0]]\n",
-    );
+    // The reference failing experiment stops at step 23; stopped earlier,
+    // it does not fail.
+    std::fs::write(t.path().join("fail.toml"), common::FAILS).unwrap();
+    let f = t.path().join("f.toml");
+    std::fs::write(
+        &f,
+        "base = \"fail.toml\"\nmode = \"zip\"\n[vary]\n\"time.duration\" = [0.1, 1.0, 0.2]\n",
+    )
+    .unwrap();
     let out = t.path().join("out");
     let o = fbd(&["sweep", s(&f), "--out", s(&out), "--jobs", "2"]);
     assert_eq!(o.status.code(), Some(3), "{}", text(&o));
@@ -264,7 +266,11 @@ fn a_failing_run_is_isolated() {
     assert_eq!(rows[2][1], "ok");
     assert_eq!(rows[1][1], "error");
     assert!(!rows[1][error].is_empty(), "{:?}", rows[1]);
-    assert!(rows[1][error].contains("step 11"), "{:?}", rows[1]);
+    assert!(
+        rows[1][error].contains(&common::fail_prefix()),
+        "{:?}",
+        rows[1]
+    );
     let sum = std::fs::read_to_string(out.join("runs/1/summary.json")).unwrap();
     assert!(sum.contains("\"status\": \"error\""));
 }
@@ -367,4 +373,36 @@ fn bad_arguments_are_usage_errors() {
         let o = fbd(&args);
         assert_eq!(o.status.code(), Some(2), "{extra:?}: {}", text(&o));
     }
+}
+
+#[test]
+fn counts_agree_with_their_nouns() {
+    let t = tempfile::tempdir().unwrap();
+    let f = sweep_file(t.path(), "one.toml", "[vary]\n\"time.duration\" = [0.2]\n");
+    let out = t.path().join("one");
+    let o = run_ok(&["sweep", s(&f), "--out", s(&out)]);
+    let so = String::from_utf8_lossy(&o.stdout);
+    assert!(so.starts_with("sweep: 1 run; ran 1,"), "{so}");
+    let merged = t.path().join("merged");
+    let o = run_ok(&["sweep", "merge", s(&out), "--out", s(&merged)]);
+    let so = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        so.contains(&format!(
+            "merged 1 of 1 run from 1 directory into {}",
+            merged.display()
+        )),
+        "{so}"
+    );
+    // One failure among one run: "1 of 1 run failed (run 0)".
+    std::fs::write(t.path().join("fail.toml"), common::FAILS).unwrap();
+    let f = t.path().join("f.toml");
+    std::fs::write(
+        &f,
+        "base = \"fail.toml\"\n[vary]\n\"time.duration\" = [1.0]\n",
+    )
+    .unwrap();
+    let o = fbd(&["sweep", s(&f), "--out", s(&t.path().join("f"))]);
+    assert_eq!(o.status.code(), Some(3), "{}", text(&o));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("1 of 1 run failed (run 0)"), "{e}");
 }

@@ -1,6 +1,6 @@
 //! # fbd-contact
 //!
-//! The foot–soil interaction of the paper (§5.4, SPEC §3): a rigid terrain
+//! The foot–soil interaction of the paper (§5.4, docs/reference.md): a rigid terrain
 //! `y = ϱ(x)` with its local tangent and normal ([`terrain`]), and the
 //! three-state contact machine ST1 (no contact), ST2 (contact without
 //! sliding), ST3 (contact with sliding) with every switching rule

@@ -1,4 +1,4 @@
-//! The ST1/ST2/ST3 contact state machine of paper §5.4 and SPEC §3.
+//! The ST1/ST2/ST3 contact state machine of paper §5.4 and docs/reference.md.
 //!
 //! | state | meaning | equations the point contributes |
 //! |---|---|---|
@@ -80,7 +80,7 @@ impl ContactState {
         }
     }
 
-    /// The state of a point at `t = 0` (SPEC §3): within `tol` of the terrain
+    /// The state of a point at `t = 0` (docs/reference.md): within `tol` of the terrain
     /// it starts in ST2 at its vertical projection, above it in ST1. Returns
     /// `Err(depth)` when the point is deeper than `tol` below the terrain.
     pub fn initial(p: [f64; 2], terrain: &Terrain, tol: f64) -> Result<Self, f64> {
@@ -148,7 +148,7 @@ pub struct ContactParams {
     /// Default `1e-9`.
     pub speed_tol: f64,
     /// A point within this distance of the terrain at `t = 0` starts in ST2
-    /// (SPEC §3). Default `1e-9` m.
+    /// (docs/reference.md). Default `1e-9` m.
     pub initial_tol: f64,
     /// Dimensionless regularisation β of the contact position rows
     /// (`K·(p − a) + β·F = 0` with `K = M/Δt²`, see `fbd_dynamics::assemble`):
@@ -216,7 +216,7 @@ impl Trial {
     }
 }
 
-/// The switching rules of SPEC §3. Returns `None` when `state` is consistent
+/// The switching rules of docs/reference.md. Returns `None` when `state` is consistent
 /// with the trial, otherwise the state to re-solve the step in.
 ///
 /// * ST1 → ST2 when the point would end the step below the terrain; the anchor

@@ -264,7 +264,7 @@ impl Terrain {
     }
 
     /// Unit tangent `(1, ϱ′)/√(1+ϱ′²)` and unit normal `(−ϱ′, 1)/√(1+ϱ′²)`
-    /// at `x` (SPEC §6).
+    /// at `x` (docs/reference.md).
     #[inline]
     pub fn frame(&self, x: f64) -> ([f64; 2], [f64; 2]) {
         let s = self.slope(x);

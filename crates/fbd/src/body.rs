@@ -1,5 +1,5 @@
 //! One isolated rigid body: its discretised Newton–Euler equations
-//! (paper eqs. 11–13 in the inertial frame, SPEC §2).
+//! (paper eqs. 11–13 in the inertial frame, the contract).
 //!
 //! For body `b` with mass `m`, inertia `I`, versor `v` and coordinates
 //! `X(q), Y(q), ψ(q)` (centre of mass and absolute angle):

@@ -1,6 +1,6 @@
 //! # fbd-dynamics
 //!
-//! Free Body Diagram equation assembly (paper §4–§5.3, SPEC §2).
+//! Free Body Diagram equation assembly (paper §4–§5.3, the contract).
 //!
 //! Every rigid body is isolated and its Newton–Euler equations are written in
 //! the inertial frame with every force explicit: gravity at its centre of

@@ -234,7 +234,7 @@ impl Mechanism {
         self
     }
 
-    /// The paper's planar model: central body, legs 3 and 4 (SPEC §1.4).
+    /// The paper's planar model: central body, legs 3 and 4 (docs/reference.md).
     /// Bodies `[body, upper3, lower3, upper4, lower4]`; joints
     /// `[hip3, knee3, hip4, knee4]`; contacts in the order tips (3, 4), knees
     /// (3, 4), hips (3, 4) for those enabled.

@@ -1,7 +1,7 @@
 //! The hexagonal central body and where the legs are mounted (paper eq. 5,
-//! SPEC §1.2).
+//! docs/reference.md).
 //!
-//! Legs are numbered 1–6 as in SPEC §1.2; arrays in this crate are indexed by
+//! Legs are numbered 1–6 as in docs/reference.md; arrays in this crate are indexed by
 //! `leg number − 1`. In body coordinates `y` is vertical (up), `−z` is
 //! forward, and the hip of leg `i` is `(d·cosγi, 0, −d·sinγi)` with
 //! `d = L·cos(π/6)`.
@@ -44,7 +44,7 @@ impl LegMount {
     /// `sinγ` and `cosγ` are snapped to the exact values 0, ±½, ±1 when
     /// within `1e-15` of them, so that the table's γ's (multiples of 60°)
     /// are exact: legs 3 and 4 then stay exactly in the body's `z = 0`
-    /// plane, as the planar model (SPEC §1.4) requires.
+    /// plane, as the planar model (docs/reference.md) requires.
     pub fn new(gamma: f64, d: f64) -> Self {
         let (s, c) = gamma.sin_cos();
         let (s, c) = (snap(s), snap(c));

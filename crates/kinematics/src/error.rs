@@ -54,7 +54,7 @@ pub enum KinematicsError {
     /// The inverse kinematics of one leg of a stance failed.
     #[error("leg {leg}: {source}")]
     Leg {
-        /// Leg number, 1–6 (SPEC §1.2 numbering).
+        /// Leg number, 1–6 (docs/reference.md numbering).
         leg: usize,
         /// Why this leg failed.
         #[source]

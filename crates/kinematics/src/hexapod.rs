@@ -1,4 +1,4 @@
-//! 24-DOF forward kinematics of the hexapod (paper §3.1, SPEC §1.1–1.3),
+//! 24-DOF forward kinematics of the hexapod (paper §3.1, docs/reference.md),
 //! every auxiliary point and rotation versor, into a reusable workspace.
 //!
 //! The model ([`HexapodModel`]) is immutable; [`forward`] fills a
@@ -20,7 +20,7 @@
 //!
 //! `u` is the horizontal (in the body) direction of the leg's vertical plane,
 //! pointing towards the body at θ2 = 0 (the upper link then points along
-//! `−u`, outward, as SPEC §1.1 says).
+//! `−u`, outward, as docs/reference.md says).
 //!
 //! # Rotation versors (paper §5.2)
 //!
@@ -46,7 +46,7 @@
 //!   about which `φx, φy, φz` turn, i.e. `ω = Σ phi_axes[k]·φ̇_k`).
 //!
 //! Check in the plane: leg 4 (γ = 0, θ1 = 0) has `z1 = −Z`, leg 3 (γ = 180°)
-//! has `z1 = +Z`, matching paper §5.2 and SPEC §1.4.
+//! has `z1 = +Z`, matching paper §5.2 and docs/reference.md.
 //!
 //! # Generalised coordinates
 //!
@@ -85,7 +85,7 @@ pub struct HexapodModel {
 }
 
 impl Default for HexapodModel {
-    /// The paper's robot (SPEC §1.4 test-vector geometry):
+    /// The paper's robot (docs/reference.md test-vector geometry):
     /// * `side` `L = 0.25` m (so `d = 0.25·cos 30°`),
     /// * `leg` `a = 0.2` m, `c = 0.42` m,
     /// * `upper_com = lower_com = 0.5` (centres of mass at mid-link).

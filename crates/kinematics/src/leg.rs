@@ -1,4 +1,4 @@
-//! One 3-DOF leg in its base frame 0 (paper eqs. 1–4, SPEC §1.1).
+//! One 3-DOF leg in its base frame 0 (paper eqs. 1–4, docs/reference.md).
 //!
 //! Expanding `0A1(θ1)·1A2(θ2)·2A3(θ3)·[0,0,0,1]ᵀ` (see [`crate::dh`]) gives
 //!
@@ -26,7 +26,7 @@ pub struct LegGeometry {
 }
 
 impl Default for LegGeometry {
-    /// The paper's leg (SPEC §1.4 test vector):
+    /// The paper's leg (docs/reference.md test vector):
     /// * `a = 0.2` m,
     /// * `c = 0.42` m.
     fn default() -> Self {

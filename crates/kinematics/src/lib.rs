@@ -1,10 +1,10 @@
 //! # fbd-kinematics
 //!
 //! Denavit–Hartenberg kinematics of the six-legged robot of the paper
-//! (eqs. 1–5) and the planar 7-DOF two-leg model (SPEC §1.4), with analytic
+//! (eqs. 1–5) and the planar 7-DOF two-leg model (docs/reference.md), with analytic
 //! Jacobians.
 //!
-//! Conventions (SPEC §1): inertial `Y` is vertical, up; body `y` is vertical,
+//! Conventions (docs/reference.md): inertial `Y` is vertical, up; body `y` is vertical,
 //! body `−z` forward; legs are numbered 1–6 (front-left, front-right,
 //! middle-left, middle-right, rear-left, rear-right) and arrays are indexed
 //! by `leg number − 1`; angles in radians, lengths in metres.

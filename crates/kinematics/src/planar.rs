@@ -1,4 +1,4 @@
-//! Planar 7-DOF kinematics of the two-leg model (SPEC §1.4, paper §3.2).
+//! Planar 7-DOF kinematics of the two-leg model (docs/reference.md, paper §3.2).
 //!
 //! Every auxiliary point of the planar model (hips, knees, tips, link centres
 //! of mass) is the body position plus a sum of rotated segments,
@@ -39,7 +39,7 @@ pub const fn theta3_index(leg: usize) -> usize {
     4 + 2 * leg
 }
 
-/// Side sign `s` of SPEC §1.4: −1 for leg 3 (left), +1 for leg 4 (right).
+/// Side sign `s` of docs/reference.md: −1 for leg 3 (left), +1 for leg 4 (right).
 pub const fn side_sign(leg: usize) -> f64 {
     if leg == 0 { -1.0 } else { 1.0 }
 }
@@ -117,7 +117,7 @@ pub struct PlanarGeometry {
 }
 
 impl Default for PlanarGeometry {
-    /// The SPEC §1.4 test-vector geometry: `L = 0.25` (so `d = 0.25·cos 30°`),
+    /// The docs/reference.md test-vector geometry: `L = 0.25` (so `d = 0.25·cos 30°`),
     /// `a = 0.2`, `c = 0.42`, centres of mass at mid-link.
     fn default() -> Self {
         Self {
@@ -155,7 +155,7 @@ pub struct TwoLegIndex {
 }
 
 impl PlanarChains {
-    /// The paper's planar model: central body and legs 3 and 4 (SPEC §1.4).
+    /// The paper's planar model: central body and legs 3 and 4 (docs/reference.md).
     pub fn two_leg(g: &PlanarGeometry) -> (Self, TwoLegIndex) {
         use std::f64::consts::PI;
         let mut angles = vec![LinearAngle {
@@ -369,7 +369,7 @@ mod tests {
 
     #[test]
     fn spec_formulas_in_body_frame() {
-        // SPEC §1.4 written out literally, at an arbitrary configuration.
+        // docs/reference.md written out literally, at an arbitrary configuration.
         let g = PlanarGeometry::default();
         let (ch, ix) = PlanarChains::two_leg(&g);
         let mut d = ch.new_data();

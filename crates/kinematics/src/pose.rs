@@ -1,4 +1,4 @@
-//! The central body's pose in the inertial frame (SPEC §1.3).
+//! The central body's pose in the inertial frame (docs/reference.md).
 //!
 //! `p_inertial = R + Rot·p_body`, with `Rot = Rx(φx)·Rz(φz)·Ry(φy)`: rotations
 //! about the *inertial* axes applied in the sequence Y, then Z, then X (the

@@ -100,6 +100,9 @@ impl Columns {
         w.f(r.potential);
         w.f(r.kinetic + r.potential);
         w.i(r.newton_iterations as i64);
+        for &m in &r.limit_moment {
+            w.f(m);
+        }
         debug_assert_eq!(w.i, self.names.len(), "a value for every column");
     }
 

@@ -2,27 +2,33 @@
 //! memory, the CLI's files written only when `out` is given.
 
 use std::path::PathBuf;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use fbd_cli::run::{Simulated, simulate};
+use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::columns::Columns;
 use crate::errors::{cli_error, guard};
 
+/// Rows between two looks at Python's signals during a run.
+pub const SIGNAL_CHECK: usize = 4096;
+
 /// Every event of a run — contact, joint-limit and retried-step events, as
-/// `events.csv` lists them ([`fbd_cli::output::run_events`]) — as a list of
-/// dicts (`t`, `step`, `leg` (None for a retried step), `point`, `from`,
+/// `events.csv` lists them ([`fbd_cli::output::merge_events`]) — as a list
+/// of dicts (`t`, `step`, `leg` (None for a retried step), `point`, `from`,
 /// `to`).
 pub fn events<'py>(
     py: Python<'py>,
-    run: &fbd_sim::RunSummary,
+    events: &[fbd_sim::Event],
+    limit_events: &[fbd_sim::LimitEvent],
+    retries: &[fbd_sim::RetryEvent],
     dt: f64,
 ) -> PyResult<Bound<'py, PyList>> {
     let times = fbd_cli::steptime::StepTimes::new(dt);
     let list = PyList::empty(py);
-    for (step, _, e) in fbd_cli::output::run_events(run, &times) {
+    for (step, _, e) in fbd_cli::output::merge_events(events, limit_events, retries, &times) {
         let d = PyDict::new(py);
         d.set_item("t", e.t)?;
         d.set_item("step", step)?;
@@ -48,40 +54,47 @@ pub fn run<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let loaded = crate::config::load(py, config)?;
-        let (dt, stride, steps) = match &loaded.config {
-            fbd_scenario::Config::Planar(c) => (c.time.dt, c.output.stride.max(1), {
-                let n = (c.time.duration / c.time.dt).round();
-                if n.is_finite() && n < 1e8 {
-                    n as usize + 1
-                } else {
-                    0
-                }
-            }),
-            fbd_scenario::Config::Hexapod(c) => (c.time.dt, 1, 0),
-        };
         let outcome = py.detach(|| {
-            let names = match &loaded.config {
-                fbd_scenario::Config::Planar(c) => c.model(&loaded.source).ok().map(|m| {
-                    m.mech
-                        .contacts
-                        .iter()
-                        .map(|c| c.name.clone())
-                        .collect::<Vec<_>>()
-                }),
-                fbd_scenario::Config::Hexapod(_) => None,
+            // The columns' names and capacity; an invalid model is reported
+            // by `simulate` itself.
+            let (names, dt, rows) = match &loaded.config {
+                fbd_scenario::Config::Planar(c) => match c.model(&loaded.source) {
+                    Ok(m) => (
+                        m.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+                        m.dt(),
+                        m.steps.div_ceil(m.params.stride.max(1)),
+                    ),
+                    Err(_) => (Vec::new(), c.time.dt, 0),
+                },
+                fbd_scenario::Config::Hexapod(c) => (Vec::new(), c.time.dt, 0),
             };
-            let mut cols = Columns::new(names.as_deref().unwrap_or(&[]), dt, steps / stride + 1);
+            let mut cols = Columns::new(&names, dt, rows);
+            // Ctrl-C (KeyboardInterrupt) stops the run: every SIGNAL_CHECK
+            // rows the GIL is taken back to let Python run its signal
+            // handlers (on the main thread only, as Python does).
             let stop = AtomicBool::new(false);
+            let mut signal: Option<PyErr> = None;
+            let mut count = 0usize;
             simulate(
                 &loaded.config,
                 &loaded.source,
                 out.as_deref(),
                 &stop,
-                &mut |r| cols.push(r),
+                &mut |r| {
+                    cols.push(r);
+                    count += 1;
+                    if count.is_multiple_of(SIGNAL_CHECK)
+                        && signal.is_none()
+                        && let Err(e) = Python::attach(|py| py.check_signals())
+                    {
+                        signal = Some(e);
+                        stop.store(true, Ordering::Relaxed);
+                    }
+                },
             )
-            .map(|s| (s, cols))
+            .map(|s| (s, cols, dt, signal))
         });
-        let (sim, cols) = outcome.map_err(|e| cli_error(py, &e, loaded.from_text))?;
+        let (sim, cols, dt, signal) = outcome.map_err(|e| cli_error(py, &e, loaded.from_text))?;
         let Simulated {
             run,
             summary,
@@ -91,11 +104,25 @@ pub fn run<'py>(
         if let Some(e) = io_error {
             return Err(cli_error(py, &e, loaded.from_text));
         }
+        if let Some(e) = signal {
+            // The signal handler's exception (KeyboardInterrupt for Ctrl-C),
+            // with where the run stopped.
+            if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                return Err(PyKeyboardInterrupt::new_err(format!(
+                    "{}: interrupted after {} steps",
+                    loaded.source, run.steps
+                )));
+            }
+            return Err(e);
+        }
         let d = PyDict::new(py);
         let (names, data) = cols.into_py(py)?;
         d.set_item("columns", names)?;
         d.set_item("data", data)?;
-        d.set_item("events", events(py, &run, dt)?)?;
+        d.set_item(
+            "events",
+            events(py, &run.events, &run.limit_events, &run.retries, dt)?,
+        )?;
         let json = serde_json::to_string(&summary).unwrap_or_else(|_| "{}".into());
         d.set_item("summary", json)?;
         d.set_item("source", &loaded.source)?;

@@ -13,8 +13,16 @@ use crate::errors::{config_error, guard, simulation_error};
 /// Joints of the planar model: hip3, knee3, hip4, knee4.
 const JOINTS: usize = fbd_sim::record::MAX_JOINTS;
 
-/// The planar model stepped from Python (see the Python docstring of
-/// `fbd.Simulator`).
+/// The planar model stepped one Δt at a time, for controllers written in
+/// Python. `config` is a configuration as for `fbd.run` (None, a path, TOML
+/// text or a dict).
+///
+/// `step(torques=None, steps=1)` solves steps with the given joint torques
+/// (N·m: hip3, knee3, hip4, knee4, applied as given) or the configured
+/// controller; `q`, `qdot` (the backward difference the built-in PD uses),
+/// `t`, `k` are the current state; `contact_states`, `contact_forces`,
+/// `joint_forces`, `joint_torques` those of the step solved last; `events`,
+/// `reset()`. The GIL is released while stepping.
 #[pyclass(module = "fbd._fbd")]
 pub struct Simulator {
     model: Model,
@@ -119,15 +127,23 @@ impl Simulator {
         let last = &mut self.last;
         let result = py.detach(|| {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                for _ in 0..steps {
+                for i in 1..=steps {
                     *last = Some(fbd_sim::step(model, data)?);
+                    // Ctrl-C between steps of a long call.
+                    if i.is_multiple_of(crate::run::SIGNAL_CHECK)
+                        && i < steps
+                        && let Err(e) = Python::attach(|py| py.check_signals())
+                    {
+                        return Ok(Some(e));
+                    }
                 }
-                Ok::<_, SimError>(())
+                Ok::<_, SimError>(None)
             }))
         });
         self.data.external_torque = None;
         match result {
-            Ok(Ok(())) => Ok(()),
+            Ok(Ok(None)) => Ok(()),
+            Ok(Ok(Some(interrupt))) => Err(interrupt),
             Ok(Err(e)) => {
                 let msg = format!("{e} ({})", self.source);
                 let (k, t) = (e.step(), e.step().map(|k| k as f64 * self.model.dt()));
@@ -285,18 +301,7 @@ impl Simulator {
     #[getter]
     fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let d = &self.data;
-        let run = fbd_sim::RunSummary {
-            steps: d.k,
-            newton_iterations: d.newton_iterations,
-            wall_seconds: 0.0,
-            symbolic_factorizations: d.symbolic_factorizations(),
-            events: d.events.clone(),
-            error: self.failed.clone(),
-            limit_events: d.limit_events.clone(),
-            retries: d.retries.clone(),
-            interrupted: false,
-        };
-        crate::run::events(py, &run, self.model.dt())
+        crate::run::events(py, &d.events, &d.limit_events, &d.retries, self.model.dt())
     }
 
     fn __repr__(&self) -> String {

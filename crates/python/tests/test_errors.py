@@ -140,3 +140,26 @@ def test_unwritable_out_is_an_os_error(tmp):
     f.write_text("x")
     with pytest.raises(OSError, match="not a directory"):
         fbd.run("[time]\nduration = 0.05\n", out=f)
+
+
+def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call():
+    import _thread
+    import threading
+
+    long = {"time": {"dt": 1e-4, "duration": 100.0}, "terrain": {"kind": "none"}}
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt, match="interrupted after"):
+        fbd.run(long)
+    timer.join()
+    sim = fbd.Simulator(long)
+    timer = threading.Timer(0.3, _thread.interrupt_main)
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        sim.step(steps=sim.steps)
+    timer.join()
+    # Stopped between steps: the state is a solved one, and stepping goes on.
+    k = sim.k
+    assert 0 < k < sim.steps
+    sim.step()
+    assert sim.k == k + 1

@@ -230,7 +230,7 @@ impl ControlConfig {
             }
         };
         control.validate().map_err(|(key, what, got)| {
-            semantic(file, &key, what, got, "see [control] in SPEC §4")
+            semantic(file, &key, what, got, "see [control] in docs/reference.md")
         })?;
         Ok(control)
     }
@@ -289,11 +289,11 @@ impl TerrainConfig {
             .parent()
             .unwrap_or(Path::new(""))
             .join(&name);
-        let text = std::fs::read_to_string(&path).map_err(|e| {
+        let text = crate::read_text(&path).map_err(|e| {
             semantic(
                 config_file,
                 "terrain.file",
-                &format!("cannot read {}: {e}", path.display()),
+                &format!("cannot read it: {e}"),
                 &name,
                 "a readable CSV of x,y lines",
             )

@@ -233,7 +233,12 @@ impl GaitConfig {
                 );
             }
             if !(l.is_finite() && l > 0.0) {
-                return err("gait.step_length", "must be positive", &l, "a finite value > 0");
+                return err(
+                    "gait.step_length",
+                    "must be positive",
+                    &l,
+                    "a finite value > 0",
+                );
             }
             return err(
                 "gait.step_length",
@@ -326,7 +331,12 @@ impl GaitConfig {
         if let Some(w) = self.walk_time
             && !(w.is_finite() && w >= 0.0)
         {
-            return err("gait.walk_time", "must be finite and ≥ 0", &w, "a value ≥ 0");
+            return err(
+                "gait.walk_time",
+                "must be finite and ≥ 0",
+                &w,
+                "a value ≥ 0",
+            );
         }
         self.forward_speed.check(file, "gait.forward_speed")?;
         self.lateral_speed.check(file, "gait.lateral_speed")?;
@@ -451,7 +461,10 @@ mod tests {
             .unwrap_err();
         assert!(e.contains("gait.forward_speed: times must increase"), "{e}");
         let e = parse("model = \"hexapod\"\n[gait]\nforward_speed = \"fast\"\n").unwrap_err();
-        assert!(e.contains("gait.forward_speed") && e.contains("profile"), "{e}");
+        assert!(
+            e.contains("gait.forward_speed") && e.contains("profile"),
+            "{e}"
+        );
         let e = parse("[gait]\nkind = \"tripod\"\n").unwrap_err();
         assert!(e.contains("gait"), "{e}");
     }
@@ -464,6 +477,9 @@ mod tests {
         .unwrap();
         let Config::Hexapod(h) = &c else { panic!() };
         let g = h.gait.as_ref().unwrap();
-        assert_eq!((g.period, g.step_length, g.walk_time), (Some(2.0), None, Some(1.0)));
+        assert_eq!(
+            (g.period, g.step_length, g.walk_time),
+            (Some(2.0), None, Some(1.0))
+        );
     }
 }

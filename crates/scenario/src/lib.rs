@@ -13,11 +13,45 @@
 //!   they are converted to radians only by [`PlanarConfig::params`] and
 //!   [`HexapodConfig::joints_rad`].
 //!
-//! Loading ([`load`], [`parse_str`]) happens in two phases so that errors in
-//! the file point at the file: the text is deserialized as written (errors
-//! carry `file:line:col`), then optional dotted-key [`Override`]s are applied
-//! to the parsed [`toml::Table`] one at a time and the result deserialized
-//! again (errors name the override).
+//! ## The API (for the CLI, the Python package and Rust programs)
+//!
+//! Every entry point returns a complete, validated [`Config`] (defaults
+//! filled in by [`Config::resolve`], every key checked by
+//! [`Config::validate`]) or one [`ConfigError`]:
+//!
+//! * [`load`]`(path)` — a file; [`load_with_overrides`]`(path, overrides)`
+//!   with dotted-key [`Override`]s applied on top (what a sweep does);
+//! * [`parse_str`]`(text, name, overrides)` — TOML text, `name` standing for
+//!   the file in errors; an empty text is the built-in default experiment;
+//! * [`parse_table`]`(table, name, overrides)` — an in-memory
+//!   [`toml::Table`] (e.g. a Python dict converted key by key); errors carry
+//!   the key but no line;
+//! * [`read_text`]`(path)` — the file reading of [`load`], with the one
+//!   wording of a missing file every command uses (`FILE: no such file`).
+//!
+//! Then [`PlanarConfig::model`] builds the simulator's [`fbd_sim::Model`]
+//! (errors: the same [`ConfigError`]), [`PlanarConfig::params`] gives the
+//! raw [`fbd_sim::PlanarParams`], [`Config::to_toml`] the complete file
+//! (`config.toml`), and [`PlanarConfig::advice`] a hint for a failed run
+//! (a time step too large).
+//!
+//! ## One source of each rule
+//!
+//! The physical domain of every parameter (positive masses, lengths and
+//! Δt, gravity a magnitude, `0 ≤ μD ≤ μS`, stride ≥ 1, terrain values,
+//! controller gains) is checked by the simulator, [`fbd_sim::PlanarParams::validate`],
+//! whose errors name the `table.key`; this crate calls it (for either model)
+//! and adds the file. This crate checks what only the file knows: which keys
+//! a terrain kind or controller kind uses, the contact-point list, array
+//! lengths, joint ranges per key, and the hexapod's initial state.
+//!
+//! ## Errors point at the file
+//!
+//! Loading happens in two phases: the text is deserialized as written
+//! (errors carry `file:line:col`, and an unknown key suggests the closest
+//! known one), then optional dotted-key [`Override`]s are applied to the
+//! parsed [`toml::Table`] one at a time and the result deserialized again
+//! (errors name the override).
 
 use std::fmt;
 use std::path::Path;
@@ -128,10 +162,10 @@ impl ConfigError {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ModelKind {
-    /// The 7-DOF planar two-leg model (SPEC §1.4).
+    /// The 7-DOF planar two-leg model (legs 3 and 4 in the X–Y plane).
     #[default]
     Planar,
-    /// The 24-DOF hexapod (SPEC §1.3).
+    /// The 24-DOF hexapod.
     Hexapod,
 }
 
@@ -410,7 +444,7 @@ pub enum PointKind {
     Hips,
 }
 
-/// `[contact]` (an extension of SPEC §4).
+/// `[contact]` (an extension of the paper's model).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ContactConfig {
@@ -692,53 +726,39 @@ impl<I> ConfigFile<I> {
         self.terrain.resolve_kind();
     }
 
+    /// The simulator's parameters of the tables every model shares
+    /// (`[time]`, `[world]`, `[body]`, `[leg]`, `[terrain]`, `[contact]`,
+    /// `[output]`), with the default initial state and no control.
+    pub fn shared_params(&self) -> PlanarParams {
+        PlanarParams {
+            dt: self.time.dt,
+            duration: self.time.duration,
+            gravity: self.world.gravity,
+            body_mass: self.body.mass,
+            body_inertia: self.body.inertia,
+            side: self.body.side,
+            upper_length: self.leg.upper_length,
+            upper_mass: self.leg.upper_mass,
+            upper_inertia: self.leg.upper_inertia(),
+            upper_com: self.leg.upper_com,
+            lower_length: self.leg.lower_length,
+            lower_mass: self.leg.lower_mass,
+            lower_inertia: self.leg.lower_inertia(),
+            lower_com: self.leg.lower_com,
+            joint_limits: self.leg.joint_limits(),
+            terrain: self.terrain.terrain(),
+            friction: self.terrain.friction(),
+            contact_points: self.contact.contact_points(),
+            stride: self.output.stride,
+            ..PlanarParams::default()
+        }
+    }
+
     /// Checks the keys every model shares; errors name `table.key`.
     pub fn validate_common(&self, file: &str) -> Result<(), ConfigError> {
         let err = |key: &str, what: &str, got: &dyn fmt::Display, expected: &str| {
             Err(ConfigError::semantic(file, key, what, got, expected))
         };
-        let positive = |key: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                err(key, "must be positive and finite", &v, "a finite value > 0")
-            }
-        };
-        positive("time.dt", self.time.dt)?;
-        positive("time.duration", self.time.duration)?;
-        if self.time.dt > self.time.duration {
-            return err(
-                "time.dt",
-                "must not exceed time.duration",
-                &self.time.dt,
-                &format!("dt ≤ {}", self.time.duration),
-            );
-        }
-        if !(self.world.gravity.is_finite() && self.world.gravity >= 0.0) {
-            return err(
-                "world.gravity",
-                "is the magnitude g of gravity (which acts along −Y) and must be finite and ≥ 0",
-                &self.world.gravity,
-                "a finite value ≥ 0, e.g. 9.81",
-            );
-        }
-        positive("body.mass", self.body.mass)?;
-        positive("body.inertia", self.body.inertia)?;
-        positive("body.side", self.body.side)?;
-        positive("leg.upper_length", self.leg.upper_length)?;
-        positive("leg.upper_mass", self.leg.upper_mass)?;
-        positive("leg.upper_inertia", self.leg.upper_inertia())?;
-        positive("leg.lower_length", self.leg.lower_length)?;
-        positive("leg.lower_mass", self.leg.lower_mass)?;
-        positive("leg.lower_inertia", self.leg.lower_inertia())?;
-        for (key, v) in [
-            ("leg.upper_com", self.leg.upper_com),
-            ("leg.lower_com", self.leg.lower_com),
-        ] {
-            if !(v.is_finite() && (0.0..=1.0).contains(&v)) {
-                return err(key, "must lie on the link", &v, "a fraction in [0, 1]");
-            }
-        }
         for (key, [lo, hi]) in self.leg.limits_deg() {
             if !(lo.is_finite() && hi.is_finite() && lo < hi) {
                 return err(
@@ -760,23 +780,15 @@ impl<I> ConfigFile<I> {
             );
         }
         self.terrain.validate_kind(file)?;
-        let (ms, md) = (self.terrain.mu_static, self.terrain.mu_dynamic);
-        if !(ms.is_finite() && ms >= 0.0) {
-            return err(
-                "terrain.mu_static",
-                "must be finite and ≥ 0",
-                &ms,
-                "0 ≤ mu_static",
-            );
-        }
-        if !(md.is_finite() && md >= 0.0 && md <= ms) {
-            return err(
-                "terrain.mu_dynamic",
-                "must satisfy 0 ≤ mu_dynamic ≤ mu_static",
-                &md,
-                &format!("0 ≤ mu_dynamic ≤ {ms}"),
-            );
-        }
+        // The physical domains (positive masses, lengths and time step,
+        // gravity a magnitude, 0 ≤ μD ≤ μS, stride ≥ 1, …) have one source,
+        // the simulator's parameter check; the file is added here.
+        self.shared_params()
+            .validate()
+            .map_err(|e| ConfigError::Semantic {
+                file: file.to_owned(),
+                message: e.to_string(),
+            })?;
         if !self.contact.points.contains(&PointKind::Tips) {
             let got = format!(
                 "{:?}",
@@ -791,14 +803,6 @@ impl<I> ConfigFile<I> {
                 "must include the tips",
                 &got,
                 "a list containing \"tips\"",
-            );
-        }
-        if self.output.stride < 1 {
-            return err(
-                "output.stride",
-                "must be at least 1",
-                &self.output.stride,
-                "an integer ≥ 1",
             );
         }
         Ok(())
@@ -1265,6 +1269,37 @@ pub fn parse_str(text: &str, file: &str, overrides: &[Override]) -> Result<Confi
     Ok(config)
 }
 
+/// Builds a configuration from an in-memory TOML `table` (e.g. a Python
+/// dict converted key by key), named `file` in errors, then applies
+/// `overrides`, fills defaults and validates, as [`parse_str`]. A table
+/// has no lines: a key or type error is a [`ConfigError::Semantic`] whose
+/// message starts with the dotted key (`terrain: unknown field …`).
+/// A `[terrain] file` is relative to the working directory.
+pub fn parse_table(
+    table: &toml::Table,
+    file: &str,
+    overrides: &[Override],
+) -> Result<Config, ConfigError> {
+    let mut table = table.clone();
+    for o in overrides {
+        apply_override(&mut table, &o.key, o.value.clone()).map_err(|message| {
+            ConfigError::Override {
+                file: file.to_owned(),
+                key: o.key.clone(),
+                message,
+            }
+        })?;
+    }
+    let mut config = from_table(&table).map_err(|e| ConfigError::Semantic {
+        file: file.to_owned(),
+        message: describe(&e),
+    })?;
+    load_profile(&mut config, file)?;
+    config.resolve();
+    config.validate(file)?;
+    Ok(config)
+}
+
 /// Reads and parses the configuration file at `path` ([`parse_str`]).
 pub fn load(path: &Path) -> Result<Config, ConfigError> {
     load_with_overrides(path, &[])
@@ -1276,6 +1311,22 @@ pub fn load(path: &Path) -> Result<Config, ConfigError> {
 pub fn load_with_overrides(path: &Path, overrides: &[Override]) -> Result<Config, ConfigError> {
     let text = read_text(path)?;
     parse_str(&text, &path.display().to_string(), overrides)
+}
+
+/// The operating system's message without its `(os error N)` suffix and
+/// with a lower-case first letter, as every other message:
+/// `No such file or directory (os error 2)` → `no such file or directory`.
+pub fn os_message(e: &std::io::Error) -> String {
+    let s = e.to_string();
+    let s = match s.rfind(" (os error ") {
+        Some(i) if s.ends_with(')') => s[..i].to_owned(),
+        _ => s,
+    };
+    let mut c = s.chars();
+    match c.next() {
+        Some(first) => first.to_lowercase().chain(c).collect(),
+        None => s,
+    }
 }
 
 /// Reads the UTF-8 text file at `path` with the messages every command
@@ -1294,7 +1345,7 @@ pub fn read_text(path: &Path) -> Result<String, ConfigError> {
         Err(e) => {
             return Err(ConfigError::Io {
                 file,
-                what: e.to_string(),
+                what: os_message(&e),
             });
         }
         Ok(m) if m.is_dir() => {
@@ -1304,7 +1355,7 @@ pub fn read_text(path: &Path) -> Result<String, ConfigError> {
     }
     let bytes = std::fs::read(path).map_err(|e| ConfigError::Io {
         file: file.clone(),
-        what: e.to_string(),
+        what: os_message(&e),
     })?;
     String::from_utf8(bytes).map_err(|e| {
         unreadable(&format!(
@@ -1419,6 +1470,29 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("terrain.mu_dynamic"), "{e}");
+    }
+
+    #[test]
+    fn a_table_parses_as_its_text_does() {
+        let text = "[time]\ndt = 0.005\n[terrain]\nmu_static = 0.6\n";
+        let table: toml::Table = toml::from_str(text).unwrap();
+        let o = [Override::parse("body.mass = 7.0").unwrap()];
+        assert_eq!(
+            parse_table(&table, "<dict>", &o).unwrap(),
+            parse_str(text, "t.toml", &o).unwrap()
+        );
+        let bad: toml::Table = toml::from_str("[terrain]\nmu_statc = 0.6\n").unwrap();
+        let e = parse_table(&bad, "<dict>", &[]).unwrap_err().to_string();
+        assert!(
+            e.starts_with("<dict>: terrain: unknown field `mu_statc`, did you mean `mu_static`?"),
+            "{e}"
+        );
+        let neg: toml::Table = toml::from_str("[world]\ngravity = -1.0\n").unwrap();
+        let e = parse_table(&neg, "<dict>", &[]).unwrap_err().to_string();
+        assert!(
+            e.starts_with("<dict>: world.gravity: is the magnitude"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -65,6 +65,17 @@ pub struct Data {
     /// The trial states at which the whole step failed (for the error).
     pub(crate) failed_trial: Vec<ContactState>,
     pub(crate) failed_limits: Vec<LimitState>,
+    /// The state search's least inconsistent trial so far (see
+    /// `step::violation`): its violation (N), unknowns and states.
+    pub(crate) best_violation: f64,
+    pub(crate) best_z: Vec<f64>,
+    pub(crate) best_trial: Vec<ContactState>,
+    pub(crate) best_limits: Vec<LimitState>,
+    /// State searches that cycled and were closed by their least
+    /// inconsistent trial.
+    pub resolved_cycles: usize,
+    /// Set while solving the finest substeps of a retried step.
+    pub(crate) last_resort: bool,
 }
 
 impl Data {
@@ -105,6 +116,12 @@ impl Data {
             grid_events: [0, 0],
             failed_trial: model.initial_states.clone(),
             failed_limits: vec![LimitState::Free; lay.limits],
+            best_violation: f64::INFINITY,
+            best_z: vec![0.0; lay.dim()],
+            best_trial: model.initial_states.clone(),
+            best_limits: vec![LimitState::Free; lay.limits],
+            resolved_cycles: 0,
+            last_resort: false,
         }
     }
 

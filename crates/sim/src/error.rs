@@ -6,7 +6,7 @@ use fbd_solver::SolverError;
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SimError {
     /// A parameter is out of its domain. `key` is the configuration key
-    /// (SPEC §4), e.g. `leg.upper_mass`.
+    /// (docs/reference.md), e.g. `leg.upper_mass`.
     #[error("{key}: {what} (got {got}, expected {expected})")]
     InvalidParameter {
         /// Dotted configuration key.

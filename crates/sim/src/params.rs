@@ -24,7 +24,7 @@ pub struct PlanarParams {
     /// Central body inertia about Z through R (kg·m²). Default 0.3.
     pub body_inertia: f64,
     /// Side `L` of the hexagonal body; hips at `d = L·cos(π/6)` (m).
-    /// Default 0.25 (the SPEC §1.4 test geometry).
+    /// Default 0.25 (the docs/reference.md test geometry).
     pub side: f64,
     /// Upper link length `a` (m). Default 0.2.
     pub upper_length: f64,

@@ -32,7 +32,7 @@ pub const MAX_CONTACTS: usize = 6;
 pub const MAX_JOINTS: usize = 4;
 
 /// Everything known about step `k` once it is solved. Row `k` of
-/// `trajectory.csv` (SPEC §6).
+/// `trajectory.csv` (docs/reference.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepRecord {
     /// Step index k.

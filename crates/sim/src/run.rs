@@ -25,6 +25,9 @@ pub struct RunSummary {
     pub limit_events: Vec<LimitEvent>,
     /// Steps that were solved in substeps (see [`crate::step`]).
     pub retries: Vec<RetryEvent>,
+    /// State searches that cycled and were closed by their least
+    /// inconsistent combination (see [`crate::step`]).
+    pub resolved_cycles: usize,
     /// `true` when the `stop` flag of [`run_until`] ended the run before
     /// its last step (the steps solved so far are valid).
     pub interrupted: bool,
@@ -88,6 +91,7 @@ pub fn run_until(
         error,
         limit_events: data.limit_events,
         retries: data.retries,
+        resolved_cycles: data.resolved_cycles,
         interrupted,
     }
 }

@@ -18,11 +18,12 @@ use crate::CliError;
 use crate::config::{Config, HexapodConfig};
 use crate::output;
 use crate::steptime::StepTimes;
+use crate::viewer::hexapod::{HexFrame, HexapodScene};
 
 pub use plots::{GaitPlotData, footprints_svg, gait_svg, joints_svg};
 
 /// The files a hexapod run writes, in order.
-pub const FILES: [&str; 7] = [
+pub const FILES: [&str; 8] = [
     "trajectory.csv",
     "events.csv",
     "summary.json",
@@ -30,6 +31,7 @@ pub const FILES: [&str; 7] = [
     "gait.svg",
     "footprints.svg",
     "joints.svg",
+    "viewer.html",
 ];
 
 /// The columns of the hexapod `trajectory.csv`, in order: `t`, the body
@@ -157,13 +159,19 @@ impl Writer {
     }
 }
 
+/// A scheduled event time for the files: `(k + φ)·T` rounded to 1e-12 s,
+/// so that `1.7999999999999998` reads `1.8`.
+fn tidy(t: f64) -> f64 {
+    (t * 1e12).round() / 1e12
+}
+
 /// `events.csv` of a hexapod run: `t, leg, event, margin` (`leg` empty for
 /// the stability events).
 pub fn events_csv(events: &[GaitEvent]) -> String {
     let mut s = String::from("t,leg,event,margin\n");
     let mut b = ryu::Buffer::new();
     for e in events {
-        s.push_str(b.format(e.t));
+        s.push_str(b.format(tidy(e.t)));
         s.push(',');
         if let Some(l) = e.leg {
             s.push_str(&l.to_string());
@@ -304,7 +312,7 @@ fn summary(model: &GaitModel, stride: usize, rows: usize, s: &GaitSummary) -> He
             .events
             .iter()
             .map(|e| EventJson {
-                t: e.t,
+                t: tidy(e.t),
                 leg: e.leg,
                 event: e.kind.as_str(),
                 margin: finite(e.margin),
@@ -338,9 +346,17 @@ pub fn simulate(
     let stride = h.output.stride.max(1);
     let mut traj = Writer::create(out_dir, model.dt)?;
     let mut plot = GaitPlotData::new(&model);
+    // viewer.html: one frame per trajectory row (decimated when long).
+    let mut view = HexapodScene::new(
+        model.kin.clone(),
+        model.surface.clone(),
+        model.steps.div_ceil(stride),
+        &crate::viewer::title_of(out_dir),
+    );
     let run = run_gait(&model, stop, |d: &GaitData| {
         if d.step.is_multiple_of(stride) {
             traj.write(d);
+            view.push(&HexFrame::of_gait(d));
         }
         plot.push(d);
     });
@@ -362,9 +378,9 @@ pub fn simulate(
     let s = summary(&model, stride, rows, &run);
     let json =
         serde_json::to_string_pretty(&s).map_err(|e| CliError::Io(format!("summary.json: {e}")));
-    keep(json.and_then(|j| {
-        output::write_file(out_dir, "summary.json", format!("{j}\n").as_bytes())
-    }));
+    keep(
+        json.and_then(|j| output::write_file(out_dir, "summary.json", format!("{j}\n").as_bytes())),
+    );
     keep(output::write_file(
         out_dir,
         "config.toml",
@@ -380,6 +396,7 @@ pub fn simulate(
                 .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
         );
     }
+    keep(crate::viewer::write(out_dir, &view.finish()));
     Ok(HexapodRun {
         run,
         summary: s,

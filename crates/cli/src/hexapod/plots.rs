@@ -70,9 +70,9 @@ impl GaitPlotData {
     /// Records one step.
     pub fn push(&mut self, d: &GaitData) {
         let stance = d.stance();
-        for leg in 0..LEGS {
+        for (leg, &down) in stance.iter().enumerate() {
             let s = &mut self.stance[leg];
-            if stance[leg] {
+            if down {
                 if d.step > 0 && self.was_stance[leg] {
                     if let Some(last) = s.last_mut() {
                         last[1] = d.t;
@@ -158,9 +158,11 @@ pub fn gait_svg(d: &GaitPlotData) -> PlotResult {
                 )))
                 .map_err(err)?;
             chart
-                .draw_series(d.stance[leg].iter().map(|s| {
-                    Rectangle::new([(s[0], y0), (s[1].max(s[0]), y1)], BLACK.filled())
-                }))
+                .draw_series(
+                    d.stance[leg].iter().map(|s| {
+                        Rectangle::new([(s[0], y0), (s[1].max(s[0]), y1)], BLACK.filled())
+                    }),
+                )
                 .map_err(err)?;
         }
         root.present().map_err(err)?;
@@ -214,7 +216,9 @@ pub fn footprints_svg(d: &GaitPlotData) -> PlotResult {
                 let mut pts: Vec<(f64, f64)> = s.hull.iter().map(|p| (p[0], p[1])).collect();
                 pts.push(pts[0]);
                 let style = RGBColor(120, 120, 120).stroke_width(1);
-                let drawn = chart.draw_series(LineSeries::new(pts, style)).map_err(err)?;
+                let drawn = chart
+                    .draw_series(LineSeries::new(pts, style))
+                    .map_err(err)?;
                 if i == 0 {
                     drawn
                         .label("support polygon")
@@ -229,9 +233,9 @@ pub fn footprints_svg(d: &GaitPlotData) -> PlotResult {
                 )))
                 .map_err(err)?;
             if i == 0 {
-                drawn.label("centre of mass").legend(|(x, y)| {
-                    Cross::new((x + 10, y), 5, BLACK.stroke_width(2))
-                });
+                drawn
+                    .label("centre of mass")
+                    .legend(|(x, y)| Cross::new((x + 10, y), 5, BLACK.stroke_width(2)));
             }
         }
         chart
@@ -245,10 +249,7 @@ pub fn footprints_svg(d: &GaitPlotData) -> PlotResult {
         for (leg, f) in d.footholds.iter().enumerate() {
             let c = LEG_COLORS[leg];
             chart
-                .draw_series(
-                    f.iter()
-                        .map(|p| Circle::new((p[0], p[1]), 3, c.filled())),
-                )
+                .draw_series(f.iter().map(|p| Circle::new((p[0], p[1]), 3, c.filled())))
                 .map_err(err)?
                 .label(format!("foot {}", leg + 1))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 3, c.filled()));
@@ -285,8 +286,7 @@ pub fn joints_svg(d: &GaitPlotData) -> PlotResult {
                 .light_line_style(WHITE.mix(0.0))
                 .draw()
                 .map_err(err)?;
-            for leg in 0..LEGS {
-                let c = LEG_COLORS[leg];
+            for (leg, &c) in LEG_COLORS.iter().enumerate() {
                 chart
                     .draw_series(LineSeries::new(
                         d.t.iter().zip(&d.theta[j][leg]).map(|(a, b)| (*a, *b)),

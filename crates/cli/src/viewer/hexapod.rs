@@ -9,13 +9,13 @@
 //! [`HexapodScene::push`], then [`HexapodScene::finish`] and
 //! [`super::write`]; `fbd view DIR` does the same from the CSV.
 
-use fbd_contact::Terrain;
+use fbd_contact::Surface;
 use fbd_kinematics::body::{GAMMA_DEG, LEG_COUNT};
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
 
 use super::{
     Curve, Decimator, EventMark, Line, Marker, Panel, Scene, SceneKind, round, round_time,
-    terrain_view, value,
+    surface_view, value,
 };
 
 /// One row of a hexapod run.
@@ -33,6 +33,32 @@ pub struct HexFrame {
     pub margin: Option<f64>,
 }
 
+impl HexFrame {
+    /// The frame of one step of a kinematic gait run.
+    pub fn of_gait(d: &fbd_sim::gait::GaitData) -> Self {
+        let mut q = [0.0; NQ];
+        let b = &d.body;
+        q[..6].copy_from_slice(&[
+            b.position.x,
+            b.position.y,
+            b.position.z,
+            b.phi.x,
+            b.phi.y,
+            b.phi.z,
+        ]);
+        for (leg, l) in d.legs.iter().enumerate() {
+            q[6 + 3 * leg..9 + 3 * leg].copy_from_slice(&l.theta);
+        }
+        Self {
+            t: d.t,
+            q,
+            stance: d.stance(),
+            com: [d.com.x, d.com.y, d.com.z],
+            margin: d.margin.is_finite().then_some(d.margin),
+        }
+    }
+}
+
 /// Points per leg in the layout: hip, knee, foot.
 const PER_LEG: usize = 3;
 /// Index of leg `leg`'s first point (the hip): after the body centre and
@@ -44,7 +70,7 @@ const fn leg_point(leg: usize, k: usize) -> usize {
 /// Builds the scene of a hexapod run row by row.
 pub struct HexapodScene {
     model: HexapodModel,
-    terrain: Terrain,
+    surface: Surface,
     data: HexapodData,
     decimator: Decimator,
     rows_planned: usize,
@@ -61,9 +87,9 @@ pub struct HexapodScene {
 }
 
 impl HexapodScene {
-    /// A scene of `model` over `terrain`, expecting about `rows_planned`
+    /// A scene of `model` over `surface`, expecting about `rows_planned`
     /// rows (the last pushed row is always kept).
-    pub fn new(model: HexapodModel, terrain: Terrain, rows_planned: usize, title: &str) -> Self {
+    pub fn new(model: HexapodModel, surface: Surface, rows_planned: usize, title: &str) -> Self {
         let mut points = vec!["body".to_owned()];
         points.extend((1..=LEG_COUNT).map(|k| format!("corner{k}")));
         let mut lines: Vec<Line> = (0..LEG_COUNT)
@@ -109,7 +135,7 @@ impl HexapodScene {
         };
         Self {
             model,
-            terrain,
+            surface,
             data: HexapodData::new(),
             decimator: Decimator::new(rows_planned),
             rows_planned,
@@ -190,7 +216,7 @@ impl HexapodScene {
         }
         let mut s = std::mem::take(&mut self.scene);
         s.rows = self.rows;
-        s.terrain = terrain_view(&self.terrain, &s.p);
+        s.terrain = surface_view(&self.surface, &s.p);
         for k in 1..s.state.len() {
             let (a, b) = (s.state[k - 1].as_bytes(), s.state[k].as_bytes());
             for leg in 0..LEG_COUNT.min(a.len()).min(b.len()) {

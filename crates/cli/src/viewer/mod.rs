@@ -89,6 +89,22 @@ pub enum TerrainView {
         /// Flattened samples (m).
         xy: Vec<f64>,
     },
+    /// Heights `y = ϱ(x, z)` on an `n × n` grid over `[x0, x1] × [z0, z1]`,
+    /// row by row (z outer, x inner) (hexapod).
+    Grid {
+        /// Grid corners (m).
+        x0: f64,
+        /// Grid corners (m).
+        x1: f64,
+        /// Grid corners (m).
+        z0: f64,
+        /// Grid corners (m).
+        z1: f64,
+        /// Samples per side.
+        n: usize,
+        /// Heights (m).
+        y: Vec<f64>,
+    },
     /// No ground (the default).
     #[default]
     None,
@@ -206,6 +222,49 @@ pub(crate) fn terrain_view(terrain: &fbd_contact::Terrain, p: &[Vec<f64>]) -> Te
     TerrainView::Profile { xy }
 }
 
+/// Samples per side of a [`TerrainView::Grid`].
+const GRID_SAMPLES: usize = 61;
+
+/// The surface `y = ϱ(x, z)` over the x–z range of the frames' points
+/// (`p`, `[x, y, z, …]` per frame), widened by 0.6 m on every side.
+pub(crate) fn surface_view(surface: &fbd_contact::Surface, p: &[Vec<f64>]) -> TerrainView {
+    if !surface.exists() {
+        return TerrainView::None;
+    }
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for c in p.iter().flat_map(|p| p.chunks(3)) {
+        for (k, v) in [c[0], c[2]].into_iter().enumerate() {
+            lo[k] = lo[k].min(v);
+            hi[k] = hi[k].max(v);
+        }
+    }
+    if lo[0] > hi[0] {
+        (lo, hi) = ([-1.0; 2], [1.0; 2]);
+    }
+    // A square grid: the longer side sets the spacing.
+    let half = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 0.6;
+    let (cx, cz) = (0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]));
+    let (x0, x1, z0, z1) = (cx - half, cx + half, cz - half, cz + half);
+    let n = GRID_SAMPLES;
+    let at = |a: f64, b: f64, i: usize| a + (b - a) * i as f64 / (n - 1) as f64;
+    let mut y = Vec::with_capacity(n * n);
+    for j in 0..n {
+        for i in 0..n {
+            let h = surface.height(at(x0, x1, i), at(z0, z1, j));
+            y.push(round(if h.is_finite() { h } else { 0.0 }));
+        }
+    }
+    TerrainView::Grid {
+        x0: round(x0),
+        x1: round(x1),
+        z0: round(z0),
+        z1: round(z1),
+        n,
+        y,
+    }
+}
+
 /// A time rounded to the nanosecond: `k·Δt` computed in floating point
 /// and the decimal read back from `trajectory.csv` give the same value.
 pub(crate) fn round_time(t: f64) -> f64 {
@@ -315,6 +374,14 @@ const BODY_HTML: &str = r#"<header><h1 id="title">fbd viewer</h1><span id="info"
 <div id="panels"></div>
 </main>
 "#;
+
+/// The page title of a run written to `dir`: the folder's name.
+pub fn title_of(dir: &Path) -> String {
+    dir.file_name().map_or_else(
+        || dir.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
 
 /// Writes `dir/viewer.html` all-or-nothing.
 pub fn write(dir: &Path, scene: &Scene) -> Result<PathBuf, CliError> {

@@ -31,7 +31,8 @@ pub struct PlanarScene<'a> {
     decimator: Decimator,
     rows_planned: usize,
     rows: usize,
-    last_state: Option<String>,
+    /// Contact states of the previous row (no allocation per row).
+    last_state: Option<[StateCode; fbd_sim::record::MAX_CONTACTS]>,
     /// The last row pushed, when it is not a frame (kept by `finish`).
     pending: Option<(usize, StepRecord)>,
     /// Indices into the chains' points of the drawn points, in order.
@@ -158,24 +159,25 @@ impl<'a> PlanarScene<'a> {
         let row = self.rows;
         self.rows += 1;
         let nc = self.scene.contacts.len();
-        let state: String = r.state[..nc].iter().map(|s| digit(*s)).collect();
         for (c, s) in r.state[..nc].iter().enumerate() {
             self.touched[c] |= *s != StateCode::St1;
         }
         self.torques_used |= r.torque.iter().any(|t| *t != 0.0);
-        let changed = self.last_state.as_ref().is_some_and(|s| *s != state);
+        let changed = self.last_state.is_some_and(|s| s[..nc] != r.state[..nc]);
         let last = row + 1 >= self.rows_planned;
         let keep = self.decimator.keep(row, changed, last);
-        self.last_state = Some(state.clone());
+        self.last_state = Some(r.state);
         if keep {
-            self.frame(row, r, state);
+            self.frame(row, r);
             self.pending = None;
         } else {
             self.pending = Some((row, *r));
         }
     }
 
-    fn frame(&mut self, row: usize, r: &StepRecord, state: String) {
+    fn frame(&mut self, row: usize, r: &StepRecord) {
+        let nc = self.scene.contacts.len();
+        let state: String = r.state[..nc].iter().map(|s| digit(*s)).collect();
         let chains = &self.model.mech.chains;
         chains.eval_positions(&r.q, &mut self.kin);
         let pos = &self.kin.pos;
@@ -234,9 +236,7 @@ impl<'a> PlanarScene<'a> {
     /// Completes the scene: terrain, events, panels.
     pub fn finish(mut self, events: &[Event]) -> Scene {
         if let Some((row, r)) = self.pending.take() {
-            let nc = self.scene.contacts.len();
-            let state = r.state[..nc].iter().map(|s| digit(*s)).collect();
-            self.frame(row, &r, state);
+            self.frame(row, &r);
         }
         let mut s = std::mem::take(&mut self.scene);
         s.rows = self.rows;

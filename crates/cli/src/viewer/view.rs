@@ -8,14 +8,13 @@ use std::path::{Path, PathBuf};
 
 use fbd_contact::StateCode;
 use fbd_kinematics::body::LEG_COUNT;
-use fbd_kinematics::hexapod::{HexapodModel, NQ};
-use fbd_kinematics::leg::LegGeometry;
+use fbd_kinematics::hexapod::NQ;
 use fbd_sim::{Event, Model, StepRecord};
 
 use super::hexapod::{HexFrame, HexapodScene};
 use super::planar::PlanarScene;
 use crate::CliError;
-use crate::config::{self, Config, HexapodConfig};
+use crate::config::{self, Config};
 
 /// The columns of a `trajectory.csv`, by name.
 struct Table {
@@ -81,7 +80,7 @@ fn state(s: &str) -> Option<StateCode> {
     }
 }
 
-/// Contact columns of a point: `state3, fa3, n3` for the tips (SPEC's
+/// Contact columns of a point: `state3, fa3, n3` for the tips (the contract's
 /// names), `knee3_state, knee3_fa, knee3_n` for the others.
 fn contact_columns(name: &str) -> [String; 3] {
     match name.strip_prefix("tip") {
@@ -252,8 +251,8 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
             };
         }
         if let Some(c) = &com {
-            for k in 0..3 {
-                f.com[k] = table.number(row, r, c[k])?;
+            for (v, &col) in f.com.iter_mut().zip(c) {
+                *v = table.number(row, r, col)?;
             }
         } else {
             f.com = [f.q[0], f.q[1], f.q[2]];
@@ -265,19 +264,6 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
         out.push(f);
     }
     Ok(out)
-}
-
-/// The geometry of a hexapod configuration.
-pub fn hexapod_model(c: &HexapodConfig) -> HexapodModel {
-    HexapodModel::new(
-        c.body.side,
-        LegGeometry {
-            a: c.leg.upper_length,
-            c: c.leg.lower_length,
-        },
-        c.leg.upper_com,
-        c.leg.lower_com,
-    )
 }
 
 /// Writes `dir/viewer.html` from the files of a finished run; returns its
@@ -293,7 +279,7 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
     let config = config::load(&config_file)?;
     let source = config_file.display().to_string();
     let traj = dir.join("trajectory.csv");
-    let title = dir.display().to_string();
+    let title = super::title_of(dir);
     let scene = match &config {
         Config::Planar(c) => {
             let model = c.model(&source)?;
@@ -307,10 +293,9 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
             scene.finish(&events)
         }
         Config::Hexapod(c) => {
-            c.validate(&source)?;
+            let model = c.gait_model(&source)?;
             let frames = hexapod_frames(&traj)?;
-            let mut scene =
-                HexapodScene::new(hexapod_model(c), c.terrain.terrain(), frames.len(), &title);
+            let mut scene = HexapodScene::new(model.kin, model.surface, frames.len(), &title);
             for f in &frames {
                 scene.push(f);
             }

@@ -298,7 +298,11 @@ impl BodyPlan {
         }
         // Sway σ = sway·s·sin(2πt/T) along l(ψ).
         let w = std::f64::consts::TAU / p.period;
-        let (ss, sc) = (w * t).sin_cos();
+        let (ss, sc) = if p.sway == 0.0 {
+            (0.0, 1.0)
+        } else {
+            (w * t).sin_cos()
+        };
         let sig = p.sway * s.0 * ss;
         let sigd = p.sway * (s.1 * ss + s.0 * w * sc);
         let sigdd = p.sway * (s.2 * ss + 2.0 * s.1 * w * sc - s.0 * w * w * ss);
@@ -314,8 +318,13 @@ impl BodyPlan {
         let m = rot_y(psi - self.psi0) * self.rot0;
         let (pt, ptd, ptdd) = (p.pitch * on.0, p.pitch * on.1, p.pitch * on.2);
         let (rt, rtd, rtdd) = (-p.roll * on.0, -p.roll * on.1, -p.roll * on.2);
-        let rx = rot_x(pt);
-        let rotation = m * rx * rot_z(rt);
+        let tilted = p.pitch != 0.0 || p.roll != 0.0;
+        let rx = if tilted {
+            rot_x(pt)
+        } else {
+            Matrix3::identity()
+        };
+        let rotation = if tilted { m * rx * rot_z(rt) } else { m };
         let y = Vector3::y();
         let xz = rx * Vector3::z();
         let inner = ptd * Vector3::x() + rtd * xz;

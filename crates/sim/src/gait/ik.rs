@@ -15,14 +15,15 @@
 //!
 //! then by the constant mount rotation `cA0i⁻¹` (eq. 5), and solved by
 //! [`fbd_kinematics::ik::leg_ik`] and
-//! [`fbd_kinematics::leg_jacobian::joint_accelerations`].
+//! [`fbd_kinematics::leg_jacobian::joint_accelerations_trig`] (the joint
+//! sines and cosines from the solution, one `sin_cos` per leg).
 
 use std::f64::consts::TAU;
 
 use fbd_kinematics::KinematicsError;
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::ik::{KneeBranch, leg_ik};
-use fbd_kinematics::leg_jacobian::joint_accelerations;
+use fbd_kinematics::leg_jacobian::{LegTrig, joint_accelerations_trig};
 use fbd_kinematics::limits::{Joint, JointLimits};
 use fbd_kinematics::nalgebra::Vector3;
 
@@ -107,8 +108,9 @@ pub fn solve_leg(
     for k in 0..3 {
         theta[k] = nearest(theta[k], previous[k]);
     }
+    let trig = LegTrig::of_solution(geom, theta, &p0);
     let (rate, accel) =
-        joint_accelerations(geom, theta, &v0, &a0).map_err(|s| GaitError::Singular {
+        joint_accelerations_trig(geom, &trig, &v0, &a0).map_err(|s| GaitError::Singular {
             leg: number,
             t,
             what: format!(

@@ -9,6 +9,7 @@ use fbd_kinematics::pose::BodyPose;
 
 use super::body::{BodyPlan, BodyState};
 use super::error::GaitError;
+use super::foothold::foothold;
 use super::ik::LegJoints;
 use super::params::{GaitParams, LEGS};
 use super::schedule::{LegPhase, last_swing};
@@ -65,6 +66,9 @@ pub struct GaitModel {
     pub branches: [KneeBranch; LEGS],
     /// Index of the last swing of every leg (cached from the schedule).
     pub last_swing: [Option<usize>; LEGS],
+    /// The foothold of every swing of every leg within the run
+    /// ([`super::foothold::foothold`], computed once).
+    pub footholds: [Vec<Vector3<f64>>; LEGS],
 }
 
 impl GaitModel {
@@ -121,7 +125,24 @@ impl GaitModel {
         let branches = initial.joints.map(|j| KneeBranch::of(j[2]));
         let until = params.walk_time.min(duration + params.period) + 2.0 * dt;
         let plan = BodyPlan::new(&params, &surface, r0, pose.phi, dt, until);
-        let last_swing = std::array::from_fn(|i| last_swing(&params, i));
+        let last_swing: [Option<usize>; LEGS] = std::array::from_fn(|i| last_swing(&params, i));
+        let swings_in_run = (duration / params.period).ceil() as usize + 2;
+        let footholds = std::array::from_fn(|leg| {
+            let n = last_swing[leg].map_or(0, |l| l.saturating_add(1).min(swings_in_run));
+            (0..n)
+                .map(|k| {
+                    foothold(
+                        &params,
+                        &plan,
+                        &surface,
+                        initial.phi[1],
+                        neutral[leg],
+                        leg,
+                        k,
+                    )
+                })
+                .collect()
+        });
         Ok(Self {
             kin,
             params,
@@ -135,6 +156,7 @@ impl GaitModel {
             neutral,
             branches,
             last_swing,
+            footholds,
         })
     }
 

@@ -104,7 +104,7 @@ pub fn phase_with(p: &GaitParams, leg: usize, last: Option<usize>, t: f64) -> Le
     // that instant: `k·Δt` rarely equals `(k' + φ)·T` to the last bit.
     let k = ((since / p.period + SNAP).floor() as usize).min(last);
     let u = (t - liftoff_time(p, leg, k)) / p.swing_time();
-    if u >= -SNAP && u < 1.0 - SNAP {
+    if (-SNAP..1.0 - SNAP).contains(&u) {
         LegPhase::Swing { k, u: u.max(0.0) }
     } else if u < 0.0 {
         // Round-off just before a lift-off: still standing after k − 1.

@@ -7,7 +7,6 @@ use fbd_kinematics::nalgebra::Vector3;
 use fbd_kinematics::pose::BodyPose;
 
 use super::error::GaitError;
-use super::foothold::foothold;
 use super::ik::solve_leg;
 use super::model::{GaitData, GaitModel};
 use super::params::LEGS;
@@ -20,15 +19,7 @@ use super::swing::swing;
 pub fn anchor(model: &GaitModel, leg: usize, k: Option<usize>) -> Vector3<f64> {
     match k {
         None => model.initial_feet[leg],
-        Some(k) => foothold(
-            &model.params,
-            &model.plan,
-            &model.surface,
-            model.initial.phi[1],
-            model.neutral[leg],
-            leg,
-            k,
-        ),
+        Some(k) => model.footholds[leg][k],
     }
 }
 

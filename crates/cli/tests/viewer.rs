@@ -1,0 +1,310 @@
+//! `viewer.html` and the plots of `fbd run`, end to end: the page embeds
+//! what `trajectory.csv` says (positions, states, forces), `fbd view DIR`
+//! rebuilds the same page from the files, long runs are decimated keeping
+//! every state change, and the plots show every contact point that
+//! touched. The drawing itself is tested in a real browser by
+//! `scripts/test-browser.sh`.
+
+mod common;
+
+use common::{example, fbd, s, stderr, write};
+use std::collections::HashMap;
+use std::path::Path;
+
+/// The scene JSON embedded in `dir/viewer.html`.
+fn scene(dir: &Path) -> serde_json::Value {
+    let page = std::fs::read_to_string(dir.join("viewer.html")).unwrap();
+    let start = r#"<script id="fbd-scene" type="application/json">"#;
+    let a = page.find(start).expect("the scene element") + start.len();
+    let b = a + page[a..].find("</script>").unwrap();
+    serde_json::from_str(&page[a..b].replace("<\\/", "</")).unwrap()
+}
+
+/// `trajectory.csv` as a header index and rows of fields.
+fn csv(dir: &Path) -> (HashMap<String, usize>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .enumerate()
+        .map(|(i, h)| (h.to_owned(), i))
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(str::to_owned).collect())
+        .collect();
+    (header, rows)
+}
+
+fn f(v: &serde_json::Value) -> f64 {
+    v.as_f64().unwrap()
+}
+
+/// Index of the drawn point `name` in the scene.
+fn point(scene: &serde_json::Value, name: &str) -> usize {
+    scene["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|p| p == name)
+        .unwrap_or_else(|| panic!("no drawn point {name}"))
+}
+
+/// Drawn position of point `i` at frame `k`.
+fn at(scene: &serde_json::Value, k: usize, i: usize) -> [f64; 3] {
+    let p = &scene["p"][k];
+    [f(&p[3 * i]), f(&p[3 * i + 1]), f(&p[3 * i + 2])]
+}
+
+/// Checks the page against the CSV for a planar run; returns the frames.
+fn check_planar(dir: &Path) -> usize {
+    let sc = scene(dir);
+    let (h, rows) = csv(dir);
+    let n = sc["t"].as_array().unwrap().len();
+    assert_eq!(sc["rows"].as_u64().unwrap() as usize, rows.len());
+    let contacts: Vec<(String, usize)> = sc["contacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| {
+            (
+                c["name"].as_str().unwrap().to_owned(),
+                c["point"].as_u64().unwrap() as usize,
+            )
+        })
+        .collect();
+    let (tip3, tip4, body) = (point(&sc, "tip3"), point(&sc, "tip4"), point(&sc, "body"));
+    let col = |row: &[String], name: &str| -> f64 { row[h[name]].parse().unwrap() };
+    for k in 0..n {
+        let r = sc["row"][k].as_u64().unwrap() as usize;
+        let row = &rows[r];
+        let t = col(row, "t");
+        assert!((f(&sc["t"][k]) - t).abs() < 1e-9, "frame {k}: time");
+        for (p, x, y) in [
+            (tip3, "tip3_x", "tip3_y"),
+            (tip4, "tip4_x", "tip4_y"),
+            (body, "rx", "ry"),
+        ] {
+            let d = at(&sc, k, p);
+            assert!(
+                (d[0] - col(row, x)).abs() < 1e-6 && (d[1] - col(row, y)).abs() < 1e-6,
+                "frame {k} (row {r}): {x} drawn at {d:?}, trajectory.csv has ({}, {})",
+                col(row, x),
+                col(row, y)
+            );
+        }
+        // States and forces of every contact point: the drawn force,
+        // projected on the flat ground's tangent and normal, is (fa, n).
+        let states = sc["state"][k].as_str().unwrap().as_bytes();
+        for (c, (name, _)) in contacts.iter().enumerate() {
+            let (s, fa, nn) = match name.strip_prefix("tip") {
+                Some(l) => (format!("state{l}"), format!("fa{l}"), format!("n{l}")),
+                None => (
+                    format!("{name}_state"),
+                    format!("{name}_fa"),
+                    format!("{name}_n"),
+                ),
+            };
+            assert_eq!(
+                format!("ST{}", states[c] as char),
+                row[h[&s]],
+                "frame {k}: state of {name}"
+            );
+            let fx = f(&sc["fc"][k][3 * c]);
+            let fy = f(&sc["fc"][k][3 * c + 1]);
+            assert!(
+                (fx - col(row, &fa)).abs() < 1e-5 && (fy - col(row, &nn)).abs() < 1e-5,
+                "frame {k}: force on {name} drawn ({fx}, {fy}), trajectory.csv ({}, {})",
+                col(row, &fa),
+                col(row, &nn)
+            );
+        }
+    }
+    n
+}
+
+#[test]
+fn default_run_page_shows_every_row_as_the_csv_has_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = fbd(&["run", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, rows) = csv(&out);
+    assert_eq!(check_planar(&out), rows.len());
+    let sc = scene(&out);
+    // Every contact event of events.csv is marked, at its frame.
+    let events = std::fs::read_to_string(out.join("events.csv")).unwrap();
+    let contact_events = events
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(2).is_some_and(|s| s.starts_with("ST")))
+        .count();
+    assert_eq!(sc["events"].as_array().unwrap().len(), contact_events);
+    for e in sc["events"].as_array().unwrap() {
+        let k = e["frame"].as_u64().unwrap() as usize;
+        assert!((f(&sc["t"][k]) - f(&e["t"])).abs() < 1e-9, "{e}");
+    }
+    // The page is self-contained: no external script, style or fetch.
+    let page = std::fs::read_to_string(out.join("viewer.html")).unwrap();
+    // (The browser test checks that it makes no request at all.)
+    for bad in ["<script src", "<link", "<img", "<iframe", "@import"] {
+        assert!(!page.contains(bad), "viewer.html contains {bad}");
+    }
+}
+
+#[test]
+fn fbd_view_rebuilds_the_same_page_from_the_files() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, name) in [
+        (vec!["run"], "planar"),
+        (vec!["run", &example("pd_stand.toml")], "pd"),
+        (vec!["run", &example("hexapod_tripod.toml")], "hexapod"),
+    ] {
+        let out = dir.path().join(name);
+        let mut a = args.clone();
+        a.extend(["--out", s(&out)]);
+        let o = fbd(&a);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let written = std::fs::read(out.join("viewer.html")).unwrap();
+        std::fs::remove_file(out.join("viewer.html")).unwrap();
+        let o = fbd(&["view", s(&out)]);
+        assert!(o.status.success(), "{name}: {}", stderr(&o));
+        let rebuilt = std::fs::read(out.join("viewer.html")).unwrap();
+        assert!(
+            written == rebuilt,
+            "{name}: fbd view wrote a different page"
+        );
+    }
+}
+
+#[test]
+fn hexapod_page_draws_the_feet_where_the_csv_has_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("hexapod");
+    let o = fbd(&["run", &example("hexapod_tripod.toml"), "--out", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sc = scene(&out);
+    let (h, rows) = csv(&out);
+    let n = sc["t"].as_array().unwrap().len();
+    assert_eq!(n, rows.len());
+    let col = |row: &[String], name: &str| -> f64 { row[h[name]].parse().unwrap() };
+    let feet: Vec<usize> = (1..=6).map(|l| point(&sc, &format!("foot{l}"))).collect();
+    for k in 0..n {
+        let row = &rows[k];
+        for (l, &p) in feet.iter().enumerate() {
+            let d = at(&sc, k, p);
+            for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+                let want = col(row, &format!("foot{}_{axis}", l + 1));
+                assert!(
+                    (d[a] - want).abs() < 1e-6,
+                    "frame {k}: foot{} {axis} drawn {} (trajectory.csv {want})",
+                    l + 1,
+                    d[a]
+                );
+            }
+            let stance = row[h[&format!("stance{}", l + 1)]] == "1";
+            let drawn = sc["state"][k].as_str().unwrap().as_bytes()[l] == b'2';
+            assert_eq!(stance, drawn, "frame {k}: stance of leg {}", l + 1);
+        }
+    }
+}
+
+#[test]
+fn long_runs_are_decimated_keeping_every_state_change() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "long.toml", "[time]\nduration = 25.0\n");
+    let out = dir.path().join("out");
+    let o = fbd(&["run", s(&cfg), "--out", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let sc = scene(&out);
+    let (h, rows) = csv(&out);
+    assert!(
+        rows.len() > fbd_cli::viewer::MAX_FRAMES,
+        "{} rows",
+        rows.len()
+    );
+    let frames: Vec<usize> = sc["row"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r.as_u64().unwrap() as usize)
+        .collect();
+    assert!(frames.len() <= fbd_cli::viewer::MAX_FRAMES);
+    assert_eq!(frames.last(), Some(&(rows.len() - 1)));
+    let states: Vec<usize> = h
+        .iter()
+        .filter(|(k, _)| k.starts_with("state") || k.ends_with("_state"))
+        .map(|(_, v)| *v)
+        .collect();
+    for r in 1..rows.len() {
+        if states.iter().any(|&c| rows[r][c] != rows[r - 1][c]) {
+            assert!(
+                frames.binary_search(&r).is_ok(),
+                "row {r}: a state changes and the frame was dropped"
+            );
+        }
+    }
+    check_planar(&out);
+}
+
+#[test]
+fn plots_show_every_contact_point_that_touched() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let o = fbd(&["run", "--out", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (h, rows) = csv(&out);
+    let forces = std::fs::read_to_string(out.join("forces.svg")).unwrap();
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for name in summary["contact_points"].as_array().unwrap() {
+        let name = name.as_str().unwrap();
+        let state = match name.strip_prefix("tip") {
+            Some(l) => format!("state{l}"),
+            None => format!("{name}_state"),
+        };
+        let touched = rows.iter().any(|r| r[h[&state]] != "ST1");
+        assert_eq!(
+            forces.contains(&format!(">\nn {name}\n<")),
+            touched,
+            "forces.svg and the contact of {name}"
+        );
+    }
+    for f in ["joints.svg", "energy.svg"] {
+        let svg = std::fs::read_to_string(out.join(f)).unwrap();
+        assert!(svg.starts_with("<svg"), "{f}");
+    }
+    // Passive: no torques.svg.
+    assert!(!out.join("torques.svg").exists());
+    let pd = dir.path().join("pd");
+    let o = fbd(&["run", &example("pd_stand.toml"), "--out", s(&pd)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(pd.join("torques.svg").is_file());
+}
+
+#[test]
+fn view_of_a_folder_without_a_run_is_a_one_line_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = fbd(&["view", s(dir.path())]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.contains("config.toml"), "{e}");
+    assert!(!dir.path().join("viewer.html").exists());
+
+    // A trajectory without the columns of its configuration.
+    let out = dir.path().join("out");
+    assert!(fbd(&["run", "--out", s(&out)]).status.success());
+    std::fs::write(out.join("trajectory.csv"), "t,rx\n0,0\n").unwrap();
+    std::fs::remove_file(out.join("viewer.html")).unwrap();
+    let o = fbd(&["view", s(&out)]);
+    assert!(!o.status.success());
+    let e = stderr(&o);
+    assert_eq!(e.lines().count(), 1, "{e}");
+    assert!(e.contains("trajectory.csv") && e.contains("ry"), "{e}");
+    assert!(!out.join("viewer.html").exists());
+
+    let o = fbd(&["view", s(&dir.path().join("missing"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+}

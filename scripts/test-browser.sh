@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# The browser test of viewer.html: runs the default experiment and the
+# hexapod tripod gait, opens each run's viewer.html in headless Chromium
+# (Debian's package, driven by playwright-core from npm) and checks what it
+# draws against trajectory.csv (tests/browser/viewer.test.mjs). Installs
+# chromium with apt-get when it is missing (needs root), and the pinned
+# playwright-core with `npm ci`. Saves the screenshots docs/viewer.png and
+# docs/viewer_hexapod.png.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+chromium=${CHROMIUM:-/usr/bin/chromium}
+if [ ! -x "$chromium" ]; then
+  if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null; then
+    echo "installing Debian's chromium"
+    apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null
+  else
+    echo "error: $chromium is missing: install Debian's chromium (apt-get install chromium) or set CHROMIUM" >&2
+    exit 1
+  fi
+fi
+command -v node >/dev/null || { echo "error: node is missing (apt-get install nodejs npm)" >&2; exit 1; }
+(cd tests/browser && npm ci --no-audit --no-fund --loglevel=error)
+
+cargo build --release --bin fbd
+fbd="${CARGO_TARGET_DIR:-$PWD/target}/release/fbd"
+runs=$(mktemp -d)
+trap 'rm -rf "$runs"' EXIT
+# The folder names are the viewer's page titles.
+"$fbd" run --out "$runs/paper-fall" >/dev/null
+"$fbd" run examples/hexapod_tripod.toml --out "$runs/hexapod-tripod" >/dev/null
+
+cd tests/browser
+CHROMIUM="$chromium" FBD_PLANAR_DIR="$runs/paper-fall" FBD_HEXAPOD_DIR="$runs/hexapod-tripod" \
+  FBD_SCREENSHOT_DIR="$PWD/../../docs" node --test

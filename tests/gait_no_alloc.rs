@@ -1,0 +1,44 @@
+//! One kinematic gait step does not touch the heap (the footholds and the
+//! body path are computed when the model is built).
+//!
+//! The global allocator of this test binary is `System` wrapped by
+//! `stats_alloc`'s counting `StatsAlloc`; the counters are process-global,
+//! so this file holds a single `#[test]`.
+
+mod common;
+
+use std::alloc::System;
+
+use common::gait::model;
+use fbd_sim::gait::{Command, GaitData, GaitKind, GaitParams, step};
+use stats_alloc::{INSTRUMENTED_SYSTEM, Region, StatsAlloc};
+
+#[global_allocator]
+static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
+
+#[test]
+fn gait_steps_do_not_allocate() {
+    let params = GaitParams {
+        forward: Command::Profile(vec![[0.0, 0.02], [2.0, 0.08]]),
+        yaw_rate: Command::Constant(4f64.to_radians()),
+        sway: 0.01,
+        walk_time: 4.0,
+        ..GaitParams::preset(GaitKind::Wave)
+    };
+    let m = model(params, 0.005, 5.0);
+    let mut data = GaitData::new(&m);
+    // A first step outside the count (one-time lazy initialisations of the
+    // process, if any).
+    step(&m, &mut data, 0).expect("reachable");
+    let region = Region::new(GLOBAL);
+    for k in 0..=m.steps {
+        step(&m, &mut data, k).expect("reachable");
+    }
+    let stats = region.change();
+    assert_eq!(
+        (stats.allocations, stats.reallocations, stats.deallocations),
+        (0, 0, 0),
+        "{} steps: {stats:?}",
+        m.steps + 1
+    );
+}

@@ -28,7 +28,7 @@ struct Outcome {
     final_kinetic: f64,
 }
 
-fn tip_events<'a>(s: &'a RunSummary, leg: usize) -> impl Iterator<Item = &'a Event> {
+fn tip_events(s: &RunSummary, leg: usize) -> impl Iterator<Item = &Event> {
     s.events
         .iter()
         .filter(move |e| e.point == "tip" && e.leg == leg)

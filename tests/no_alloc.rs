@@ -9,7 +9,8 @@
 //!
 //! Cases: the benchmarks' fixtures (`benches/common/mod.rs`), the default
 //! experiment's robot at Δt = 1 ms with its feet in flight (ST1), sticking
-//! (ST2) or sliding (ST3).
+//! (ST2; its knees reach their joint limits during the measured pass and
+//! stay there) or sliding (ST3).
 //!
 //! Each case builds a `Model`, runs 2010 steps once so that the solver has
 //! met every contact pattern of the run (the first solve of a pattern builds
@@ -76,6 +77,16 @@ fn steady_stepping_does_not_allocate() {
             stats.allocations == 0 && stats.reallocations == 0 && stats.deallocations == 0,
             "{case:?}: heap traffic in 2000 steady steps: {stats:?}"
         );
+        if let Case::Stick = case {
+            // The collapsing robot straightens its knees onto their limits
+            // during the measured pass: the joint-limit rows (a limit
+            // reached, then held) are covered too.
+            assert!(
+                data.limit_states.iter().filter(|l| l.is_at()).count() == 2,
+                "{case:?}: both knees at their limits, {:?}",
+                data.limit_states
+            );
+        }
         eprintln!("{case:?}: 2000 steps, {stats:?}");
     }
 }

@@ -80,6 +80,10 @@ impl Case {
                     mu_dynamic: 0.0,
                 };
                 p.qdot0[0] = 0.5;
+                // Without joint limits the frictionless robot collapses
+                // onto its sliding feet and stays there; with them a stop
+                // lifts a foot off the ground.
+                p.joint_limits = fbd_sim::JointLimits::none();
             }
         }
         p

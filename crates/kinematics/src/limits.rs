@@ -87,15 +87,20 @@ pub struct JointLimits {
 
 impl Default for JointLimits {
     fn default() -> Self {
+        let rad = |[lo, hi]: [f64; 2]| [lo.to_radians(), hi.to_radians()];
+        let [t1, t2, t3] = Self::DEFAULT_DEG;
         Self {
-            theta1: [-90f64.to_radians(), 90f64.to_radians()],
-            theta2: [-120f64.to_radians(), 120f64.to_radians()],
-            theta3: [180f64.to_radians(), 330f64.to_radians()],
+            theta1: rad(t1),
+            theta2: rad(t2),
+            theta3: rad(t3),
         }
     }
 }
 
 impl JointLimits {
+    /// The default ranges of θ1, θ2, θ3 in degrees (see the fields).
+    pub const DEFAULT_DEG: [[f64; 2]; 3] = [[-90.0, 90.0], [-120.0, 120.0], [180.0, 330.0]];
+
     /// Limits so wide that they never act (`±∞`).
     pub fn none() -> Self {
         let all = [f64::NEG_INFINITY, f64::INFINITY];

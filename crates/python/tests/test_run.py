@@ -150,3 +150,10 @@ def test_config_toml_round_trips(tmp):
     a = fbd.run(text)
     b = fbd.run({"time": {"duration": 0.25}})
     np.testing.assert_array_equal(a["ry"], b["ry"])
+
+
+def test_module_docstring_examples():
+    import doctest
+
+    failures, tried = doctest.testmod(fbd, verbose=False)
+    assert tried >= 3 and failures == 0

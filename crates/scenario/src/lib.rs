@@ -299,12 +299,11 @@ impl Default for LegConfig {
 impl LegConfig {
     /// The joint-limit keys with their values (deg), defaults filled in.
     pub fn limits_deg(&self) -> [(&'static str, [f64; 2]); 3] {
-        let d = fbd_sim::JointLimits::default();
-        let deg = |r: [f64; 2]| [r[0].to_degrees(), r[1].to_degrees()];
+        let [d1, d2, d3] = fbd_sim::JointLimits::DEFAULT_DEG;
         [
-            ("leg.theta1_deg", self.theta1_deg.unwrap_or(deg(d.theta1))),
-            ("leg.theta2_deg", self.theta2_deg.unwrap_or(deg(d.theta2))),
-            ("leg.theta3_deg", self.theta3_deg.unwrap_or(deg(d.theta3))),
+            ("leg.theta1_deg", self.theta1_deg.unwrap_or(d1)),
+            ("leg.theta2_deg", self.theta2_deg.unwrap_or(d2)),
+            ("leg.theta3_deg", self.theta3_deg.unwrap_or(d3)),
         ]
     }
 

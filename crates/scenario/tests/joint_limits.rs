@@ -46,3 +46,29 @@ fn bad_ranges_name_the_key() {
         .to_string();
     assert!(e.contains("theta2_deg") && e.contains("2 numbers"), "{e}");
 }
+
+#[test]
+fn an_initial_angle_outside_its_limits_names_the_key_and_the_excess() {
+    let c = parse_str("[initial.leg3]\ntheta_deg = [0.0, 340.0]\n", "t.toml", &[]).unwrap();
+    let Config::Planar(p) = c else {
+        panic!("planar")
+    };
+    let e = p.model("t.toml").unwrap_err().to_string();
+    assert!(
+        e.starts_with("t.toml: initial.leg3.theta_deg")
+            && e.contains("theta3")
+            && e.contains("10.000°"),
+        "{e}"
+    );
+    // Inside wider limits the same pose is fine.
+    let c = parse_str(
+        "[leg]\ntheta3_deg = [180.0, 350.0]\n[initial.leg3]\ntheta_deg = [0.0, 340.0]\n",
+        "t.toml",
+        &[],
+    )
+    .unwrap();
+    let Config::Planar(p) = c else {
+        panic!("planar")
+    };
+    assert!(p.model("t.toml").is_ok());
+}

@@ -8,6 +8,9 @@
 //! * [`step`] — one staged time step (kinematics → predictor → solve →
 //!   contact check → accept), see [`mod@step`];
 //! * [`run`] — the whole loop with per-row callback and a [`RunSummary`].
+//! * [`gait`] — the kinematic gait of the 24-DOF hexapod (gait schedule,
+//!   body path, footholds, swing, IK with rates and accelerations, static
+//!   stability), with its own model/workspace pair and run loop.
 //!
 //! ```
 //! use fbd_sim::{Model, PlanarParams, run_collect};

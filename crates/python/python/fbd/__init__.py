@@ -7,9 +7,9 @@ run sweeps in parallel, and evaluate the kinematics:
 >>> import fbd
 >>> r = fbd.run({"time": {"duration": 0.3}})       # the paper's fall
 >>> r["ry"][:3]                                      # a column as a NumPy array
-array([0.6      , 0.599019 , 0.5960760])             # doctest: +SKIP
->>> [e["t"] for e in r.events][:2]
-[0.19, 0.21]                                         # doctest: +SKIP
+array([0.6      , 0.5995095, 0.598038 ])
+>>> [(e["t"], e["leg"], e["to"]) for e in r.events][:2]   # touchdowns
+[(0.19, 4, 'ST2'), (0.21, 3, 'ST2')]
 
 The GIL is released while simulating, so Python threads (e.g.
 ``concurrent.futures.ThreadPoolExecutor``) run simulations in parallel.

@@ -120,6 +120,8 @@ pub struct BodyPlan {
     psi0: f64,
     /// `ϱ̄` under the initial body centre.
     ground0: f64,
+    /// The initial rotation is a pure yaw (`φx = φz = 0`).
+    level: bool,
 }
 
 impl BodyPlan {
@@ -153,6 +155,7 @@ impl BodyPlan {
             rot0,
             psi0: phi0.y,
             ground0,
+            level: phi0.x == 0.0 && phi0.z == 0.0,
         };
         let n = if params.walking {
             (until.max(0.0) / dt).ceil() as usize + 2
@@ -314,11 +317,17 @@ impl BodyPlan {
         let position = Vector3::new(x, self.r0.y + p.height * on.0 + gy, z) + sway;
         let velocity = Vector3::new(vx, p.height * on.1 + gyd, vz) + swayd;
         let acceleration = Vector3::new(ax, p.height * on.2 + gydd, az) + swaydd;
-        // Rotation.
-        let m = rot_y(psi - self.psi0) * self.rot0;
+        // Rotation. A level start (φx = φz = 0) without roll or pitch is a
+        // pure yaw: Rot = Ry(ψ), φ = (0, ψ, 0), no trigonometry left to do.
+        let tilted = p.pitch != 0.0 || p.roll != 0.0;
+        let level = !tilted && self.level;
+        let m = if level {
+            Matrix3::new(cs, 0.0, sn, 0.0, 1.0, 0.0, -sn, 0.0, cs)
+        } else {
+            rot_y(psi - self.psi0) * self.rot0
+        };
         let (pt, ptd, ptdd) = (p.pitch * on.0, p.pitch * on.1, p.pitch * on.2);
         let (rt, rtd, rtdd) = (-p.roll * on.0, -p.roll * on.1, -p.roll * on.2);
-        let tilted = p.pitch != 0.0 || p.roll != 0.0;
         let rx = if tilted {
             rot_x(pt)
         } else {
@@ -339,7 +348,11 @@ impl BodyPlan {
             rotation,
             omega,
             omega_dot,
-            phi: phi_of(&rotation, psi),
+            phi: if level {
+                Vector3::new(0.0, psi, 0.0)
+            } else {
+                phi_of(&rotation, psi)
+            },
         }
     }
 
@@ -400,6 +413,31 @@ mod tests {
             "{pl:?}"
         );
         assert!((pl.q[2] - psi).abs() < 1e-12);
+    }
+
+    #[test]
+    fn level_yaw_fast_path_is_the_general_rotation() {
+        let p = GaitParams {
+            yaw_rate: Command::Constant(0.9),
+            walk_time: 5.0,
+            ..GaitParams::default()
+        };
+        let b = BodyPlan::new(
+            &p,
+            &Surface::default(),
+            Vector3::new(0.0, 0.4, 0.0),
+            Vector3::new(0.0, 2.9, 0.0),
+            1e-3,
+            6.0,
+        );
+        for k in [0, 1234, 4000] {
+            let pl = b.planar_at_step(k);
+            let st = b.state(k as f64 * 1e-3, &pl);
+            let general = rot_y(pl.q[2] - 2.9) * rot_y(2.9);
+            assert!((st.rotation - general).norm() < 1e-14);
+            let phi = phi_of(&general, pl.q[2]);
+            assert!((st.phi - phi).norm() < 1e-12, "{} vs {phi}", st.phi);
+        }
     }
 
     #[test]

@@ -6,31 +6,9 @@
 
 mod common;
 
-use common::physics::{run_ok, worst_body_imbalance};
+use common::physics::{landing, run_ok, worst_body_imbalance};
 use fbd_contact::StateCode;
 use fbd_sim::{Model, PlanarParams, StepRecord};
-
-/// The robot of the default experiment thrown as in the sweep's run.
-fn landing(
-    phi_deg: f64,
-    omega_deg: f64,
-    drop: f64,
-    t3: [f64; 2],
-    t4: [f64; 2],
-    mus: f64,
-) -> PlanarParams {
-    let mut p = PlanarParams::default();
-    p.q0[2] = phi_deg.to_radians();
-    p.qdot0[2] = omega_deg.to_radians();
-    p.q0[3] = t3[0].to_radians();
-    p.q0[4] = t3[1].to_radians();
-    p.q0[5] = t4[0].to_radians();
-    p.q0[6] = t4[1].to_radians();
-    p.friction.mu_static = mus;
-    p.friction.mu_dynamic = 0.75 * mus;
-    p.set_drop_height(drop);
-    p
-}
 
 fn check(p: &PlanarParams, what: &str) -> (Model, Vec<StepRecord>, fbd_sim::RunSummary) {
     assert!(

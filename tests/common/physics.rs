@@ -59,6 +59,31 @@ pub fn angular_momentum(model: &Model, q0: &[f64], q1: &[f64], dt: f64) -> f64 {
     l
 }
 
+/// The robot of the default experiment thrown as in a run of
+/// `examples/sweep_landing_1000.toml`: initial tilt and spin (degrees,
+/// °/s), drop height of the lowest point (m), legs 3 and 4 `[θ2, θ3]`
+/// (degrees), μS (μD = 0.75 μS).
+pub fn landing(
+    phi_deg: f64,
+    omega_deg: f64,
+    drop: f64,
+    t3: [f64; 2],
+    t4: [f64; 2],
+    mus: f64,
+) -> PlanarParams {
+    let mut p = PlanarParams::default();
+    p.q0[2] = phi_deg.to_radians();
+    p.qdot0[2] = omega_deg.to_radians();
+    p.q0[3] = t3[0].to_radians();
+    p.q0[4] = t3[1].to_radians();
+    p.q0[5] = t4[0].to_radians();
+    p.q0[6] = t4[1].to_radians();
+    p.friction.mu_static = mus;
+    p.friction.mu_dynamic = 0.75 * mus;
+    p.set_drop_height(drop);
+    p
+}
+
 /// Builds and runs a model; panics with the error if the run fails.
 pub fn run_ok(p: &PlanarParams) -> (Model, Vec<StepRecord>, fbd_sim::RunSummary) {
     let model = Model::planar(p).expect("valid parameters");

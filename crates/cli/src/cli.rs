@@ -11,7 +11,9 @@ use crate::CliError;
 ///
 /// Simulates the planar two-leg model of the paper's §6 (a hexapod
 /// falling onto flat ground, legs 3 and 4), writing trajectories, contact
-/// events and the plots of the paper's Fig. 7. Without a command, `fbd`
+/// events and the plots of the paper's Fig. 7, and walks the 24-DOF
+/// hexapod kinematically with a periodic gait (`model = "hexapod"`).
+/// Every run writes a viewer.html to open in a browser. Without a command, `fbd`
 /// is `fbd run`: the built-in experiment, files in out/ (or --out DIR).
 /// Exit status: 0 ok, 2 usage or configuration error, 3 simulation failed
 /// (partial files written), 4 input/output error, 130 interrupted
@@ -65,8 +67,9 @@ pub struct ViewArgs {
 /// Arguments of `fbd run`.
 #[derive(Debug, Args)]
 pub struct RunArgs {
-    /// TOML configuration (every key: docs/reference.md). Without it: the
-    /// built-in default, the paper's falling experiment.
+    /// TOML configuration, planar or hexapod (every key:
+    /// docs/reference.md). Without it: the built-in default, the paper's
+    /// falling experiment.
     #[arg(value_name = "CONFIG")]
     pub config: Option<PathBuf>,
     /// Output directory, created if needed.

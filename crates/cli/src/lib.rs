@@ -78,7 +78,17 @@ where
                         .find(|l| !l.trim().is_empty())
                         .unwrap_or("invalid command line");
                     let first = first.strip_prefix("error: ").unwrap_or(first);
-                    eprintln!("error: {first} (see `fbd --help`)");
+                    // `fbd CONFIG.toml`: a configuration where a command
+                    // is expected; point to `fbd run`.
+                    let hint = match e.get(clap::error::ContextKind::InvalidSubcommand) {
+                        Some(clap::error::ContextValue::String(arg))
+                            if arg.ends_with(".toml") || std::path::Path::new(arg).is_file() =>
+                        {
+                            format!("; to simulate a configuration: `fbd run {arg}`")
+                        }
+                        _ => String::new(),
+                    };
+                    eprintln!("error: {first} (see `fbd --help`){hint}");
                     ExitCode::from(2)
                 }
             };

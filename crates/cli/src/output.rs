@@ -95,6 +95,35 @@ pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliEr
     Ok(dest)
 }
 
+/// Removes from `dir` every file that `fbd run` may write, for either
+/// model ([`FILES`], `torques.svg`, [`crate::hexapod::FILES`]), that the
+/// run just finished did not write (`written`), so that no file of an
+/// earlier run (its `torques.svg`, or the planar plots after a hexapod run)
+/// is left beside the new ones looking current. A file that cannot be
+/// removed is an input/output error.
+pub fn remove_stale(dir: &Path, written: &[&str]) -> Result<(), CliError> {
+    let known = FILES
+        .iter()
+        .chain(&["torques.svg"])
+        .chain(&crate::hexapod::FILES);
+    for name in known.filter(|n| !written.contains(n)) {
+        let path = dir.join(name);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != io::ErrorKind::NotFound => {
+                return Err(CliError::io(
+                    format!(
+                        "{}: cannot remove the file of an earlier run",
+                        path.display()
+                    ),
+                    &e,
+                ));
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Creates `dir` if needed and checks that files can be created in it.
 pub fn prepare_dir(dir: &Path) -> Result<(), CliError> {
     if dir.exists() && !dir.is_dir() {

@@ -317,8 +317,8 @@ const POINT_COLORS: [[RGBColor; 2]; 3] = [
     [RGBColor(44, 160, 44), RGBColor(148, 103, 189)],
     [RGBColor(140, 86, 75), RGBColor(227, 119, 194)],
 ];
-/// A palette for anything else.
-const PALETTE: [RGBColor; 8] = [
+/// A palette for anything else (also the lines of `sweep.svg`).
+pub const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),

@@ -202,6 +202,9 @@ pub struct Simulated {
     pub contacts: Vec<String>,
     /// The first failure writing a file (every file is still attempted).
     pub io_error: Option<CliError>,
+    /// The names of the files written, in order (none without an output
+    /// directory).
+    pub files: Vec<&'static str>,
 }
 
 /// Simulates the loaded `config` (named `source` in messages), handing every
@@ -267,6 +270,7 @@ pub fn simulate(
             summary: s,
             contacts: names,
             io_error: None,
+            files: Vec::new(),
         });
     };
 
@@ -298,6 +302,7 @@ pub fn simulate(
         config.to_toml().as_bytes(),
     ));
     let torques = plot::torques_svg(&plot_data).map(|svg| ("torques.svg", svg));
+    let torques_written = torques.is_some();
     for (name, svg) in [
         ("tips.svg", plot::tips_svg(&plot_data)),
         ("forces.svg", plot::forces_svg(&plot_data)),
@@ -316,11 +321,19 @@ pub fn simulate(
     if let Some(v) = view {
         keep(viewer::write(out_dir, &v.finish(&run.events)));
     }
+    let mut files = output::FILES.to_vec();
+    files.extend(torques_written.then_some("torques.svg"));
+    if io_error.is_none()
+        && let Err(e) = output::remove_stale(out_dir, &files)
+    {
+        io_error = Some(e);
+    }
     Ok(Simulated {
         run,
         summary: s,
         contacts: names,
         io_error,
+        files,
     })
 }
 
@@ -339,12 +352,22 @@ pub fn run_command(
         None => (Config::default(), "the built-in default".to_owned()),
     };
     if let Config::Hexapod(h) = &config {
-        return crate::hexapod::run_command(h, &config, &source, out_dir, out);
+        let r = crate::hexapod::run_command(h, &config, &source, out_dir, out);
+        // Every file was written (also after a simulation error or an
+        // interruption): remove the planar files of an earlier run.
+        if matches!(
+            r,
+            Ok(()) | Err(CliError::Simulation(_) | CliError::Interrupted(_))
+        ) {
+            output::remove_stale(out_dir, &crate::hexapod::FILES)?;
+        }
+        return r;
     }
     let Simulated {
         run,
         io_error,
         summary,
+        files,
         ..
     } = simulate(
         &config,
@@ -379,7 +402,7 @@ pub fn run_command(
         text.push_str(&format!(
             "files in {}: {}\n",
             out_dir.display(),
-            output::FILES.join(" ")
+            files.join(" ")
         ));
     }
     out.write_all(text.as_bytes())

@@ -51,11 +51,65 @@ pub const COLUMNS: [&str; 12] = [
     "error",
 ];
 
+/// The fixed columns of `index.csv` of a hexapod sweep (the kinematic
+/// gait), after `run, status` and the varied keys: the body's path length,
+/// net displacement, mean speed and heading change, the smallest
+/// stability margin and when, the largest joint rate and acceleration
+/// over all joints, the number of lift-offs, then as for the planar model.
+pub const HEXAPOD_COLUMNS: [&str; 12] = [
+    "distance",
+    "displacement",
+    "mean_speed",
+    "heading_change_deg",
+    "min_margin",
+    "min_margin_t",
+    "max_joint_rate",
+    "max_joint_acceleration",
+    "liftoffs",
+    "steps",
+    "wall_seconds",
+    "error",
+];
+
+/// Which model a sweep runs, and so which columns `index.csv` has.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum IndexKind {
+    /// The planar dynamics: [`COLUMNS`].
+    #[default]
+    Planar,
+    /// The hexapod's kinematic gait: [`HEXAPOD_COLUMNS`].
+    Hexapod,
+}
+
+impl IndexKind {
+    /// The fixed columns of `index.csv`.
+    pub fn columns(self) -> &'static [&'static str; 12] {
+        match self {
+            IndexKind::Planar => &COLUMNS,
+            IndexKind::Hexapod => &HEXAPOD_COLUMNS,
+        }
+    }
+
+    fn of(config: &Config) -> Self {
+        match config {
+            Config::Planar(_) => IndexKind::Planar,
+            Config::Hexapod(_) => IndexKind::Hexapod,
+        }
+    }
+}
+
 /// Columns `--plot` accepts: `touchdown`, the first touchdown of either
-/// tip (the default), and the numeric columns of `index.csv` (all of
-/// [`COLUMNS`] but `error`).
+/// tip (the default; `distance` for a hexapod sweep), and the numeric
+/// columns of `index.csv` (all of [`COLUMNS`] and [`HEXAPOD_COLUMNS`] but
+/// `error`).
 pub fn plot_columns() -> impl Iterator<Item = &'static str> {
-    std::iter::once("touchdown").chain(COLUMNS.iter().copied().filter(|c| *c != "error"))
+    std::iter::once("touchdown").chain(
+        COLUMNS
+            .iter()
+            .chain(&HEXAPOD_COLUMNS[..9])
+            .copied()
+            .filter(|c| *c != "error"),
+    )
 }
 
 /// Marker written in a run directory after all its files.
@@ -83,8 +137,8 @@ pub struct SweepArgs {
     /// Skip runs whose directory holds a finished run with status ok.
     #[arg(long)]
     pub resume: bool,
-    /// Column of index.csv plotted in sweep.svg (default: touchdown, the
-    /// first touchdown of either tip).
+    /// Column of index.csv plotted in sweep.svg (touchdown: the first
+    /// touchdown of either tip).
     #[arg(long, value_name = "COLUMN", default_value = "touchdown")]
     pub plot: String,
 }
@@ -410,8 +464,11 @@ pub struct Row {
     pub status: String,
     /// The varied values, formatted ([`format_value`]).
     pub values: Vec<String>,
-    /// [`COLUMNS`] `touchdown3` … `wall_seconds`, `None` = empty.
+    /// The numeric columns of `kind` ([`COLUMNS`] `touchdown3` …
+    /// `wall_seconds`, or [`HEXAPOD_COLUMNS`]), `None` = empty.
     pub numbers: [Option<f64>; 11],
+    /// Which columns `numbers` holds.
+    pub kind: IndexKind,
     /// The error message ("" when ok).
     pub error: String,
 }
@@ -425,7 +482,7 @@ impl Row {
                 (a, b) => a.or(b),
             };
         }
-        COLUMNS[..11]
+        self.kind.columns()[..11]
             .iter()
             .position(|c| *c == name)
             .and_then(|i| self.numbers[i])
@@ -436,15 +493,53 @@ fn fmt_num(v: Option<f64>) -> String {
     v.map(|x| x.to_string()).unwrap_or_default()
 }
 
-/// Writes `index.csv` (rows sorted by run).
-pub fn write_index(dir: &Path, keys: &[String], rows: &[Row]) -> Result<(), CliError> {
+/// Removes `DIR/runs/<i>` for every `i ≥ total`: the runs of an earlier,
+/// larger sweep into the same directory, which would otherwise sit beside
+/// this sweep's runs looking current.
+fn remove_stale_runs(dir: &Path, total: usize) -> Result<(), CliError> {
+    let Ok(entries) = std::fs::read_dir(dir.join("runs")) else {
+        return Ok(());
+    };
+    for e in entries.flatten() {
+        let path = e.path();
+        let stale = e
+            .file_name()
+            .to_str()
+            .and_then(|n| {
+                n.parse::<usize>()
+                    .ok()
+                    .filter(|i| *i >= total && i.to_string() == n)
+            })
+            .is_some();
+        if stale && path.is_dir() {
+            std::fs::remove_dir_all(&path).map_err(|err| {
+                CliError::io(
+                    format!(
+                        "{}: cannot remove the run of an earlier sweep",
+                        path.display()
+                    ),
+                    &err,
+                )
+            })?;
+        }
+    }
+    Ok(())
+}
+
+/// Writes `index.csv` (rows sorted by run) with the columns of `kind`.
+pub fn write_index(
+    dir: &Path,
+    keys: &[String],
+    kind: IndexKind,
+    rows: &[Row],
+) -> Result<(), CliError> {
     let mut rows: Vec<&Row> = rows.iter().collect();
     rows.sort_by_key(|r| r.run);
     let mut w = csv::Writer::from_writer(Vec::new());
     let io = |e: csv::Error| CliError::Io(format!("index.csv: {e}"));
     let mut header = vec!["run".to_owned(), "status".to_owned()];
     header.extend(keys.iter().cloned());
-    header.extend(COLUMNS.iter().map(|s| (*s).to_owned()));
+    header.extend(kind.columns().iter().map(|s| (*s).to_owned()));
     w.write_record(&header).map_err(io)?;
     for r in rows {
         let mut rec = vec![r.run.to_string(), r.status.clone()];
@@ -465,10 +560,15 @@ pub fn write_index(dir: &Path, keys: &[String], rows: &[Row]) -> Result<(), CliE
     crate::output::write_file(dir, "index.csv", &bytes).map(drop)
 }
 
-/// Reads `index.csv` back (for `merge`).
-pub fn read_index(path: &Path, nkeys: usize) -> Result<Vec<Row>, CliError> {
+/// Reads `index.csv` back (for `merge`): its rows and which columns it
+/// has.
+pub fn read_index(path: &Path, nkeys: usize) -> Result<(IndexKind, Vec<Row>), CliError> {
     let mut r = csv::Reader::from_path(path)
         .map_err(|e| CliError::Io(format!("{}: {e}", path.display())))?;
+    let kind = match r.headers() {
+        Ok(h) if h.get(2 + nkeys) == Some(HEXAPOD_COLUMNS[0]) => IndexKind::Hexapod,
+        _ => IndexKind::Planar,
+    };
     let mut rows = Vec::new();
     for rec in r.records() {
         let rec = rec.map_err(|e| CliError::Io(format!("{}: {e}", path.display())))?;
@@ -490,10 +590,11 @@ pub fn read_index(path: &Path, nkeys: usize) -> Result<Vec<Row>, CliError> {
             status: rec[1].to_owned(),
             values: (0..nkeys).map(|i| rec[2 + i].to_owned()).collect(),
             numbers,
+            kind,
             error: rec[2 + nkeys + 11].to_owned(),
         });
     }
-    Ok(rows)
+    Ok((kind, rows))
 }
 
 /// The row of a finished run, from its `summary.json`.
@@ -501,6 +602,31 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
     let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
     let s: serde_json::Value = serde_json::from_str(&text).ok()?;
     let num = |v: &serde_json::Value| v.as_f64();
+    if s["model"] == "hexapod" {
+        let liftoffs = s["events"]
+            .as_array()
+            .map(|e| e.iter().filter(|e| e["event"] == "liftoff").count() as f64);
+        return Some(Row {
+            run,
+            status: s["status"].as_str().unwrap_or("error").to_owned(),
+            values,
+            numbers: [
+                num(&s["distance"]),
+                num(&s["displacement"]),
+                num(&s["mean_speed"]),
+                num(&s["heading_change_deg"]),
+                num(&s["min_margin"]["value"]),
+                num(&s["min_margin"]["t"]),
+                num(&s["peak_joint_rate_max"]),
+                num(&s["peak_joint_acceleration_max"]),
+                liftoffs,
+                num(&s["steps"]),
+                num(&s["wall_seconds"]),
+            ],
+            kind: IndexKind::Hexapod,
+            error: s["error"].as_str().unwrap_or("").replace('\n', " "),
+        });
+    }
     let numbers = [
         num(&s["first_touchdown"]["leg3"]),
         num(&s["first_touchdown"]["leg4"]),
@@ -519,6 +645,7 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
         status: s["status"].as_str().unwrap_or("error").to_owned(),
         values,
         numbers,
+        kind: IndexKind::Planar,
         error: s["error"].as_str().unwrap_or("").replace('\n', " "),
     })
 }
@@ -625,10 +752,8 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
             Config::Planar(p) => {
                 p.model(&base_name).map_err(|e| fail(e.to_string()))?;
             }
-            Config::Hexapod(_) => {
-                return Err(fail(
-                    "model = \"hexapod\": `fbd run` does not simulate hexapods yet".into(),
-                ));
+            Config::Hexapod(h) => {
+                h.gait_model(&base_name).map_err(|e| fail(e.to_string()))?;
             }
         }
         configs.push(c);
@@ -716,6 +841,7 @@ fn run_one(dir: &Path, config: &Config, run: usize, values: Vec<String>) -> Row 
         status: "error".into(),
         values: values.clone(),
         error: msg.replace('\n', " "),
+        kind: IndexKind::of(config),
         ..Row::default()
     };
     if dir.exists()
@@ -784,6 +910,16 @@ fn write_plot(
     }
 }
 
+/// The plotted column: `distance` for the default `touchdown` of a
+/// hexapod sweep (no contact dynamics, no touchdowns of the planar tips).
+fn default_plot(kind: IndexKind, column: &str) -> &str {
+    if kind == IndexKind::Hexapod && column == "touchdown" {
+        "distance"
+    } else {
+        column
+    }
+}
+
 fn check_plot_column(c: &str) -> Result<(), CliError> {
     if plot_columns().any(|p| p == c) {
         Ok(())
@@ -813,6 +949,7 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
     let plan = plan(path)?;
     let total = plan.configs.len();
     let dir = &a.out;
+    crate::output::prepare_dir(dir)?;
     crate::output::prepare_dir(&dir.join("runs"))?;
     let formatted: Vec<Vec<String>> = plan
         .values
@@ -890,8 +1027,13 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
     let ran_n = ran.len();
     rows.extend(ran);
     rows.sort_by_key(|r| r.run);
-    write_index(dir, &plan.keys, &rows)?;
-    write_plot(dir, &plan.keys, &rows, &a.plot, out)?;
+    let kind = plan
+        .configs
+        .first()
+        .map_or(IndexKind::Planar, IndexKind::of);
+    remove_stale_runs(dir, total)?;
+    write_index(dir, &plan.keys, kind, &rows)?;
+    write_plot(dir, &plan.keys, &rows, default_plot(kind, &a.plot), out)?;
 
     let failed: Vec<usize> = rows
         .iter()
@@ -960,6 +1102,7 @@ pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError>
     let mut first: Option<SweepJson> = None;
     let mut rows: BTreeMap<usize, Row> = BTreeMap::new();
     let mut sources: BTreeMap<usize, PathBuf> = BTreeMap::new();
+    let mut kind = IndexKind::Planar;
     for d in &m.dirs {
         let p = d.join("sweep.json");
         if !d.is_dir() {
@@ -993,7 +1136,9 @@ pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError>
         if !idx.exists() {
             continue;
         }
-        for r in read_index(&idx, j.keys.len())? {
+        let (k, runs) = read_index(&idx, j.keys.len())?;
+        kind = k;
+        for r in runs {
             sources.insert(r.run, d.clone());
             rows.insert(r.run, r);
         }
@@ -1001,6 +1146,7 @@ pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError>
     let Some(mut j) = first else {
         return Err(CliError::Usage("merge: no directory given".into()));
     };
+    crate::output::prepare_dir(&m.out)?;
     crate::output::prepare_dir(&m.out.join("runs"))?;
     let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
         (Ok(x), Ok(y)) => x == y,
@@ -1020,8 +1166,8 @@ pub fn merge_command(m: &MergeArgs, out: &mut dyn Write) -> Result<(), CliError>
     let rows: Vec<Row> = rows.into_values().collect();
     j.shard = None;
     write_json(&m.out, "sweep.json", &j)?;
-    write_index(&m.out, &j.keys, &rows)?;
-    write_plot(&m.out, &j.keys, &rows, &m.plot, out)?;
+    write_index(&m.out, &j.keys, kind, &rows)?;
+    write_plot(&m.out, &j.keys, &rows, default_plot(kind, &m.plot), out)?;
     let missing: Vec<usize> = (0..j.total_runs)
         .filter(|i| rows.binary_search_by_key(i, |r| r.run).is_err())
         .collect();

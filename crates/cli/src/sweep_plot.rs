@@ -9,19 +9,8 @@
 
 use plotters::prelude::*;
 
-use crate::plot::{Entry, LEGEND_WIDTH, Style, err, range, side_legend, tick};
+use crate::plot::{Entry, LEGEND_WIDTH, PALETTE, Style, err, range, side_legend, tick};
 use crate::sweep::Row;
-
-const PALETTE: [RGBColor; 8] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-];
 
 /// Numbers of a formatted value: `0.4` → `[0.4]`, `[0.0, 0.5]` →
 /// `[0.0, 0.5]`; `None` when anything is not a number.

@@ -103,12 +103,16 @@ fn toml_syntax_error_has_line_and_column() {
 #[test]
 fn wrong_type_names_the_key() {
     let c = Case::new("[body]\nmass = \"heavy\"\n");
-    let e = c.rejected(&["body.mass", "invalid type"]);
+    let e = c.rejected(&["body.mass", "invalid type", "expected a number"]);
     assert!(
         e.starts_with(&format!("error: {}:2:8: body.mass:", s(&c.cfg))),
         "{e}"
     );
-    Case::new("[output]\nstride = 1.5\n").rejected(&[":2:10:", "output.stride"]);
+    Case::new("[output]\nstride = 1.5\n").rejected(&[
+        ":2:10:",
+        "output.stride",
+        "expected a whole number",
+    ]);
     Case::new("[initial]\nposition = [0.0]\n").rejected(&["initial.position", "2 numbers"]);
 }
 

@@ -72,3 +72,15 @@ fn help_still_lists_the_commands() {
         "--help ran the experiment"
     );
 }
+
+#[test]
+fn a_configuration_without_a_command_points_to_fbd_run() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("my.toml"), "").unwrap();
+    let o = fbd_in(dir.path(), &["my.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("`fbd run my.toml`"), "{err}");
+    assert!(!dir.path().join("out").exists());
+}

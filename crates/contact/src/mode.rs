@@ -155,7 +155,10 @@ pub struct ContactParams {
     /// a point under load `N` sits `β·N·Δt²/M` below its anchor. It makes
     /// statically indeterminate contact sets (two sticking points on one
     /// body) solvable. Default `1e-8`: 1e-10 m for 1 kN on the default
-    /// robot at Δt = 0.01 s, and far above round-off in the Jacobian.
+    /// robot at Δt = 0.01 s, and far above round-off in the Jacobian. This
+    /// is its value at Δt = 0.01 s: the stepping loop (`fbd_sim::step`)
+    /// scales it as `(0.01 s/Δt)²`, so that the compliance `β·Δt²/M` is
+    /// the same at every step length.
     pub regularization: f64,
     /// Dimensionless regularisation β_b added to β on the knees' and hips'
     /// contact rows: they read `K·(p − a) + (β + β_b)·F = 0` (ST2), a very

@@ -57,6 +57,7 @@ use nalgebra::{Matrix3, SMatrix, Vector3};
 
 use crate::body::{GAMMA_DEG, LEG_COUNT, LegMount, hip_distance};
 use crate::leg::LegGeometry;
+use crate::leg_jacobian::LegTrig;
 use crate::planar::PlanarGeometry;
 use crate::pose::BodyPose;
 
@@ -361,29 +362,42 @@ impl HexapodData {
 
 /// Full 24-DOF forward kinematics: fills `data` with every inertial
 /// auxiliary point and versor of configuration `cfg`. Allocation-free,
-/// 21 `sin_cos` evaluations.
+/// 21 `sin_cos` evaluations ([`forward_trig`] takes them precomputed).
 #[inline]
 pub fn forward(model: &HexapodModel, cfg: &HexapodConfig, data: &mut HexapodData) {
-    let phi = &cfg.pose.phi;
-    let (sx, cx) = phi.x.sin_cos();
-    let (sy, cy) = phi.y.sin_cos();
-    let (sz, cz) = phi.z.sin_cos();
+    let trig = cfg.joints.map(LegTrig::new);
+    forward_trig(model, &cfg.pose, &cfg.pose.rotation(), &trig, data);
+}
+
+/// [`forward`] with the trigonometry precomputed: `rotation` is
+/// `pose.rotation()` (e.g. kept from the body's motion) and `trig[i]` the
+/// sines and cosines of leg i's joint angles (e.g. from the inverse
+/// kinematics, [`crate::ik::leg_ik_trig`]): one `sin_cos` (of φx, for
+/// [`HexapodData::phi_axes`]) instead of 21. With `pose.rotation()` and
+/// [`LegTrig::new`] of the angles it is [`forward`], bit for bit.
+#[inline]
+pub fn forward_trig(
+    model: &HexapodModel,
+    pose: &BodyPose,
+    rotation: &Matrix3<f64>,
+    trig: &[LegTrig; LEG_COUNT],
+    data: &mut HexapodData,
+) {
+    let (sx, cx) = pose.phi.x.sin_cos();
     // Rot = Rx(φx)·Rz(φz)·Ry(φy), by columns.
-    let ex = Vector3::new(cz * cy, cx * sz * cy + sx * sy, sx * sz * cy - cx * sy);
-    let ey = Vector3::new(-sz, cx * cz, sx * cz);
-    let ez = Vector3::new(cz * sy, cx * sz * sy - sx * cy, sx * sz * sy + cx * cy);
-    data.rotation = Matrix3::from_columns(&[ex, ey, ez]);
-    let r = cfg.pose.position;
+    let ex: Vector3<f64> = rotation.column(0).into();
+    let ey: Vector3<f64> = rotation.column(1).into();
+    let ez: Vector3<f64> = rotation.column(2).into();
+    data.rotation = *rotation;
+    let r = pose.position;
     data.body_com = r;
     data.body_versor = ez;
     data.phi_axes = [Vector3::x(), ey, Vector3::new(0.0, -sx, cx)];
 
     let (a, c) = (model.leg.a, model.leg.c);
     let (fu, fl) = (model.upper_com, model.lower_com);
-    for ((out, m), th) in data.legs.iter_mut().zip(&model.mounts).zip(&cfg.joints) {
-        let (s1, c1) = th[0].sin_cos();
-        let (s2, c2) = th[1].sin_cos();
-        let (s23, c23) = (th[1] + th[2]).sin_cos();
+    for ((out, m), t) in data.legs.iter_mut().zip(&model.mounts).zip(trig) {
+        let (s1, c1, s2, c2, s23, c23) = (t.s1, t.c1, t.s2, t.c2, t.s23, t.c23);
         // cos(γ+θ1), sin(γ+θ1) by the addition formulas (γ's are constants).
         let cg = m.cos_gamma * c1 - m.sin_gamma * s1;
         let sg = m.sin_gamma * c1 + m.cos_gamma * s1;
@@ -503,6 +517,31 @@ mod tests {
             let tj = d.tip_joint_jacobian(leg);
             let full = d.leg_point_jacobian(leg, LegPoint::Tip);
             assert!((tj - full.fixed_view::<3, 3>(0, 6)).norm() < 1e-15);
+        }
+    }
+
+    #[test]
+    fn forward_trig_is_forward() {
+        let (model, cfg) = (HexapodModel::default(), sample());
+        let mut want = HexapodData::new();
+        forward(&model, &cfg, &mut want);
+        // With the angles' own trigonometry: bit for bit.
+        let mut got = HexapodData::new();
+        let trig = cfg.joints.map(LegTrig::new);
+        forward_trig(&model, &cfg.pose, &cfg.pose.rotation(), &trig, &mut got);
+        assert_eq!(got, want);
+        // With the inverse kinematics' sines and cosines: to round-off.
+        let trig: [LegTrig; LEG_COUNT] = std::array::from_fn(|i| {
+            let p0 = model
+                .mount(i)
+                .body_to_base(&cfg.pose.to_body(&want.legs[i].tip));
+            let branch = crate::ik::KneeBranch::of(cfg.joints[i][2]);
+            crate::ik::leg_ik_trig(model.leg(), &p0, branch).unwrap().1
+        });
+        forward_trig(&model, &cfg.pose, &cfg.pose.rotation(), &trig, &mut got);
+        for (g, w) in got.legs.iter().zip(&want.legs) {
+            assert!((g.tip - w.tip).norm() < 1e-14, "{:?} vs {:?}", g.tip, w.tip);
+            assert!((g.knee - w.knee).norm() < 1e-14);
         }
     }
 

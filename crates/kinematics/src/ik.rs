@@ -34,6 +34,7 @@ use nalgebra::Vector3;
 use crate::error::KinematicsError;
 use crate::hexapod::HexapodModel;
 use crate::leg::LegGeometry;
+use crate::leg_jacobian::LegTrig;
 
 /// Relative tolerance of the θ1 singularity: the target is "on the θ1 axis"
 /// when its distance from it is `≤ SINGULAR_TOLERANCE·(a + c)`.
@@ -88,6 +89,24 @@ pub fn leg_ik(
     target: &Vector3<f64>,
     branch: KneeBranch,
 ) -> Result<[f64; 3], KinematicsError> {
+    leg_ik_trig(geom, target, branch).map(|(theta, _)| theta)
+}
+
+/// [`leg_ik`] with the sines and cosines of the solution, as the solve
+/// finds them (no `sin_cos`): `(c1, s1) = (x, y)/ρ`, `cos θ3` from the law
+/// of cosines and `sin θ3` of the branch, `(c2, s2)` from
+/// `(ρ, ζ) = Rot(θ2)·(A, B)` (`A = c·c3 − a`, `B = c·s3`), then the sum
+/// formulas. Equal to [`LegTrig::new`]`(theta)` up to round-off; the
+/// Jacobians and [`crate::hexapod::forward_trig`] take them.
+///
+/// # Errors
+/// As [`leg_ik`].
+#[inline]
+pub fn leg_ik_trig(
+    geom: &LegGeometry,
+    target: &Vector3<f64>,
+    branch: KneeBranch,
+) -> Result<([f64; 3], LegTrig), KinematicsError> {
     let (x, y, z) = (target.x, target.y, target.z);
     if !(x.is_finite() && y.is_finite() && z.is_finite()) {
         return Err(KinematicsError::NonFinite);
@@ -124,7 +143,18 @@ pub fn leg_ik(
     let big_a = c * cos3 - a;
     let big_b = c * sin3;
     let theta2 = (big_a * z - big_b * rho).atan2(big_a * rho + big_b * z);
-    Ok([theta1, theta2, theta3])
+    let n = big_a * big_a + big_b * big_b;
+    let c2 = (big_a * rho + big_b * z) / n;
+    let s2 = (big_a * z - big_b * rho) / n;
+    let trig = LegTrig {
+        s1: y / rho,
+        c1: x / rho,
+        s2,
+        c2,
+        s23: s2 * cos3 + c2 * sin3,
+        c23: c2 * cos3 - s2 * sin3,
+    };
+    Ok(([theta1, theta2, theta3], trig))
 }
 
 /// Inverse kinematics of leg `leg` (array index 0–5, i.e. leg number − 1)
@@ -155,6 +185,37 @@ mod tests {
     fn angle_eq(a: f64, b: f64) -> bool {
         let d = (a - b).rem_euclid(TAU);
         d.min(TAU - d) < 1e-9
+    }
+
+    #[test]
+    fn trig_of_the_solve_is_that_of_the_angles() {
+        let g = LegGeometry::default();
+        for th in [
+            [0.0, 0.0, 245f64.to_radians()],
+            [0.3, -0.2, 4.0],
+            [-1.0, 0.5, 3.5],
+            [2.0, 1.0, 1.2],
+        ] {
+            let (theta, t) = leg_ik_trig(&g, &g.tip(th), KneeBranch::of(th[2])).unwrap();
+            let want = LegTrig::new(theta);
+            for (i, (a, b)) in [
+                (t.s1, want.s1),
+                (t.c1, want.c1),
+                (t.s2, want.s2),
+                (t.c2, want.c2),
+                (t.s23, want.s23),
+                (t.c23, want.c23),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                assert!((a - b).abs() < 1e-14, "{th:?}: entry {i}: {a} vs {b}");
+            }
+            assert_eq!(
+                theta,
+                leg_ik(&g, &g.tip(th), KneeBranch::of(th[2])).unwrap()
+            );
+        }
     }
 
     #[test]

@@ -94,7 +94,7 @@ pub fn simulation_error(
 }
 
 /// A CLI-library error as a Python exception: configuration errors as
-/// `fbd.ConfigError` (a hexapod run names the key `model`), file errors as
+/// `fbd.ConfigError` (a hexapod `Simulator` names the key `model`), file errors as
 /// `OSError`.
 pub fn cli_error(py: Python<'_>, e: &CliError, from_text: bool) -> PyErr {
     match e {

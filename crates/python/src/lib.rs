@@ -13,6 +13,7 @@
 mod columns;
 mod config;
 mod errors;
+mod hexapod;
 mod kinematics;
 mod run;
 mod simulator;

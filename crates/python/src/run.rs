@@ -54,6 +54,16 @@ pub fn run<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let loaded = crate::config::load(py, config)?;
+        if let fbd_scenario::Config::Hexapod(h) = &loaded.config {
+            return crate::hexapod::run(
+                py,
+                h,
+                &loaded.config,
+                &loaded.source,
+                loaded.from_text,
+                out.as_deref(),
+            );
+        }
         let outcome = py.detach(|| {
             // The columns' names and capacity; an invalid model is reported
             // by `simulate` itself.

@@ -124,8 +124,23 @@ impl ControlConfig {
     /// `control.key`.
     pub fn control(&self, file: &str) -> Result<Control, ConfigError> {
         let (kp, kd, torque_limit) = (self.kp, self.kd, self.torque_limit);
+        let invalid = |(key, what, got): (String, &'static str, String)| {
+            semantic(file, &key, what, got, "see [control] in docs/reference.md")
+        };
         let control = match self.kind {
-            ControlKind::None => Control::None,
+            // Passive joints do not use the gains, but a value out of its
+            // domain is still an error (the rule is the one of PD).
+            ControlKind::None => {
+                Control::Pd {
+                    kp,
+                    kd,
+                    torque_limit,
+                    target: [[0.0; 2]; 2],
+                }
+                .validate()
+                .map_err(invalid)?;
+                Control::None
+            }
             ControlKind::Pd => {
                 let mut target = [[0.0; 2]; 2];
                 for (i, (name, l)) in self.legs().into_iter().enumerate() {
@@ -229,9 +244,7 @@ impl ControlConfig {
                 }
             }
         };
-        control.validate().map_err(|(key, what, got)| {
-            semantic(file, &key, what, got, "see [control] in docs/reference.md")
-        })?;
+        control.validate().map_err(invalid)?;
         Ok(control)
     }
 }
@@ -496,6 +509,8 @@ mod tests {
     #[test]
     fn errors_name_the_key() {
         assert!(err("[control]\nkind = \"pd\"\nkp = -1.0\n").contains("control.kp"));
+        // Unused by passive joints, but still out of its domain.
+        assert!(err("[control]\nkind = \"none\"\nkp = nan\n").contains("control.kp"));
         assert!(err("[control]\nkind = \"pd\"\nkd = -1.0\n").contains("control.kd"));
         assert!(
             err("[control]\nkind = \"pd\"\ntorque_limit = 0.0\n").contains("control.torque_limit")

@@ -4,12 +4,31 @@
 //! is held for the duration.
 
 use fbd_contact::Surface;
-use fbd_kinematics::hexapod::HexapodModel;
+use fbd_kinematics::hexapod::{HexapodData, HexapodModel, forward};
+use fbd_kinematics::ik::KneeBranch;
 use fbd_kinematics::leg::LegGeometry;
+use fbd_kinematics::nalgebra::Vector3;
+use fbd_kinematics::pose::BodyPose;
+use fbd_kinematics::stance::stance_ik;
 use fbd_sim::gait::{Command, GaitKind, GaitModel, GaitParams, InitialPose, Masses};
 use serde::{Deserialize, Serialize};
 
-use crate::{ConfigError, HexapodConfig};
+use crate::{Config, ConfigError, HexapodConfig, HexapodInitial, HexapodLegInitial};
+
+/// The joint angles `(θ1, θ2, θ3)` (deg) of the default stance, every leg
+/// alike: the upper link horizontal and the lower link 25° outward from
+/// the vertical (the paper's leg-3 pose). The body then stands
+/// `c·sin 65°` above its feet (0.3806 m with `c` = 0.42 m) and every foot
+/// is `d + a + c·cos 65°` from the body centre (0.5940 m).
+pub const STANCE_THETA_DEG: [f64; 3] = [0.0, 0.0, 245.0];
+
+/// Gait periods walked when neither `[time] duration` nor
+/// `[gait] walk_time` is given: `walk_time = 5·period`, and the default
+/// duration is `walk_time + period` (the last swings land).
+pub const DEFAULT_WALK_PERIODS: f64 = 5.0;
+
+/// The default forward speed of `[gait]` (m/s): a gait table alone walks.
+pub const DEFAULT_FORWARD_SPEED: f64 = 0.1;
 
 /// `[gait] kind`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -139,7 +158,8 @@ pub struct GaitConfig {
     /// Swing height above the straight lift-off → touchdown line (m).
     /// Default 0.05.
     pub swing_height: f64,
-    /// Forward speed (m/s): number or `[[t, v], ...]`. Default 0.
+    /// Forward speed (m/s): number or `[[t, v], ...]`. Default 0.1
+    /// ([`DEFAULT_FORWARD_SPEED`]): a `[gait]` table alone walks forward.
     pub forward_speed: SpeedConfig,
     /// Lateral speed to the right (m/s): number or profile. Default 0.
     pub lateral_speed: SpeedConfig,
@@ -148,7 +168,8 @@ pub struct GaitConfig {
     /// Start-up and stop blend time (s). Default 0.5.
     pub ramp: f64,
     /// No lift-off from this time on; the body stops here (s). Default
-    /// `time.duration − period`, so that every foot is down at the end.
+    /// `time.duration − period`, so that every foot is down at the end;
+    /// without `[time] duration`, `5·period` ([`DEFAULT_WALK_PERIODS`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub walk_time: Option<f64>,
     /// Body height offset (m). Default 0.
@@ -178,7 +199,7 @@ impl Default for GaitConfig {
             period: None,
             step_length: None,
             swing_height: p.swing_height,
-            forward_speed: SpeedConfig::default(),
+            forward_speed: SpeedConfig::Constant(DEFAULT_FORWARD_SPEED),
             lateral_speed: SpeedConfig::default(),
             yaw_rate_deg: SpeedConfig::default(),
             ramp: p.ramp,
@@ -195,6 +216,29 @@ impl Default for GaitConfig {
 }
 
 impl GaitConfig {
+    /// The period the gait will use (s): `period`, else
+    /// `step_length / |forward_speed|`, else the default 1 s.
+    fn period_used(&self) -> f64 {
+        if let Some(t) = self.period {
+            return t;
+        }
+        if let (Some(l), SpeedConfig::Constant(v)) = (self.step_length, &self.forward_speed)
+            && *v != 0.0
+            && l > 0.0
+        {
+            return l / v.abs();
+        }
+        GaitParams::default().period
+    }
+
+    /// The duration of a walk whose file gives no `[time] duration` (s):
+    /// `walk_time + period`, `walk_time` defaulting to
+    /// [`DEFAULT_WALK_PERIODS`] periods.
+    pub fn default_duration(&self) -> f64 {
+        let period = self.period_used();
+        self.walk_time.unwrap_or(DEFAULT_WALK_PERIODS * period) + period
+    }
+
     /// Fills the preset's β and phases, the period (from `step_length`) and
     /// `walk_time`, so that `config.toml` holds every value used.
     pub fn resolve(&mut self, duration: f64) {
@@ -371,6 +415,89 @@ impl GaitConfig {
     }
 }
 
+/// The default `[initial]` of a hexapod on its terrain: the body level at
+/// the origin, [`STANCE_THETA_DEG`]'s height above the ground under it, and
+/// every foot where that pose puts it horizontally, on the terrain (the
+/// leg inverse kinematics gives the angles; on flat ground they are
+/// [`STANCE_THETA_DEG`]). `None` when the geometry cannot stand so (the
+/// validation then names the key at fault).
+pub fn default_stance(h: &HexapodConfig) -> Option<HexapodInitial> {
+    let kin = HexapodModel::new(
+        h.body.side,
+        LegGeometry {
+            a: h.leg.upper_length,
+            c: h.leg.lower_length,
+        },
+        h.leg.upper_com,
+        h.leg.lower_com,
+    );
+    let theta = STANCE_THETA_DEG.map(f64::to_radians);
+    let mut fk = HexapodData::new();
+    forward(
+        &kin,
+        &fbd_kinematics::hexapod::HexapodConfig {
+            pose: BodyPose::default(),
+            joints: [theta; 6],
+        },
+        &mut fk,
+    );
+    let surface = Surface::new(h.terrain.terrain(), 0.0);
+    let ground = |x: f64, z: f64| {
+        if surface.exists() {
+            surface.height(x, z)
+        } else {
+            0.0
+        }
+    };
+    let below = -fk.legs[0].tip.y;
+    let y0 = ground(0.0, 0.0) + below;
+    let pose = BodyPose::new([0.0, y0, 0.0], [0.0; 3]);
+    let feet = fk
+        .legs
+        .map(|l| Vector3::new(l.tip.x, ground(l.tip.x, l.tip.z), l.tip.z));
+    let joints = stance_ik(&kin, &pose, &feet, &[KneeBranch::of(theta[2]); 6]).ok()?;
+    // Whole nano-degrees, so that flat ground reads 245, not 244.99999999999997.
+    let deg = |v: f64| (v.to_degrees() * 1e9).round() / 1e9;
+    let leg = |n: usize| HexapodLegInitial {
+        theta_deg: joints[n].map(deg),
+        rate_deg: [0.0; 3],
+    };
+    (y0.is_finite() && joints.iter().flatten().all(|v| v.is_finite())).then(|| HexapodInitial {
+        position: [0.0, y0, 0.0],
+        leg1: leg(0),
+        leg2: leg(1),
+        leg3: leg(2),
+        leg4: leg(3),
+        leg5: leg(4),
+        leg6: leg(5),
+        ..HexapodInitial::default()
+    })
+}
+
+/// The defaults of a hexapod file that depend on what else it gives,
+/// filled before [`Config::resolve`]; `table` is the file's (with its
+/// overrides): without `[initial]` the robot stands on its terrain
+/// ([`default_stance`]); with `[gait]` and without `[time] duration` it
+/// walks for [`GaitConfig::default_duration`].
+pub fn fill_hexapod_defaults(config: &mut Config, table: &toml::Table) {
+    let Config::Hexapod(h) = config else { return };
+    if !table.contains_key("initial")
+        && let Some(initial) = default_stance(h)
+    {
+        h.initial = initial;
+    }
+    let duration_given = table
+        .get("time")
+        .and_then(toml::Value::as_table)
+        .is_some_and(|t| t.contains_key("duration"));
+    if !duration_given && let Some(g) = &h.gait {
+        let d = g.default_duration();
+        if d.is_finite() && d > 0.0 {
+            h.time.duration = d;
+        }
+    }
+}
+
 impl HexapodConfig {
     /// The kinematic run of this configuration: the `[gait]`, or a standing
     /// run without it. Joint limits from `[leg] theta*_deg`.
@@ -467,6 +594,60 @@ mod tests {
         );
         let e = parse("[gait]\nkind = \"tripod\"\n").unwrap_err();
         assert!(e.contains("gait"), "{e}");
+    }
+
+    fn run(text: &str) -> (crate::HexapodConfig, fbd_sim::gait::GaitSummary) {
+        let Config::Hexapod(h) = parse(text).unwrap() else {
+            panic!()
+        };
+        let model = h.gait_model("g.toml").unwrap();
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let s = fbd_sim::gait::run_gait(&model, &stop, |_| {});
+        (*h, s)
+    }
+
+    #[test]
+    fn a_gait_table_alone_walks_from_the_default_stance() {
+        let (h, s) = run("model = \"hexapod\"\n[gait]\n");
+        // The default stance: the paper's leg-3 pose, feet on the ground.
+        assert_eq!(h.initial.leg1.theta_deg, super::STANCE_THETA_DEG);
+        let c = 0.42f64;
+        assert!((h.initial.position[1] - c * 65f64.to_radians().sin()).abs() < 1e-12);
+        // 5 periods of walking at 0.1 m/s, then one to set the feet down.
+        assert_eq!(h.time.duration, 6.0);
+        assert_eq!(h.gait.as_ref().unwrap().walk_time, Some(5.0));
+        assert!(s.error.is_none(), "{:?}", s.error);
+        // 0.1 m/s for 5 s less the two half-ramps of 0.5 s: 0.45 m.
+        assert!((s.distance - 0.45).abs() < 1e-9, "{}", s.distance);
+        assert!(s.min_margin.unwrap().0 > 0.2);
+        // The walk's config.toml reruns the same walk.
+        let again = parse(&Config::Hexapod(Box::new(h.clone())).to_toml()).unwrap();
+        assert_eq!(again, Config::Hexapod(Box::new(h)));
+    }
+
+    #[test]
+    fn a_bare_hexapod_stands_on_the_ground() {
+        let (h, s) = run("model = \"hexapod\"\n");
+        assert!(h.gait.is_none());
+        assert_eq!(h.time.duration, 1.0);
+        assert!(s.error.is_none() && s.distance == 0.0, "{s:?}");
+        let model = h.gait_model("g.toml").unwrap();
+        for f in &model.initial_feet {
+            assert!(f.y.abs() < 1e-9, "a foot off the ground: {f:?}");
+        }
+        // On a 10° slope the default stance puts every foot on the slope.
+        let (h, _) = run("model = \"hexapod\"\n[terrain]\nkind = \"slope\"\nangle_deg = 10.0\n");
+        let model = h.gait_model("g.toml").unwrap();
+        for f in &model.initial_feet {
+            let g = model.surface.height(f.x, f.z);
+            assert!((f.y - g).abs() < 1e-9, "foot {f:?} vs ground {g}");
+        }
+        // An explicit duration or [initial] is kept.
+        let (h, _) = run(
+            "model = \"hexapod\"\n[time]\nduration = 3.0\n[initial]\nposition = [0.0, 0.38, 0.0]\n[gait]\n",
+        );
+        assert_eq!((h.time.duration, h.initial.position[1]), (3.0, 0.38));
+        assert_eq!(h.gait.unwrap().walk_time, Some(2.0));
     }
 
     #[test]

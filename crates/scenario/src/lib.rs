@@ -63,7 +63,10 @@ use serde::{Deserialize, Serialize};
 
 mod actuation;
 mod gait;
-pub use gait::{GaitConfig, GaitKindConfig, SpeedConfig};
+pub use gait::{
+    DEFAULT_FORWARD_SPEED, DEFAULT_WALK_PERIODS, GaitConfig, GaitKindConfig, STANCE_THETA_DEG,
+    SpeedConfig, default_stance,
+};
 mod advice;
 pub use actuation::{ControlConfig, ControlKind, ControlLegConfig, TargetDeg};
 
@@ -905,21 +908,6 @@ impl PlanarConfig {
         let [t3, t4] = [i.theta_deg(0), i.theta_deg(1)];
         let [r3, r4] = [i.rate_deg(0), i.rate_deg(1)];
         PlanarParams {
-            dt: self.time.dt,
-            duration: self.time.duration,
-            gravity: self.world.gravity,
-            body_mass: self.body.mass,
-            body_inertia: self.body.inertia,
-            side: self.body.side,
-            upper_length: self.leg.upper_length,
-            upper_mass: self.leg.upper_mass,
-            upper_inertia: self.leg.upper_inertia(),
-            upper_com: self.leg.upper_com,
-            lower_length: self.leg.lower_length,
-            lower_mass: self.leg.lower_mass,
-            lower_inertia: self.leg.lower_inertia(),
-            lower_com: self.leg.lower_com,
-            joint_limits: self.leg.joint_limits(),
             q0: [
                 i.position[0],
                 i.position[1],
@@ -938,11 +926,8 @@ impl PlanarConfig {
                 r4[0].to_radians(),
                 r4[1].to_radians(),
             ],
-            terrain: self.terrain.terrain(),
-            friction: self.terrain.friction(),
-            contact_points: self.contact.contact_points(),
-            stride: self.output.stride,
             control: self.control.control("").unwrap_or_default(),
+            ..self.shared_params()
         }
     }
 
@@ -1156,7 +1141,12 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 /// The message of a toml error, prefixed with the dotted key it concerns
 /// (when toml knows it and the message does not already say it).
 fn describe(err: &toml::de::Error) -> String {
-    let message = describe_key(err);
+    // serde names Rust types (`expected f64`): say what the file needs.
+    let message = describe_key(err)
+        .replace("expected f64", "expected a number")
+        .replace("expected usize", "expected a whole number")
+        .replace("expected u64", "expected a whole number")
+        .replace("expected u32", "expected a whole number");
     match suggestion(&message) {
         // `table: unknown field `x`, did you mean `y`? expected one of …`
         Some(hint) => message.replacen(", expected", &format!(", {hint}expected"), 1),
@@ -1263,6 +1253,7 @@ pub fn parse_str(text: &str, file: &str, overrides: &[Override]) -> Result<Confi
         config = from_table(&table).map_err(|e| fail(describe(&e)))?;
         load_profile(&mut config, file)?;
     }
+    gait::fill_hexapod_defaults(&mut config, &table);
     config.resolve();
     config.validate(file)?;
     Ok(config)
@@ -1294,6 +1285,7 @@ pub fn parse_table(
         message: describe(&e),
     })?;
     load_profile(&mut config, file)?;
+    gait::fill_hexapod_defaults(&mut config, &table);
     config.resolve();
     config.validate(file)?;
     Ok(config)

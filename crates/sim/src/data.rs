@@ -52,6 +52,9 @@ pub struct Data {
     pub(crate) seen: Vec<u8>,
     /// Per contact, the tangential force of its last sticking trial.
     pub(crate) stick_fa: Vec<f64>,
+    /// Per contact, the anchor of its last sticking trial (meaningful when
+    /// bit 1 of `seen` is set).
+    pub(crate) stick_anchor: Vec<[f64; 2]>,
     /// Trial states of the joint limits.
     pub(crate) limit_trial: Vec<LimitState>,
     /// The step's start, kept for a retry in substeps: `q[k]`, `q[k−1]`,
@@ -74,6 +77,10 @@ pub struct Data {
     /// State searches that cycled and were closed by their least
     /// inconsistent trial.
     pub resolved_cycles: usize,
+    /// State searches that cycled and were closed by a consistent
+    /// combination found by trying every combination of the points and
+    /// joint limits involved (see [`crate::step`]).
+    pub enumerated_cycles: usize,
     /// Set while solving the finest substeps of a retried step.
     pub(crate) last_resort: bool,
 }
@@ -104,6 +111,7 @@ impl Data {
             visited: Vec::with_capacity(64),
             seen: vec![0; lay.contacts],
             stick_fa: vec![0.0; lay.contacts],
+            stick_anchor: vec![[0.0; 2]; lay.contacts],
             limit_states: vec![LimitState::Free; lay.limits],
             limit_events: Vec::with_capacity(64),
             retries: Vec::with_capacity(16),
@@ -121,6 +129,7 @@ impl Data {
             best_trial: model.initial_states.clone(),
             best_limits: vec![LimitState::Free; lay.limits],
             resolved_cycles: 0,
+            enumerated_cycles: 0,
             last_resort: false,
         }
     }

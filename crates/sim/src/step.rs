@@ -14,7 +14,12 @@
 //!    between ST1 (it penetrates when free) and ST2 (it would pull on the
 //!    ground when stuck) is tried in ST3, sliding opposite to the friction
 //!    sticking needed — the remaining candidate of Coulomb's law
-//!    ([`slide_flip_flops`]);
+//!    ([`slide_flip_flops`]). If it still cycles, every combination of
+//!    the few points and joint limits involved is solved in turn and the
+//!    first consistent one is taken ([`enumerate_states`]): the greedy
+//!    rules, one switch at a time, can miss a consistent combination that
+//!    is two switches away (a foot that slides *and* a knee that leaves its
+//!    stop);
 //! 6. **accept**: record, events, and `q[k+1]` becomes the current state.
 //!
 //! **Retry in substeps.** A step that Newton cannot solve, or whose state
@@ -159,9 +164,15 @@ fn solve(model: &Model, data: &mut Data) -> Result<(usize, usize), Failure> {
             }
         }
         if data.visited.contains(&key) || trials >= MAX_STATE_TRIALS {
-            // No combination the rules reach is consistent: the one that
-            // violates the contact and limit laws least is accepted when
-            // its violation is negligible.
+            // No combination the rules reach is consistent: every
+            // combination of the points and limits involved is tried
+            // (when they are few), then the one that violates the contact
+            // and limit laws least is accepted when its violation is
+            // negligible.
+            if enumerate_states(model, data, &mut newton_iterations, &mut trials) {
+                data.enumerated_cycles += 1;
+                break;
+            }
             if data.best_violation <= model.cycle_tolerance || data.last_resort {
                 data.z.copy_from_slice(&data.best_z);
                 data.trial.copy_from_slice(&data.best_trial);
@@ -320,6 +331,122 @@ fn slide_flip_flops(data: &mut Data) -> bool {
     forced
 }
 
+/// Most contact points and joint limits [`enumerate_states`] combines.
+const MAX_INVOLVED: usize = 4;
+
+/// Most combinations (one solve each) [`enumerate_states`] tries: 4 states
+/// of 3 points, or of 2 points and 2 stops on/off.
+const MAX_ENUMERATED: usize = 64;
+
+/// The cycle's exhaustive fallback (stage 5): the points involved in this
+/// step's search (solved in more than one state, or not free in the
+/// accepted or least inconsistent combination) each take ST1, ST2 (at the
+/// anchor of its last sticking trial, if it had one), ST3 forwards and
+/// ST3 backwards; the joint limits involved (at a stop in the accepted,
+/// least inconsistent or current combination) are free or at that stop;
+/// every other point is free and every other joint limit free. The
+/// combinations are solved in a fixed order and the first whose violation
+/// of the contact and limit laws ([`violation`]) is at most
+/// [`Model::cycle_tolerance`] is kept in `data` (`true`). `false` when none
+/// is, or when there are too many to try ([`MAX_ENUMERATED`]); the least
+/// inconsistent trial is updated either way. No allocation.
+fn enumerate_states(
+    model: &Model,
+    data: &mut Data,
+    newton_iterations: &mut usize,
+    trials: &mut usize,
+) -> bool {
+    let nq = model.mech.layout().nq;
+    let mut points = [0usize; MAX_INVOLVED];
+    let mut np = 0;
+    for c in 0..data.trial.len() {
+        let involved = data.seen[c].count_ones() >= 2
+            || !matches!(data.states[c], ContactState::Free)
+            || !matches!(data.best_trial[c], ContactState::Free);
+        if involved {
+            if np == MAX_INVOLVED {
+                return false;
+            }
+            points[np] = c;
+            np += 1;
+        }
+    }
+    let mut stops = [(0usize, LimitState::Free); MAX_INVOLVED];
+    let mut ns = 0;
+    for l in 0..data.limit_trial.len() {
+        let at = [
+            data.best_limits[l],
+            data.limit_trial[l],
+            data.limit_states[l],
+        ]
+        .into_iter()
+        .find(LimitState::is_at);
+        if let Some(at) = at {
+            if ns == MAX_INVOLVED {
+                return false;
+            }
+            stops[ns] = (l, at);
+            ns += 1;
+        }
+    }
+    let combinations = 4usize.pow(np as u32) << ns;
+    if combinations > MAX_ENUMERATED {
+        return false;
+    }
+    for combo in 0..combinations {
+        let mut m = combo;
+        data.trial.fill(ContactState::Free);
+        data.limit_trial.fill(LimitState::Free);
+        let mut possible = true;
+        for &c in &points[..np] {
+            data.trial[c] = match m % 4 {
+                0 => ContactState::Free,
+                1 if data.seen[c] & 0b10 != 0 => ContactState::Stick {
+                    anchor: data.stick_anchor[c],
+                },
+                1 => {
+                    possible = false;
+                    ContactState::Free
+                }
+                2 => ContactState::Slide { dir: 1.0 },
+                _ => ContactState::Slide { dir: -1.0 },
+            };
+            m /= 4;
+        }
+        for &(l, at) in &stops[..ns] {
+            if m % 2 == 1 {
+                data.limit_trial[l] = at;
+            }
+            m /= 2;
+        }
+        if !possible {
+            continue;
+        }
+        data.z.copy_from_slice(&data.best_z);
+        *trials += 1;
+        let (mut sys, solver, z) = system(model, data);
+        let Ok(report) = solver.solve(&mut sys, z) else {
+            continue;
+        };
+        *newton_iterations += report.iterations;
+        if data.z.iter().any(|v| !v.is_finite()) {
+            continue;
+        }
+        evaluate_next(&model.mech, &mut data.fbd, &data.z[..nq]);
+        let v = violation(model, data);
+        if v < data.best_violation {
+            data.best_violation = v;
+            data.best_z.copy_from_slice(&data.z);
+            data.best_trial.copy_from_slice(&data.trial);
+            data.best_limits.copy_from_slice(&data.limit_trial);
+        }
+        if v <= model.cycle_tolerance {
+            return true;
+        }
+    }
+    false
+}
+
 /// Stages 1–3 of [`step`]: the per-body constants of step `data.k` and the
 /// predictor of `q[k+1]` in `data.z` (the forces keep the last solution);
 /// the trial contact and limit states start from the accepted ones. Public
@@ -377,7 +504,7 @@ pub fn system<'a>(
     for (eq, &state) in data.fbd.limit.iter_mut().zip(&data.limit_trial) {
         *eq = LimitEquation {
             state,
-            regularization: model.contact.regularization,
+            regularization: beta(model, data.fbd.dt),
         };
     }
     row_scales(
@@ -399,6 +526,7 @@ pub fn system<'a>(
 /// frame at the anchor (ST2), under the point at k (ST1, ST3).
 fn set_contact_equations(model: &Model, data: &mut Data) {
     let terrain = &model.params.terrain;
+    let beta = beta(model, data.fbd.dt);
     for (c, spec) in model.mech.contacts.iter().enumerate() {
         let state = data.trial[c];
         let x = match state {
@@ -411,9 +539,30 @@ fn set_contact_equations(model: &Model, data: &mut Data) {
             tangent,
             normal,
             mu_dynamic: model.params.friction.mu_dynamic,
-            regularization: model.contact.regularization + model.contact_bumper[c],
+            regularization: beta + model.contact_bumper[c],
         };
     }
+}
+
+/// The (sub)step length at which the contact and stop rows carry the
+/// regularisation [`fbd_contact::ContactParams::regularization`] itself
+/// (s): the default Δt.
+const REGULARIZATION_DT: f64 = 0.01;
+
+/// The regularisation β of the contact and stop rows for a (sub)step of
+/// length `h`: `ContactParams::regularization · (0.01 s / h)²`, so that the
+/// compliance it stands for, `β·h²/M` (m/N), is the same at every Δt
+/// (7.8e-14 m/N on the default robot) instead of shrinking as `h²`. A
+/// compliance that shrinks with `h²` makes the split of the forces of a
+/// statically indeterminate set (a robot lying on six sticking points)
+/// round-off: at Δt = 1 ms one ulp of a coordinate (1.1e-16 m) was 0.14 N
+/// of internal friction, enough to make a lightly loaded foot at rest flip
+/// between sticking and sliding every few steps. The fixed compliance is
+/// still far too stiff for its spring to be resolved (its period on a
+/// 1.1 kg link is 2 µs): contacts stay rigid and plastic.
+fn beta(model: &Model, h: f64) -> f64 {
+    let r = REGULARIZATION_DT / h;
+    model.contact.regularization * r * r
 }
 
 /// Most solves of one (sub)step's state search: a search that has not
@@ -451,8 +600,9 @@ fn check_states(model: &Model, data: &mut Data) -> bool {
             dt,
         };
         data.seen[c] |= 1 << data.trial[c].key().min(2);
-        if matches!(data.trial[c], ContactState::Stick { .. }) {
+        if let ContactState::Stick { anchor } = data.trial[c] {
             data.stick_fa[c] = trial.fa;
+            data.stick_anchor[c] = anchor;
         }
         let Some(next) = transition(
             &data.trial[c],

@@ -63,6 +63,53 @@ pub fn columns() -> Vec<String> {
     c
 }
 
+/// Values of a `trajectory.csv` row after `t` ([`row_values`]).
+pub const ROW_VALUES: usize = 6 + 3 * 3 * LEGS + 3 * LEGS + LEGS + 4;
+
+/// Where the `stance{n}` flags are among the [`row_values`] (1 or 0).
+pub const STANCE: std::ops::Range<usize> = 6 + 12 * LEGS..6 + 13 * LEGS;
+
+/// The values of one `trajectory.csv` row after `t`, in the order of
+/// [`columns`]: body pose, joint angles, rates, accelerations, feet (where
+/// the solved joint angles put them), stance flags (1.0 or 0.0), centre of
+/// mass, margin. The file and the Python package both write these.
+pub fn row_values(d: &GaitData, out: &mut [f64; ROW_VALUES]) {
+    let body = &d.body;
+    let mut i = 0;
+    let mut put = |v: f64| {
+        out[i] = v;
+        i += 1;
+    };
+    for v in [
+        body.position.x,
+        body.position.y,
+        body.position.z,
+        body.phi.x,
+        body.phi.y,
+        body.phi.z,
+    ] {
+        put(v);
+    }
+    for l in &d.legs {
+        l.theta.into_iter().for_each(&mut put);
+    }
+    for l in &d.legs {
+        l.rate.into_iter().for_each(&mut put);
+    }
+    for l in &d.legs {
+        l.accel.into_iter().for_each(&mut put);
+    }
+    for l in &d.fk.legs {
+        [l.tip.x, l.tip.y, l.tip.z].into_iter().for_each(&mut put);
+    }
+    for s in d.stance() {
+        put(if s { 1.0 } else { 0.0 });
+    }
+    [d.com.x, d.com.y, d.com.z, d.margin]
+        .into_iter()
+        .for_each(&mut put);
+}
+
 /// Streams the hexapod `trajectory.csv` into a temporary file.
 struct Writer {
     out: BufWriter<NamedTempFile>,
@@ -93,46 +140,15 @@ impl Writer {
         let mut b = ryu::Buffer::new();
         let out = &mut self.out;
         self.times.write(out, d.step, d.t)?;
-        let mut num = |out: &mut BufWriter<NamedTempFile>, v: f64| -> std::io::Result<()> {
-            out.write_all(b",")?;
-            out.write_all(b.format(v).as_bytes())
-        };
-        let body = &d.body;
-        for v in [
-            body.position.x,
-            body.position.y,
-            body.position.z,
-            body.phi.x,
-            body.phi.y,
-            body.phi.z,
-        ] {
-            num(out, v)?;
-        }
-        for l in &d.legs {
-            for v in l.theta {
-                num(out, v)?;
+        let mut v = [0.0; ROW_VALUES];
+        row_values(d, &mut v);
+        for (i, x) in v.iter().enumerate() {
+            if STANCE.contains(&i) {
+                out.write_all(if *x == 1.0 { b",1" } else { b",0" })?;
+            } else {
+                out.write_all(b",")?;
+                out.write_all(b.format(*x).as_bytes())?;
             }
-        }
-        for l in &d.legs {
-            for v in l.rate {
-                num(out, v)?;
-            }
-        }
-        for l in &d.legs {
-            for v in l.accel {
-                num(out, v)?;
-            }
-        }
-        for l in &d.fk.legs {
-            for v in [l.tip.x, l.tip.y, l.tip.z] {
-                num(out, v)?;
-            }
-        }
-        for s in d.stance() {
-            out.write_all(if s { b",1" } else { b",0" })?;
-        }
-        for v in [d.com.x, d.com.y, d.com.z, d.margin] {
-            num(out, v)?;
         }
         out.write_all(b"\n")
     }
@@ -161,7 +177,7 @@ impl Writer {
 
 /// A scheduled event time for the files: `(k + φ)·T` rounded to 1e-12 s,
 /// so that `1.7999999999999998` reads `1.8`.
-fn tidy(t: f64) -> f64 {
+pub fn tidy(t: f64) -> f64 {
     (t * 1e12).round() / 1e12
 }
 
@@ -332,35 +348,61 @@ pub struct HexapodRun {
 }
 
 /// Runs the hexapod configuration `h` (`config` is the same, for
-/// `config.toml`) and writes every file to `out_dir`, even after a run
-/// error (which is in `run.error`).
+/// `config.toml`), handing every `output.stride`-th step to `on_row`; when
+/// `out_dir` is given, writes every file there, even after a run error
+/// (which is in `run.error`). The run stops before its next step once
+/// `stop` is set.
 pub fn simulate(
     h: &HexapodConfig,
     config: &Config,
     source: &str,
-    out_dir: &Path,
+    out_dir: Option<&Path>,
     stop: &AtomicBool,
+    on_row: &mut dyn FnMut(&GaitData),
 ) -> Result<HexapodRun, CliError> {
     let model = h.gait_model(source)?;
-    output::prepare_dir(out_dir)?;
     let stride = h.output.stride.max(1);
-    let mut traj = Writer::create(out_dir, model.dt)?;
-    let mut plot = GaitPlotData::new(&model);
+    let mut traj = match out_dir {
+        Some(dir) => {
+            output::prepare_dir(dir)?;
+            Some(Writer::create(dir, model.dt)?)
+        }
+        None => None,
+    };
+    let mut plot = out_dir.map(|_| GaitPlotData::new(&model));
     // viewer.html: one frame per trajectory row (decimated when long).
-    let mut view = HexapodScene::new(
-        model.kin.clone(),
-        model.surface.clone(),
-        model.steps.div_ceil(stride),
-        &crate::viewer::title_of(out_dir),
-    );
+    let mut view = out_dir.map(|dir| {
+        HexapodScene::new(
+            model.kin.clone(),
+            model.surface.clone(),
+            model.steps.div_ceil(stride),
+            &crate::viewer::title_of(dir),
+        )
+    });
+    let mut rows = 0;
     let run = run_gait(&model, stop, |d: &GaitData| {
         if d.step.is_multiple_of(stride) {
-            traj.write(d);
-            view.push(&HexFrame::of_gait(d));
+            if let Some(t) = traj.as_mut() {
+                t.write(d);
+            }
+            if let Some(v) = view.as_mut() {
+                v.push(&HexFrame::of_gait(d));
+            }
+            on_row(d);
+            rows += 1;
         }
-        plot.push(d);
+        if let Some(p) = plot.as_mut() {
+            p.push(d);
+        }
     });
-    let rows = traj.rows;
+    let s = summary(&model, stride, rows, &run);
+    let (Some(out_dir), Some(traj), Some(plot), Some(view)) = (out_dir, traj, plot, view) else {
+        return Ok(HexapodRun {
+            run,
+            summary: s,
+            io_error: None,
+        });
+    };
     let mut io_error: Option<CliError> = None;
     let mut keep = |r: Result<PathBuf, CliError>| {
         if let Err(e) = r
@@ -375,7 +417,6 @@ pub fn simulate(
         "events.csv",
         events_csv(&run.events).as_bytes(),
     ));
-    let s = summary(&model, stride, rows, &run);
     let json =
         serde_json::to_string_pretty(&s).map_err(|e| CliError::Io(format!("summary.json: {e}")));
     keep(
@@ -417,7 +458,14 @@ pub fn run_command(
         run,
         summary,
         io_error,
-    } = simulate(h, config, source, out_dir, crate::interrupt::flag())?;
+    } = simulate(
+        h,
+        config,
+        source,
+        Some(out_dir),
+        crate::interrupt::flag(),
+        &mut |_| {},
+    )?;
     let mut text = String::new();
     for e in run.events.iter().filter(|e| e.leg.is_none()) {
         text.push_str(&format!(

@@ -62,7 +62,9 @@ class Result(Mapping):
     Attributes:
         columns: the column names, in the file's order.
         events: contact events, dicts with ``t``, ``step``, ``leg``,
-            ``point``, ``from``, ``to`` (as ``events.csv``).
+            ``point``, ``from``, ``to`` (as ``events.csv``); for a hexapod
+            (the kinematic gait) lift-offs, touchdowns and stability
+            warnings, dicts with ``t``, ``leg``, ``event``, ``margin``.
         summary: the content of ``summary.json`` as a dict.
         source: the configuration's name (a file, ``<string>``, ``<dict>``).
         error: None, or the message of the error that stopped the run (then

@@ -14,15 +14,16 @@
 //! ```
 //!
 //! then by the constant mount rotation `cA0i⁻¹` (eq. 5), and solved by
-//! [`fbd_kinematics::ik::leg_ik`] and
+//! [`fbd_kinematics::ik::leg_ik_trig`] and
 //! [`fbd_kinematics::leg_jacobian::joint_accelerations_trig`] (the joint
-//! sines and cosines from the solution, one `sin_cos` per leg).
+//! sines and cosines from the solution, no `sin_cos`; they are returned
+//! for the forward kinematics, [`fbd_kinematics::hexapod::forward_trig`]).
 
 use std::f64::consts::TAU;
 
 use fbd_kinematics::KinematicsError;
 use fbd_kinematics::hexapod::HexapodModel;
-use fbd_kinematics::ik::{KneeBranch, leg_ik};
+use fbd_kinematics::ik::{KneeBranch, leg_ik_trig};
 use fbd_kinematics::leg_jacobian::{LegTrig, joint_accelerations_trig};
 use fbd_kinematics::limits::{Joint, JointLimits};
 use fbd_kinematics::nalgebra::Vector3;
@@ -50,6 +51,7 @@ fn nearest(a: f64, near: f64) -> f64 {
 /// Solves leg `leg` (array index) for a foot at `p, v, acc` (inertial) with
 /// the body in state `body` at time `t`; `previous` are the angles of the
 /// previous step (the branch to stay near), `branch` the knee branch.
+/// Returns the joints and the sines and cosines of their angles.
 ///
 /// # Errors
 /// [`GaitError::Unreachable`], [`GaitError::Singular`],
@@ -65,7 +67,7 @@ pub fn solve_leg(
     foot: (&Vector3<f64>, &Vector3<f64>, &Vector3<f64>),
     previous: &[f64; 3],
     branch: KneeBranch,
-) -> Result<LegJoints, GaitError> {
+) -> Result<(LegJoints, LegTrig), GaitError> {
     let (p, v, acc) = foot;
     let rt = body.rotation.transpose();
     let (w, wd) = (&body.omega, &body.omega_dot);
@@ -82,7 +84,7 @@ pub fn solve_leg(
     let (v0, a0) = (r0 * v_b, r0 * a_b);
     let number = leg + 1;
     let geom = model.leg();
-    let mut theta = leg_ik(geom, &p0, branch).map_err(|e| match e {
+    let (mut theta, trig) = leg_ik_trig(geom, &p0, branch).map_err(|e| match e {
         KinematicsError::Unreachable {
             distance,
             min_reach,
@@ -108,7 +110,6 @@ pub fn solve_leg(
     for k in 0..3 {
         theta[k] = nearest(theta[k], previous[k]);
     }
-    let trig = LegTrig::of_solution(geom, theta, &p0);
     let (rate, accel) =
         joint_accelerations_trig(geom, &trig, &v0, &a0).map_err(|s| GaitError::Singular {
             leg: number,
@@ -134,5 +135,5 @@ pub fn solve_leg(
             });
         }
     }
-    Ok(LegJoints { theta, rate, accel })
+    Ok((LegJoints { theta, rate, accel }, trig))
 }

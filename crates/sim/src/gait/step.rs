@@ -2,7 +2,8 @@
 //! body state, inverse kinematics with rates and accelerations, forward
 //! kinematics, centre of mass and stability margin. No allocation.
 
-use fbd_kinematics::hexapod::{HexapodConfig, forward};
+use fbd_kinematics::hexapod::forward_trig;
+use fbd_kinematics::leg_jacobian::LegTrig;
 use fbd_kinematics::nalgebra::Vector3;
 use fbd_kinematics::pose::BodyPose;
 
@@ -38,6 +39,14 @@ pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), Gait
     let zero = Vector3::zeros();
     let mut support = [[0.0; 2]; LEGS];
     let mut n_support = 0;
+    let mut trig = [LegTrig {
+        s1: 0.0,
+        c1: 1.0,
+        s2: 0.0,
+        c2: 1.0,
+        s23: 0.0,
+        c23: 1.0,
+    }; LEGS];
     for leg in 0..LEGS {
         let phase = phase_with(p, leg, model.last_swing[leg], t);
         let (foot, vel, acc) = match phase {
@@ -52,7 +61,7 @@ pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), Gait
             support[n_support] = [foot.x, foot.z];
             n_support += 1;
         }
-        data.legs[leg] = solve_leg(
+        (data.legs[leg], trig[leg]) = solve_leg(
             &model.kin,
             &p.limits,
             leg,
@@ -71,11 +80,8 @@ pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), Gait
         position: body.position,
         phi: body.phi,
     };
-    let cfg = HexapodConfig {
-        pose,
-        joints: data.legs.map(|l| l.theta),
-    };
-    forward(&model.kin, &cfg, &mut data.fk);
+    // The IK's sines and cosines and the body's rotation: no trigonometry.
+    forward_trig(&model.kin, &pose, &body.rotation, &trig, &mut data.fk);
     data.com = centre_of_mass(&model.masses, &data.fk);
     data.margin = margin(&support[..n_support], [data.com.x, data.com.z]);
     data.body = body;

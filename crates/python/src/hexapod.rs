@@ -1,0 +1,108 @@
+//! `run(config)` of a hexapod configuration: the kinematic gait (or a
+//! standing run without `[gait]`), every column of its `trajectory.csv` in
+//! memory ([`fbd_cli::hexapod::columns`]), the same values as the file.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use fbd_cli::hexapod::{HexapodRun, ROW_VALUES, columns, row_values, simulate};
+use fbd_cli::steptime::StepTimes;
+use fbd_scenario::{Config, HexapodConfig};
+use numpy::PyArray1;
+use pyo3::exceptions::PyKeyboardInterrupt;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::errors::cli_error;
+use crate::run::SIGNAL_CHECK;
+
+/// The hexapod's `run` dict: `columns` (names of `trajectory.csv`),
+/// `data` (float64 arrays; `stance{n}` is 1.0 or 0.0), `events` (dicts
+/// `t`, `leg` (None for stability events), `event`, `margin`, as
+/// `events.csv`), `summary` (JSON text), `error`, `source`. Runs with the
+/// GIL released.
+pub fn run<'py>(
+    py: Python<'py>,
+    h: &HexapodConfig,
+    config: &Config,
+    source: &str,
+    from_text: bool,
+    out: Option<&Path>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let names = columns();
+    let outcome = py.detach(|| {
+        let mut data: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
+        let stop = AtomicBool::new(false);
+        let mut signal: Option<PyErr> = None;
+        let mut count = 0usize;
+        let times = StepTimes::new(h.time.dt);
+        let mut row = [0.0; ROW_VALUES];
+        simulate(h, config, source, out, &stop, &mut |d| {
+            data[0].push(times.value(d.step, d.t));
+            row_values(d, &mut row);
+            for (col, v) in data[1..].iter_mut().zip(row) {
+                col.push(v);
+            }
+            count += 1;
+            if count.is_multiple_of(SIGNAL_CHECK)
+                && signal.is_none()
+                && let Err(e) = Python::attach(|py| py.check_signals())
+            {
+                signal = Some(e);
+                stop.store(true, Ordering::Relaxed);
+            }
+        })
+        .map(|r| (r, data, signal))
+    });
+    let (sim, data, signal) = outcome.map_err(|e| cli_error(py, &e, from_text))?;
+    let HexapodRun {
+        run,
+        summary,
+        io_error,
+    } = sim;
+    if let Some(e) = io_error {
+        return Err(cli_error(py, &e, from_text));
+    }
+    if let Some(e) = signal {
+        if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+            return Err(PyKeyboardInterrupt::new_err(format!(
+                "{source}: interrupted after {} steps",
+                run.steps
+            )));
+        }
+        return Err(e);
+    }
+    let d = PyDict::new(py);
+    let arrays = PyDict::new(py);
+    for (name, v) in names.iter().zip(data) {
+        arrays.set_item(name, PyArray1::from_vec(py, v))?;
+    }
+    d.set_item("columns", PyList::new(py, &names)?)?;
+    d.set_item("data", arrays)?;
+    let events = PyList::empty(py);
+    for e in &run.events {
+        let ev = PyDict::new(py);
+        ev.set_item("t", fbd_cli::hexapod::tidy(e.t))?;
+        ev.set_item("leg", e.leg)?;
+        ev.set_item("event", e.kind.as_str())?;
+        ev.set_item("margin", e.margin)?;
+        events.append(ev)?;
+    }
+    d.set_item("events", events)?;
+    let json = serde_json::to_string(&summary).unwrap_or_else(|_| "{}".into());
+    d.set_item("summary", json)?;
+    d.set_item("source", source)?;
+    let error = match &run.error {
+        Some(e) => {
+            let err = PyDict::new(py);
+            err.set_item("message", format!("{e} ({source})"))?;
+            // The failing step is the one after the last computed.
+            err.set_item("step", run.steps)?;
+            err.set_item("t", run.steps as f64 * h.time.dt)?;
+            Some(err)
+        }
+        None => None,
+    };
+    d.set_item("error", error)?;
+    Ok(d)
+}

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Regenerates the plots the README shows, in docs/: forces.svg, joints.svg
+# and energy.svg of the default experiment, the gait diagram and footprints
+# of examples/hexapod_tripod.toml, and the sweep plot of
+# examples/sweep_friction_height.toml. (The viewer screenshots docs/viewer.png
+# and docs/viewer_hexapod.png are taken by scripts/test-browser.sh.)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+cargo build --release --bin fbd
+fbd="${CARGO_TARGET_DIR:-$PWD/target}/release/fbd"
+runs=$(mktemp -d)
+trap 'rm -rf "$runs"' EXIT
+
+"$fbd" run --out "$runs/paper" >/dev/null
+for f in forces joints energy; do
+  cp "$runs/paper/$f.svg" "docs/$f.svg"
+done
+"$fbd" run examples/hexapod_tripod.toml --out "$runs/tripod" >/dev/null
+for f in gait footprints; do
+  cp "$runs/tripod/$f.svg" "docs/hexapod_tripod_$f.svg"
+done
+"$fbd" sweep examples/sweep_friction_height.toml --out "$runs/sweep" --plot slip4 \
+  >/dev/null 2>&1
+cp "$runs/sweep/sweep.svg" docs/sweep_friction_height.svg
+echo "docs/: forces.svg joints.svg energy.svg hexapod_tripod_gait.svg hexapod_tripod_footprints.svg sweep_friction_height.svg"

@@ -4,7 +4,8 @@
 
 use fbd_cli::sweep::{HEXAPOD_COLUMNS, SweepArgs, sweep_command};
 
-const BASE: &str = "model = \"hexapod\"\n[time]\nduration = 4.0\n[gait]\nperiod = 1.0\nramp = 0.5\n";
+const BASE: &str =
+    "model = \"hexapod\"\n[time]\nduration = 4.0\n[gait]\nperiod = 1.0\nramp = 0.5\n";
 
 #[test]
 fn a_hexapod_sweep_writes_the_walk_columns() {

@@ -319,7 +319,7 @@ fn summary(model: &GaitModel, stride: usize, rows: usize, s: &GaitSummary) -> He
         heading_change_deg: s.heading_change.to_degrees(),
         min_margin: s
             .min_margin
-            .and_then(|(v, t)| finite(v).map(|value| AtTime { value, t })),
+            .and_then(|(v, t)| finite(v).map(|value| AtTime { value, t: tidy(t) })),
         peak_joint_rate: per_joint(&s.peak_rate),
         peak_joint_acceleration: per_joint(&s.peak_accel),
         peak_joint_rate_max: max(&s.peak_rate),

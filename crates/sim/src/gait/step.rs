@@ -47,7 +47,7 @@ pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), Gait
         s23: 0.0,
         c23: 1.0,
     }; LEGS];
-    for leg in 0..LEGS {
+    for (leg, trig) in trig.iter_mut().enumerate() {
         let phase = phase_with(p, leg, model.last_swing[leg], t);
         let (foot, vel, acc) = match phase {
             LegPhase::Stance { last } => (anchor(model, leg, last), zero, zero),
@@ -61,7 +61,7 @@ pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), Gait
             support[n_support] = [foot.x, foot.z];
             n_support += 1;
         }
-        (data.legs[leg], trig[leg]) = solve_leg(
+        (data.legs[leg], *trig) = solve_leg(
             &model.kin,
             &p.limits,
             leg,

@@ -84,6 +84,64 @@ pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
+/// How a run ended, for [`conclude`]: `Ok` or the message of its error.
+pub enum Ending {
+    /// Every step was solved.
+    Completed,
+    /// The simulation failed.
+    Failed {
+        /// The simulator's message (names the step and time).
+        error: String,
+        /// The configuration's file name.
+        source: String,
+        /// What to change, if the loader can tell (e.g. a smaller Δt).
+        advice: Option<String>,
+    },
+    /// Stopped by SIGINT/SIGTERM; the message says where.
+    Interrupted(String),
+}
+
+/// The end of `fbd run` for every model: prints the report `text` (with
+/// the list of files unless writing them failed), then turns the outcome
+/// into the command's result: the I/O error first, then the simulation
+/// error or the interruption, each saying where the steps computed so far
+/// are.
+pub fn conclude(
+    out: &mut dyn Write,
+    mut text: String,
+    out_dir: &Path,
+    files: &[&str],
+    io_error: Option<CliError>,
+    ending: Ending,
+) -> Result<(), CliError> {
+    if io_error.is_none() {
+        text.push_str(&format!(
+            "files in {}: {}\n",
+            out_dir.display(),
+            files.join(" ")
+        ));
+    }
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(CliError::stdout)?;
+    if let Some(e) = io_error {
+        return Err(e);
+    }
+    let saved = format!("the steps computed so far are in {}", out_dir.display());
+    match ending {
+        Ending::Completed => Ok(()),
+        Ending::Failed {
+            error,
+            source,
+            advice,
+        } => Err(CliError::Simulation(format!(
+            "{error} ({source}; {saved}){}",
+            advice.map(|a| format!("; {a}")).unwrap_or_default()
+        ))),
+        Ending::Interrupted(msg) => Err(CliError::Interrupted(format!("{msg}; {saved}"))),
+    }
+}
+
 /// Writes `bytes` to `dir/name` all-or-nothing; returns the path.
 pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliError> {
     let dest = dir.join(name);

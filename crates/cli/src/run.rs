@@ -10,7 +10,7 @@ use fbd_sim::{Model, RunSummary, StepRecord};
 
 use crate::CliError;
 use crate::config::{self, Config};
-use crate::output::{self, Energy, EventJson, PeakForce, Summary, TrajectoryWriter};
+use crate::output::{self, Ending, Energy, EventJson, PeakForce, Summary, TrajectoryWriter};
 use crate::plot::{self, PlotData, PlotRecorder, Stance};
 use crate::steptime::StepTimes;
 use crate::viewer::{self, planar::PlanarScene};
@@ -398,39 +398,24 @@ pub fn run_command(
         ),
         run.wall_seconds
     ));
-    if io_error.is_none() {
-        text.push_str(&format!(
-            "files in {}: {}\n",
-            out_dir.display(),
-            files.join(" ")
-        ));
-    }
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(CliError::stdout)?;
-
-    if let Some(e) = io_error {
-        return Err(e);
-    }
-    if let Some(e) = &run.error {
-        let advice = match &config {
-            Config::Planar(p) => p.advice(e).map(|a| format!("; {a}")),
-            Config::Hexapod(_) => None,
-        };
-        return Err(CliError::Simulation(format!(
-            "{e} ({source}; the steps computed so far are in {}){}",
-            out_dir.display(),
-            advice.unwrap_or_default()
-        )));
-    }
-    if run.interrupted {
-        return Err(CliError::Interrupted(format!(
-            "interrupted after {} of {} steps (t = {} s); the steps computed so far are in {}",
+    let ending = if let Some(e) = &run.error {
+        Ending::Failed {
+            error: e.to_string(),
+            source: source.to_string(),
+            advice: match &config {
+                Config::Planar(p) => p.advice(e),
+                Config::Hexapod(_) => None,
+            },
+        }
+    } else if run.interrupted {
+        Ending::Interrupted(format!(
+            "interrupted after {} of {} steps (t = {} s)",
             run.steps,
             summary.steps_planned,
-            times.string(run.steps, run.steps as f64 * summary.dt),
-            out_dir.display()
-        )));
-    }
-    Ok(())
+            times.string(run.steps, run.steps as f64 * summary.dt)
+        ))
+    } else {
+        Ending::Completed
+    };
+    output::conclude(out, text, out_dir, &files, io_error, ending)
 }

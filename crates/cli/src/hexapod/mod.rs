@@ -16,7 +16,7 @@ use tempfile::NamedTempFile;
 
 use crate::CliError;
 use crate::config::{Config, HexapodConfig};
-use crate::output;
+use crate::output::{self, Ending};
 use crate::steptime::StepTimes;
 use crate::viewer::hexapod::{HexFrame, HexapodScene};
 
@@ -508,32 +508,20 @@ pub fn run_command(
         )),
         None => text.push_str("minimum stability margin: no support polygon\n"),
     }
-    if io_error.is_none() {
-        text.push_str(&format!(
-            "files in {}: {}\n",
-            out_dir.display(),
-            FILES.join(" ")
-        ));
-    }
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(CliError::stdout)?;
-    if let Some(e) = io_error {
-        return Err(e);
-    }
-    if let Some(e) = &run.error {
-        return Err(CliError::Simulation(format!(
-            "{e} ({source}; the steps computed so far are in {})",
-            out_dir.display()
-        )));
-    }
-    if run.interrupted {
-        return Err(CliError::Interrupted(format!(
-            "interrupted after {} steps (t = {} s); the steps computed so far are in {}",
+    let ending = if let Some(e) = &run.error {
+        Ending::Failed {
+            error: e.to_string(),
+            source: source.to_string(),
+            advice: None,
+        }
+    } else if run.interrupted {
+        Ending::Interrupted(format!(
+            "interrupted after {} steps (t = {} s)",
             run.steps,
-            fbd_sim::gait::error::fmt_time(run.time),
-            out_dir.display()
-        )));
-    }
-    Ok(())
+            fbd_sim::gait::error::fmt_time(run.time)
+        ))
+    } else {
+        Ending::Completed
+    };
+    output::conclude(out, text, out_dir, &FILES, io_error, ending)
 }

@@ -5,8 +5,10 @@
 //! therefore write the exact decimal product of `k` and the shortest
 //! decimal of Δt (`0.35`), computed in integer arithmetic: it reads back as
 //! the double nearest to `k·Δt`, and the same configuration gives the same
-//! bytes. A time that is not a whole step (a sub-step) is written as the
-//! shortest decimal that reads back to its double.
+//! bytes. A time inside a step retried in sub-steps (`j·Δt/2^m`, m ≤ 6,
+//! at most 64 sub-steps) is written the same way, as the exact decimal of
+//! `j·Δt/2^m` (`0.35625` for the third sixteenth of a 0.3 s step); any
+//! other time as the shortest decimal that reads back to its double.
 
 use std::io::{self, Write};
 
@@ -21,6 +23,10 @@ pub struct StepTimes {
 
 /// Longest decimal [`StepTimes::write`] produces.
 const BUF: usize = 64;
+
+/// Most halvings of Δt a sub-step time is recognised at (64 sub-steps, the
+/// simulator's limit).
+const MAX_HALVINGS: u32 = 6;
 
 impl StepTimes {
     /// The times of a run with time step `dt` (s).
@@ -61,11 +67,30 @@ impl StepTimes {
             .unwrap_or(t)
     }
 
-    /// Writes the decimal of `k·Δt` into `buf` and returns its length, or
-    /// `None` when `t` is not the time of step `k` or the digits overflow.
+    /// Writes the decimal of `k·Δt` into `buf` and returns its length, or,
+    /// when `t` is not the time of step `k`, that of the sub-step time
+    /// `j·Δt/2^m` equal to `t` (m ≤ [`MAX_HALVINGS`]); `None` when `t` is
+    /// neither or the digits overflow.
     fn exact(&self, k: usize, t: f64, buf: &mut [u8; BUF]) -> Option<usize> {
+        if let Some(n) = self.exact_scaled(k as u128, 0, t, buf) {
+            return Some(n);
+        }
+        (1..=MAX_HALVINGS).find_map(|m| {
+            let j = (t / self.dt * f64::from(1u32 << m)).round();
+            (j.is_finite() && j >= 0.0 && j < 1e18)
+                .then(|| self.exact_scaled(j as u128, m, t, buf))
+                .flatten()
+        })
+    }
+
+    /// The decimal of `j·Δt/2^m` (`= j·mantissa·5^m · 10^-(scale+m)`) into
+    /// `buf`, when it reads back within round-off of `t`.
+    fn exact_scaled(&self, j: u128, m: u32, t: f64, buf: &mut [u8; BUF]) -> Option<usize> {
         let (mantissa, scale) = self.digits?;
-        let product = u128::from(mantissa).checked_mul(k as u128)?;
+        let scale = scale + m;
+        let product = u128::from(mantissa)
+            .checked_mul(5u128.checked_pow(m)?)?
+            .checked_mul(j)?;
         let mut digits = [0u8; 40];
         let mut len = 0;
         let mut v = product;
@@ -181,5 +206,14 @@ mod tests {
         let s = StepTimes::new(0.01);
         assert_eq!(s.string(35, 0.355), "0.355");
         assert_eq!(s.value(35, 0.355), 0.355);
+        // A 0.3 s step retried in 16 sub-steps: its third sub-step starts at
+        // 0.3 + 3·0.01875, which floating point sums to 0.35624999999999996.
+        let s = StepTimes::new(0.3);
+        let t = 0.3 + 3.0 * (0.3 / 16.0);
+        assert_eq!(t, 0.35624999999999996);
+        assert_eq!(s.string(1, t), "0.35625");
+        assert_eq!(s.string(1, 0.3 + 0.3 / 64.0), "0.3046875");
+        // Not a sub-step time: its own shortest decimal.
+        assert_eq!(s.string(1, 0.31), "0.31");
     }
 }

@@ -77,7 +77,8 @@ impl StepTimes {
         }
         (1..=MAX_HALVINGS).find_map(|m| {
             let j = (t / self.dt * f64::from(1u32 << m)).round();
-            (0.0..1e18).contains(&j)
+            (0.0..1e18)
+                .contains(&j)
                 .then(|| self.exact_scaled(j as u128, m, t, buf))
                 .flatten()
         })

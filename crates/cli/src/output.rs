@@ -219,11 +219,6 @@ fn is_tip(name: &str) -> bool {
     name == "tip3" || name == "tip4"
 }
 
-/// `tip`, `knee` or `hip` of a contact-point name such as `knee3`.
-pub fn point_kind(name: &str) -> &str {
-    name.trim_end_matches(|c: char| c.is_ascii_digit())
-}
-
 /// Streams `trajectory.csv` through a buffer into a temporary file; no
 /// allocation per row.
 pub struct TrajectoryWriter {

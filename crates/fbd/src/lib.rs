@@ -46,5 +46,5 @@ pub use assemble::{
     advance, eval, evaluate_next, pattern, pattern_key, prepare_step, set_configuration,
 };
 pub use mechanism::{
-    BodySpec, ContactPoints, ContactSpec, JointSpec, Layout, Mechanism, TwoLegInertia,
+    BodySpec, ContactPoints, ContactSpec, JointSpec, Layout, Mechanism, PointKind, TwoLegInertia,
 };

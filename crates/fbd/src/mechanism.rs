@@ -38,13 +38,43 @@ pub struct JointSpec {
     pub axis_z: f64,
     /// Index in `q` of this joint's angle.
     pub q_index: usize,
+    /// Hexapod leg number (1–6) the joint belongs to.
+    pub leg: usize,
+    /// Which joint of the leg's D-H chain (θ1, θ2 or θ3).
+    pub joint: fbd_kinematics::Joint,
+}
+
+/// Which point of a leg a contact point is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PointKind {
+    /// The foot (the paper's tip).
+    Tip,
+    /// The knee joint.
+    Knee,
+    /// The hip joint, on the central body.
+    Hip,
+}
+
+impl PointKind {
+    /// `"tip"`, `"knee"` or `"hip"`, as written to the output files.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            PointKind::Tip => "tip",
+            PointKind::Knee => "knee",
+            PointKind::Hip => "hip",
+        }
+    }
 }
 
 /// A point of a body that can touch the terrain.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactSpec {
-    /// Name, e.g. `"tip3"`.
+    /// Name, e.g. `"tip3"` (for messages and column names).
     pub name: String,
+    /// Hexapod leg number (1–6) the point belongs to.
+    pub leg: usize,
+    /// Which point of the leg it is.
+    pub kind: PointKind,
     /// The body the point belongs to.
     pub body: usize,
     /// The point (index into the chains).
@@ -283,6 +313,8 @@ impl Mechanism {
                 point: ix.hip[leg],
                 axis_z: axis,
                 q_index: theta2_index(leg),
+                leg: n,
+                joint: fbd_kinematics::Joint::Theta2,
             });
             joints.push(JointSpec {
                 name: format!("knee{n}"),
@@ -291,19 +323,23 @@ impl Mechanism {
                 point: ix.knee[leg],
                 axis_z: axis,
                 q_index: theta3_index(leg),
+                leg: n,
+                joint: fbd_kinematics::Joint::Theta3,
             });
         }
         let mut contacts = Vec::new();
-        let groups: [(bool, &str, [usize; 2], [usize; 2]); 3] = [
-            (points.tips, "tip", ix.tip, [2, 4]),
-            (points.knees, "knee", ix.knee, [2, 4]),
-            (points.hips, "hip", ix.hip, [0, 0]),
+        let groups: [(bool, PointKind, [usize; 2], [usize; 2]); 3] = [
+            (points.tips, PointKind::Tip, ix.tip, [2, 4]),
+            (points.knees, PointKind::Knee, ix.knee, [2, 4]),
+            (points.hips, PointKind::Hip, ix.hip, [0, 0]),
         ];
-        for (on, name, pts, body) in groups {
+        for (on, kind, pts, body) in groups {
             if on {
                 for leg in 0..2 {
                     contacts.push(ContactSpec {
-                        name: format!("{name}{}", hexapod_leg_number(leg)),
+                        name: format!("{}{}", kind.as_str(), hexapod_leg_number(leg)),
+                        leg: hexapod_leg_number(leg),
+                        kind,
                         body: body[leg],
                         point: pts[leg],
                     });

@@ -2,9 +2,9 @@
 
 use crate::{PlanarParams, SimError};
 use fbd_contact::{ContactParams, ContactState};
-use fbd_dynamics::{Mechanism, TwoLegInertia};
+use fbd_dynamics::{Mechanism, PointKind, TwoLegInertia};
 use fbd_kinematics::Joint;
-use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex, theta2_index};
+use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex};
 use fbd_solver::NewtonParams;
 
 /// Everything fixed during a run: parameters, mechanism, tolerances.
@@ -245,12 +245,7 @@ impl Model {
         let mut limited = Vec::new();
         let (mut limit_joint, mut limit_leg) = (Vec::new(), Vec::new());
         for (j, spec) in mech.joints.iter().enumerate() {
-            let leg = if spec.name.ends_with('3') { 3 } else { 4 };
-            let joint = if spec.q_index == theta2_index(leg - 3) {
-                Joint::Theta2
-            } else {
-                Joint::Theta3
-            };
+            let (leg, joint) = (spec.leg, spec.joint);
             if let Err(e) = p.joint_limits.check(joint, p.q0[spec.q_index]) {
                 check(
                     false,
@@ -269,29 +264,15 @@ impl Model {
         }
         let mech = mech.with_limits(limited);
         let contact = ContactParams::default();
-        let contact_leg: Vec<usize> = mech
+        let contact_leg: Vec<usize> = mech.contacts.iter().map(|c| c.leg).collect();
+        let contact_point: Vec<&'static str> =
+            mech.contacts.iter().map(|c| c.kind.as_str()).collect();
+        let contact_bumper: Vec<f64> = mech
             .contacts
             .iter()
-            .map(|c| if c.name.ends_with('3') { 3 } else { 4 })
-            .collect();
-        let contact_point: Vec<&'static str> = mech
-            .contacts
-            .iter()
-            .map(|c| {
-                ["tip", "knee", "hip"]
-                    .into_iter()
-                    .find(|k| c.name.starts_with(k))
-                    .expect("two-leg contact points are tips, knees or hips")
-            })
-            .collect();
-        let contact_bumper: Vec<f64> = contact_point
-            .iter()
-            .map(|&k| {
-                if k == "tip" {
-                    0.0
-                } else {
-                    contact.bumper_regularization
-                }
+            .map(|c| match c.kind {
+                PointKind::Tip => 0.0,
+                PointKind::Knee | PointKind::Hip => contact.bumper_regularization,
             })
             .collect();
         let total_mass = mech.total_mass();

@@ -25,7 +25,7 @@ python3 -c 'import mujoco' 2> /dev/null || {
 }
 
 (cd "$root" && cargo build --release -q --bin fbd)
-fbd="$root/target/release/fbd"
+fbd="${CARGO_TARGET_DIR:-$root/target}/release/fbd"
 
 # case  fbd config              MuJoCo case
 cases=(

@@ -142,6 +142,24 @@ pub fn conclude(
     }
 }
 
+/// The files every run writes beside its trajectory and plots:
+/// `events.csv`, `summary.json` (pretty JSON of `summary`) and `config.toml`,
+/// each all-or-nothing. Every file is attempted; each result goes to `keep`
+/// (which remembers the first failure).
+pub fn write_run_files(
+    dir: &Path,
+    events_csv: &str,
+    summary: &impl Serialize,
+    config_toml: &str,
+    keep: &mut impl FnMut(Result<PathBuf, CliError>),
+) {
+    keep(write_file(dir, "events.csv", events_csv.as_bytes()));
+    let json = serde_json::to_string_pretty(summary)
+        .map_err(|e| CliError::Io(format!("summary.json: {e}")));
+    keep(json.and_then(|j| write_file(dir, "summary.json", format!("{j}\n").as_bytes())));
+    keep(write_file(dir, "config.toml", config_toml.as_bytes()));
+}
+
 /// Writes `bytes` to `dir/name` all-or-nothing; returns the path.
 pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliError> {
     let dest = dir.join(name);

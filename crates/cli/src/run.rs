@@ -286,21 +286,13 @@ pub fn simulate(
     if let Some(t) = traj {
         keep(t.finish());
     }
-    keep(output::write_file(
+    output::write_run_files(
         out_dir,
-        "events.csv",
-        output::run_events_csv(&run, model.dt()).as_bytes(),
-    ));
-    let json =
-        serde_json::to_string_pretty(&s).map_err(|e| CliError::Io(format!("summary.json: {e}")));
-    keep(
-        json.and_then(|j| output::write_file(out_dir, "summary.json", format!("{j}\n").as_bytes())),
+        &output::run_events_csv(&run, model.dt()),
+        &s,
+        &config.to_toml(),
+        &mut keep,
     );
-    keep(output::write_file(
-        out_dir,
-        "config.toml",
-        config.to_toml().as_bytes(),
-    ));
     let torques = plot::torques_svg(&plot_data).map(|svg| ("torques.svg", svg));
     let torques_written = torques.is_some();
     for (name, svg) in [

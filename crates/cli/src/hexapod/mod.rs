@@ -412,21 +412,13 @@ pub fn simulate(
         }
     };
     keep(traj.finish());
-    keep(output::write_file(
+    output::write_run_files(
         out_dir,
-        "events.csv",
-        events_csv(&run.events).as_bytes(),
-    ));
-    let json =
-        serde_json::to_string_pretty(&s).map_err(|e| CliError::Io(format!("summary.json: {e}")));
-    keep(
-        json.and_then(|j| output::write_file(out_dir, "summary.json", format!("{j}\n").as_bytes())),
+        &events_csv(&run.events),
+        &s,
+        &config.to_toml(),
+        &mut keep,
     );
-    keep(output::write_file(
-        out_dir,
-        "config.toml",
-        config.to_toml().as_bytes(),
-    ));
     for (name, svg) in [
         ("gait.svg", gait_svg(&plot)),
         ("footprints.svg", footprints_svg(&plot)),

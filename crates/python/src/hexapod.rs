@@ -3,7 +3,7 @@
 //! memory ([`fbd_cli::hexapod::columns`]), the same values as the file.
 
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 
 use fbd_cli::hexapod::{HexapodRun, ROW_VALUES, columns, row_values, simulate};
 use fbd_cli::steptime::StepTimes;
@@ -14,7 +14,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::errors::cli_error;
-use crate::run::SIGNAL_CHECK;
+use crate::run::SignalWatch;
 
 /// The hexapod's `run` dict: `columns` (names of `trajectory.csv`),
 /// `data` (float64 arrays; `stance{n}` is 1.0 or 0.0), `events` (dicts
@@ -33,8 +33,7 @@ pub fn run<'py>(
     let outcome = py.detach(|| {
         let mut data: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
         let stop = AtomicBool::new(false);
-        let mut signal: Option<PyErr> = None;
-        let mut count = 0usize;
+        let mut watch = SignalWatch::default();
         let times = StepTimes::new(h.time.dt);
         let mut row = [0.0; ROW_VALUES];
         simulate(h, config, source, out, &stop, &mut |d| {
@@ -43,16 +42,9 @@ pub fn run<'py>(
             for (col, v) in data[1..].iter_mut().zip(row) {
                 col.push(v);
             }
-            count += 1;
-            if count.is_multiple_of(SIGNAL_CHECK)
-                && signal.is_none()
-                && let Err(e) = Python::attach(|py| py.check_signals())
-            {
-                signal = Some(e);
-                stop.store(true, Ordering::Relaxed);
-            }
+            watch.row(&stop);
         })
-        .map(|r| (r, data, signal))
+        .map(|r| (r, data, watch.signal))
     });
     let (sim, data, signal) = outcome.map_err(|e| cli_error(py, &e, from_text))?;
     let HexapodRun {

@@ -15,6 +15,31 @@ use crate::errors::{cli_error, guard};
 /// Rows between two looks at Python's signals during a run.
 pub const SIGNAL_CHECK: usize = 4096;
 
+/// Ctrl-C (KeyboardInterrupt) during a run: every [`SIGNAL_CHECK`] rows the
+/// GIL is taken back to let Python run its signal handlers (on the main
+/// thread only, as Python does); an exception they raise sets the run's
+/// stop flag and is kept to be raised when the run returns.
+#[derive(Default)]
+pub struct SignalWatch {
+    /// The exception a signal handler raised.
+    pub signal: Option<PyErr>,
+    rows: usize,
+}
+
+impl SignalWatch {
+    /// Counts one row; every [`SIGNAL_CHECK`] rows, looks at the signals.
+    pub fn row(&mut self, stop: &AtomicBool) {
+        self.rows += 1;
+        if self.rows.is_multiple_of(SIGNAL_CHECK)
+            && self.signal.is_none()
+            && let Err(e) = Python::attach(|py| py.check_signals())
+        {
+            self.signal = Some(e);
+            stop.store(true, Ordering::Relaxed);
+        }
+    }
+}
+
 /// Every event of a run — contact, joint-limit and retried-step events, as
 /// `events.csv` lists them ([`fbd_cli::output::merge_events`]) — as a list
 /// of dicts (`t`, `step`, `leg` (None for a retried step), `point`, `from`,
@@ -79,12 +104,8 @@ pub fn run<'py>(
                 fbd_scenario::Config::Hexapod(c) => (Vec::new(), c.time.dt, 0),
             };
             let mut cols = Columns::new(&names, dt, rows);
-            // Ctrl-C (KeyboardInterrupt) stops the run: every SIGNAL_CHECK
-            // rows the GIL is taken back to let Python run its signal
-            // handlers (on the main thread only, as Python does).
             let stop = AtomicBool::new(false);
-            let mut signal: Option<PyErr> = None;
-            let mut count = 0usize;
+            let mut watch = SignalWatch::default();
             simulate(
                 &loaded.config,
                 &loaded.source,
@@ -92,17 +113,10 @@ pub fn run<'py>(
                 &stop,
                 &mut |r| {
                     cols.push(r);
-                    count += 1;
-                    if count.is_multiple_of(SIGNAL_CHECK)
-                        && signal.is_none()
-                        && let Err(e) = Python::attach(|py| py.check_signals())
-                    {
-                        signal = Some(e);
-                        stop.store(true, Ordering::Relaxed);
-                    }
+                    watch.row(&stop);
                 },
             )
-            .map(|s| (s, cols, dt, signal))
+            .map(|s| (s, cols, dt, watch.signal))
         });
         let (sim, cols, dt, signal) = outcome.map_err(|e| cli_error(py, &e, loaded.from_text))?;
         let Simulated {

@@ -7,21 +7,17 @@ use fbd_sim::gait::stability::convex_hull;
 use fbd_sim::gait::{GaitData, GaitModel, LEGS};
 use plotters::prelude::*;
 
-use crate::plot::{draw_legend, err, legend_line, range, tick};
+use crate::plot::{PALETTE, draw_legend, err, legend_line, range, tick};
 
 /// Most samples kept per plotted curve.
 const SAMPLES: usize = 4000;
 /// Support polygons drawn in `footprints.svg`.
 const POLYGONS: usize = 8;
 
-const LEG_COLORS: [RGBColor; LEGS] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 39, 40),
-    RGBColor(44, 160, 44),
-    RGBColor(255, 127, 14),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-];
+/// One colour per leg: the first six of the plots' palette.
+fn leg_color(leg: usize) -> RGBColor {
+    PALETTE[leg % PALETTE.len()]
+}
 
 /// A support polygon at one instant.
 #[derive(Clone, Debug, PartialEq)]
@@ -247,7 +243,7 @@ pub fn footprints_svg(d: &GaitPlotData) -> PlotResult {
             .label("body path")
             .legend(legend_line(BLACK, 2));
         for (leg, f) in d.footholds.iter().enumerate() {
-            let c = LEG_COLORS[leg];
+            let c = leg_color(leg);
             chart
                 .draw_series(f.iter().map(|p| Circle::new((p[0], p[1]), 3, c.filled())))
                 .map_err(err)?
@@ -286,7 +282,7 @@ pub fn joints_svg(d: &GaitPlotData) -> PlotResult {
                 .light_line_style(WHITE.mix(0.0))
                 .draw()
                 .map_err(err)?;
-            for (leg, &c) in LEG_COLORS.iter().enumerate() {
+            for (leg, c) in (0..LEGS).map(|leg| (leg, leg_color(leg))) {
                 chart
                     .draw_series(LineSeries::new(
                         d.t.iter().zip(&d.theta[j][leg]).map(|(a, b)| (*a, *b)),

@@ -32,7 +32,16 @@ Cases (the same initial states as bench/peer/*.toml):
   5 mm radius): the passive robot collapses with both feet on the floor;
 * ``hang``: floor plane y = 0; legs θ = (0°, 90°), Ry = −0.42 (+ radius):
   the body hangs below the floor (nothing but the feet collides) from both
-  feet, which stay on it.
+  feet, which stay on it;
+* ``moving_flight``: as ``flight`` with the body spinning and the legs
+  swinging from t = 0: φ̇z = −115°/s, (θ̇2₃, θ̇3₃, θ̇2₄, θ̇3₄) =
+  (170, −60, 140, 60) °/s;
+* ``passive_fall``: the built-in experiment (fbd's default configuration):
+  the default pose at rest, floor plane y = −radius (so that a sphere
+  touches it when its centre, fbd's point, is at y = 0), spheres at the
+  tips, knees (lower link, at the knee) and hips (central body), fbd's
+  default joint ranges (MuJoCo's soft limits; fbd's are plastic stops),
+  friction μS = 0.4.
 
 Prints one JSON object per case: {case, steps, seconds, steps_per_second}
 (and the number of contacts at the end, as a sanity check).
@@ -56,32 +65,59 @@ UP_COM, LOW_COM = 0.5, 0.75
 RADIUS = 0.005
 DT = 0.001
 FRICTION = 0.4
+HIP_LIMIT = math.radians(120)
+KNEE_LIMITS = (math.radians(180), math.radians(330))
 
 
-def leg(n, s):
-    """Leg n (3 or 4) with side sign s (−1 left, +1 right), at θ2 = θ3 = 0."""
+def leg(n, s, knees=False, limits=False):
+    """Leg n (3 or 4) with side sign s (−1 left, +1 right), at θ2 = θ3 = 0;
+    ``knees``: a contact sphere at the knee too; ``limits``: fbd's default
+    joint ranges (θ2 ∈ [−120°, 120°], θ3 ∈ [180°, 330°])."""
     axis = "0 0 1" if s < 0 else "0 0 -1"
+    hip_range = f' range="{-HIP_LIMIT!r} {HIP_LIMIT!r}"' if limits else ""
+    knee_range = f' range="{KNEE_LIMITS[0]!r} {KNEE_LIMITS[1]!r}"' if limits else ""
+    knee = (
+        f"""
+          <geom name="knee{n}" type="sphere" size="{RADIUS!r}" pos="0 0 0"
+                contype="1" conaffinity="0" friction="{FRICTION!r} 0.005 0.0001"/>"""
+        if knees
+        else ""
+    )
     return f"""
       <body name="upper{n}" pos="{s * D!r} 0 0">
-        <joint name="hip{n}" type="hinge" axis="{axis}"/>
+        <joint name="hip{n}" type="hinge" axis="{axis}"{hip_range}/>
         <inertial pos="{s * UP_COM * A!r} 0 0" mass="{M_UP!r}" diaginertia="{I_UP!r} {I_UP!r} {I_UP!r}"/>
         <body name="lower{n}" pos="{s * A!r} 0 0">
-          <joint name="knee{n}" type="hinge" axis="{axis}"/>
+          <joint name="knee{n}" type="hinge" axis="{axis}"{knee_range}/>
           <inertial pos="{-s * LOW_COM * C!r} 0 0" mass="{M_LOW!r}" diaginertia="{I_LOW!r} {I_LOW!r} {I_LOW!r}"/>
           <geom name="foot{n}" type="sphere" size="{RADIUS!r}" pos="{-s * C!r} 0 0"
-                contype="1" conaffinity="0" friction="{FRICTION!r} 0.005 0.0001"/>
+                contype="1" conaffinity="0" friction="{FRICTION!r} 0.005 0.0001"/>{knee}
         </body>
       </body>"""
 
 
-def mjcf(floor):
+def mjcf(floor, floor_y=0.0, every_point=False):
+    """The model; ``floor``: a ground plane at y = ``floor_y``;
+    ``every_point``: spheres at the knees and hips too and fbd's joint
+    ranges (the built-in experiment's robot)."""
     floor_geom = (
-        '<geom name="floor" type="plane" zaxis="0 1 0" size="0 0 1" contype="0" conaffinity="1"/>'
+        f'<geom name="floor" type="plane" zaxis="0 1 0" size="0 0 1" pos="0 {floor_y!r} 0" contype="0" conaffinity="1"/>'
         if floor
+        else ""
+    )
+    hips = (
+        "".join(
+            f"""
+      <geom name="hip{n}" type="sphere" size="{RADIUS!r}" pos="{s * D!r} 0 0"
+            contype="1" conaffinity="0" friction="{FRICTION!r} 0.005 0.0001"/>"""
+            for n, s in ((3, -1.0), (4, 1.0))
+        )
+        if every_point
         else ""
     )
     return f"""
 <mujoco model="fbd_planar">
+  <compiler angle="radian"/>
   <option timestep="{DT!r}" integrator="Euler" gravity="0 -9.81 0"/>
   <worldbody>
     {floor_geom}
@@ -89,33 +125,39 @@ def mjcf(floor):
       <joint name="rx" type="slide" axis="1 0 0"/>
       <joint name="ry" type="slide" axis="0 1 0"/>
       <joint name="phiz" type="hinge" axis="0 0 1"/>
-      <inertial pos="0 0 0" mass="{M_BODY!r}" diaginertia="{I_BODY!r} {I_BODY!r} {I_BODY!r}"/>
-      {leg(3, -1.0)}
-      {leg(4, +1.0)}
+      <inertial pos="0 0 0" mass="{M_BODY!r}" diaginertia="{I_BODY!r} {I_BODY!r} {I_BODY!r}"/>{hips}
+      {leg(3, -1.0, every_point, every_point)}
+      {leg(4, +1.0, every_point, every_point)}
     </body>
   </worldbody>
 </mujoco>"""
 
 
 def case_setup(case):
-    """(floor?, qpos) of a case; qpos = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)."""
+    """(mjcf text, qpos, qvel) of a case; qpos = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)."""
     r = math.radians
+    rest = [0.0] * 7
+    q_default = [0.0, 0.6, 0.0, 0.0, r(245), 0.0, r(255)]
     if case == "flight":
-        return False, [0.0, 0.6, 0.0, 0.0, r(245), 0.0, r(255)]
+        return mjcf(False), q_default, rest
     if case == "stand":
         th3 = r(250)
-        return True, [0.0, -C * math.sin(th3) + RADIUS, 0.0, 0.0, th3, 0.0, th3]
+        return mjcf(True), [0.0, -C * math.sin(th3) + RADIUS, 0.0, 0.0, th3, 0.0, th3], rest
     if case == "hang":
-        return True, [0.0, -C + RADIUS, 0.0, 0.0, r(90), 0.0, r(90)]
+        return mjcf(True), [0.0, -C + RADIUS, 0.0, 0.0, r(90), 0.0, r(90)], rest
+    if case == "moving_flight":
+        return mjcf(False), q_default, [0.0, 0.0, r(-115), r(170), r(-60), r(140), r(60)]
+    if case == "passive_fall":
+        return mjcf(True, -RADIUS, every_point=True), q_default, rest
     raise ValueError(case)
 
 
 def run(case, steps, repeat):
-    floor, qpos = case_setup(case)
-    model = mujoco.MjModel.from_xml_string(mjcf(floor))
+    xml, qpos, qvel = case_setup(case)
+    model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
     data.qpos[:] = qpos
-    data.qvel[:] = 0.0
+    data.qvel[:] = qvel
     mujoco.mj_forward(model, data)
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state0 = np.empty(mujoco.mj_stateSize(model, spec))
@@ -141,7 +183,7 @@ def run(case, steps, repeat):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("cases", nargs="*", default=["flight", "stand", "hang"])
+    ap.add_argument("cases", nargs="*", default=["flight", "stand", "hang", "moving_flight", "passive_fall"])
     ap.add_argument("--steps", type=int, default=100_000, help="steps per rollout (default 100000 = 100 s)")
     ap.add_argument("--repeat", type=int, default=3, help="rollouts per case; the fastest is reported")
     args = ap.parse_args()

@@ -1,14 +1,23 @@
 #!/usr/bin/env bash
-# fbd vs MuJoCo on the same planar model, one core, dt = 1 ms (issue 5).
+# fbd vs MuJoCo on the same models, one core, dt = 1 ms (issues 5, 11, 14).
 #
 #   bench/peer/run.sh            # from anywhere; needs cargo and python3
 #   REPEAT=5 bench/peer/run.sh   # best of 5 runs per case (default 3)
+#   CASES="moving_flight hexapod_stand" bench/peer/run.sh   # some cases
 #
 # fbd: `fbd run` on bench/peer/<case>.toml, steps_per_second from
-# summary.json (wall time of the stepping loop alone, output excluded).
-# MuJoCo: mujoco_planar.py (mujoco.rollout, one thread, same model, same
-# initial state, same number of steps). Prints: case, fbd steps/s, MuJoCo
-# steps/s, ratio fbd/MuJoCo. Pin both to one core with taskset if present.
+# summary.json (wall time of the stepping loop alone, output excluded), and
+# its Newton iterations per step (mean, max) and the split of the
+# iterations into chord steps (a factorisation reused) and full Newton
+# steps (the Jacobian factored at the iterate).
+# MuJoCo: the planar cases by mujoco_planar.py, the hexapod cases by
+# mujoco_hexapod.py on the model `fbd export mjcf` writes of the same
+# configuration (mujoco.rollout, one thread, same initial state, same
+# number of steps). Prints one table: case, steps, fbd steps/s, MuJoCo
+# steps/s, ratio fbd/MuJoCo, Newton iterations per step, chord/full; then
+# the standing hexapod's normal forces in both and the walk's distance.
+# Pins both to one core with taskset if present. The binary is built in
+# CARGO_TARGET_DIR (default: the tree's target/).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -27,30 +36,111 @@ python3 -c 'import mujoco' 2> /dev/null || {
 (cd "$root" && cargo build --release -q --bin fbd)
 fbd="${CARGO_TARGET_DIR:-$root/target}/release/fbd"
 
-# case  fbd config              MuJoCo case
-cases=(
-    "flight flight.toml flight"
-    "contact_stand contact_stand.toml stand"
-    "contact_hang contact_hang.toml hang"
+# case           model    MuJoCo case
+all=(
+    "flight planar flight"
+    "contact_stand planar stand"
+    "contact_hang planar hang"
+    "moving_flight planar moving_flight"
+    "passive_fall planar passive_fall"
+    "hexapod_stand hexapod stand"
+    "hexapod_walk hexapod walk"
 )
+wanted="${CASES:-}"
 
-printf '%-14s %8s %14s %14s %8s\n' case steps "fbd steps/s" "MuJoCo steps/s" ratio
-for row in "${cases[@]}"; do
-    read -r name config mj <<< "$row"
-    best=0
-    steps=0
+# Best steps/s of $repeat fbd runs of $1 into $2, then the last run's
+# "steps sps iterations" (iterations: "mean max chord/full").
+fbd_best() {
+    local config=$1 dir=$2 best=0 line
     for _ in $(seq "$repeat"); do
-        "${pin[@]}" "$fbd" run "$here/$config" --out "$out/$name" > /dev/null
-        read -r s sps < <(python3 -c '
+        if ! "${pin[@]}" "$fbd" run "$config" --out "$dir" > "$dir.log" 2>&1; then
+            if [ ! -f "$dir/summary.json" ]; then
+                echo "FAILED $(tail -n 1 "$dir.log")"
+                return
+            fi
+        fi
+        line=$(python3 - "$dir/summary.json" << 'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
-assert d["status"] == "ok", d["error"]
-print(d["steps"], d["steps_per_second"])' "$out/$name/summary.json")
-        steps=$s
+if d["status"] != "ok":
+    print("FAILED", d["error"])
+    sys.exit()
+if d.get("model") == "hexapod" and not d.get("newton_iterations"):
+    print("FAILED this fbd ran the kinematic gait, not the 3D dynamics")
+    sys.exit()
+per = d.get("newton_iterations_per_step")
+mean = per["mean"] if per else d["newton_iterations"] / max(d["steps"], 1)
+mx = per["max"] if per else "-"
+split = f'{d["chord_iterations"]}/{d["full_newton_iterations"]}' if "chord_iterations" in d else "-"
+print(d["steps"], d["steps_per_second"], f"{mean:.2f}", mx, split)
+EOF
+        )
+        case $line in FAILED*) echo "$line"; return ;; esac
+        read -r steps sps rest <<< "$line"
         best=$(python3 -c "print(max($best, $sps))")
     done
-    mujoco=$("${pin[@]}" python3 "$here/mujoco_planar.py" "$mj" --steps "$steps" --repeat "$repeat" |
-        python3 -c 'import json, sys; print(json.loads(sys.stdin.readline())["steps_per_second"])')
-    printf '%-14s %8d %14.0f %14.0f %8.2f\n' "$name" "$steps" "$best" "$mujoco" \
-        "$(python3 -c "print($best / $mujoco)")"
+    echo "$steps $best $rest"
+}
+
+printf '%-14s %7s %12s %12s %7s %9s %7s %16s\n' \
+    case steps "fbd steps/s" "MuJoCo st/s" ratio "it/step" "it max" "chord/full"
+notes=()
+for row in "${all[@]}"; do
+    read -r name model mj <<< "$row"
+    if [ -n "$wanted" ] && [[ " $wanted " != *" $name "* ]]; then continue; fi
+    config="$here/$name.toml"
+    result=$(fbd_best "$config" "$out/$name")
+    case $result in
+        FAILED*)
+            printf '%-14s fbd failed: %s\n' "$name" "${result#FAILED }"
+            continue
+            ;;
+    esac
+    read -r steps best mean mx split <<< "$result"
+    if [ "$model" = planar ]; then
+        mujoco=$("${pin[@]}" python3 "$here/mujoco_planar.py" "$mj" --steps "$steps" --repeat "$repeat")
+    else
+        "$fbd" export mjcf "$config" --out "$out/$name.xml"
+        extra=()
+        if [ "$mj" = walk ]; then
+            python3 "$here/mujoco_hexapod.py" twin "$config" "$out/${name}_kinematic.toml"
+            "$fbd" run "$out/${name}_kinematic.toml" --out "$out/${name}_kinematic" > /dev/null
+            extra=(--targets "$out/${name}_kinematic/trajectory.csv")
+        fi
+        mujoco=$("${pin[@]}" python3 "$here/mujoco_hexapod.py" "$mj" "$out/$name.xml" \
+            --steps "$steps" --repeat "$repeat" "${extra[@]}")
+        notes+=("$name|$mj|$mujoco")
+    fi
+    msps=$(python3 -c 'import json, sys; print(json.loads(sys.argv[1])["steps_per_second"])' "$mujoco")
+    printf '%-14s %7d %12.0f %12.0f %7.2f %9s %7s %16s\n' "$name" "$steps" "$best" "$msps" \
+        "$(python3 -c "print($best / $msps)")" "$mean" "$mx" "$split"
+done
+
+# The hexapod cases' physics side by side (fbd: the last row of
+# trajectory.csv, t = the run's end).
+for note in "${notes[@]}"; do
+    IFS='|' read -r name mj mujoco <<< "$note"
+    python3 - "$out/$name/trajectory.csv" "$mj" "$mujoco" << 'EOF'
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+case, mj = sys.argv[2], json.loads(sys.argv[3])
+first, last = rows[0], rows[-1]
+print()
+if case == "stand":
+    print(f"hexapod_stand at t = {float(last['t']):g} s: normal force of the ground on each foot (N)")
+    print(f"{'foot':>6} {'fbd':>10} {'MuJoCo':>10}")
+    total = 0.0
+    for n in range(1, 7):
+        f = float(last.get(f"foot{n}_fy", "nan"))
+        total += f
+        m = mj["normal"].get(f"tip{n}", 0.0)
+        print(f"{n:>6} {f:>10.3f} {m:>10.3f}")
+    print(f"{'sum':>6} {total:>10.3f} {mj['normal_sum']:>10.3f}   weight {mj['weight']:.3f} N")
+else:
+    d = [float(last[k]) - float(first[k]) for k in ("rx", "ry", "rz")]
+    m = [b - a for a, b in zip(mj["body_start"], mj["body_end"])]
+    print(f"hexapod_walk: body displacement over {float(last['t']):g} s (m)")
+    print(f"  fbd    ({d[0]:+.4f}, {d[1]:+.4f}, {d[2]:+.4f})")
+    print(f"  MuJoCo ({m[0]:+.4f}, {m[1]:+.4f}, {m[2]:+.4f})")
+EOF
 done

@@ -10,6 +10,9 @@
   const S = JSON.parse(document.getElementById('fbd-scene').textContent);
   const N = S.t.length;
   const planar = S.model === 'planar';
+  // Contact states ST1/ST2/ST3 and force arrows: the planar model and a
+  // dynamic hexapod run (a kinematic gait has only swing and stance).
+  const forces = planar || !!S.dynamic;
   const NP = S.points.length;
 
   // Colours: body, legs (planar: leg 3 blue, leg 4 red, as in the plots),
@@ -144,7 +147,9 @@
     for (let f = 0; f < N; f++) for (let a = 0; a < 3; a++) pos[3 * f + a] = S.p[f][3 * pi + a];
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    const c = planar ? LEGS[k % LEGS.length] : LEGS[k % LEGS.length];
+    // Hexapod: the colour of the leg whose link ends at the trail's point.
+    const leg = S.lines.find((l) => l.b === pi && l.group > 0);
+    const c = planar || !leg ? LEGS[k % LEGS.length] : LEGS[(leg.group - 1) % LEGS.length];
     const line = new THREE.Line(g, new THREE.LineBasicMaterial({ color: c, transparent: true, opacity: 0.6 }));
     scene.add(line);
     return line;
@@ -495,27 +500,29 @@
 
   // ---- header and legend -------------------------------------------------
   document.getElementById('title').textContent = 'fbd viewer — ' + S.title;
-  document.getElementById('info').textContent = (planar ? 'planar model, side view' : 'hexapod, 3D') + ' · ' + N + ' frames of ' + S.rows + ' rows' +
+  document.getElementById('info').textContent = (planar ? 'planar model, side view' : S.dynamic ? 'hexapod, 3D dynamics' : 'hexapod, 3D') + ' · ' + N + ' frames of ' + S.rows + ' rows' +
     (N < S.rows ? ' (decimated, every event kept)' : '') + ' · ' + S.events.length + ' events' +
     (forceScale > 0 ? ' · arrows: ' + Number((0.1 / forceScale).toPrecision(2)) + ' N per 0.1 m' : '');
   const legend = document.getElementById('legend');
-  const states = planar ? ['1', '2', '3'] : ['1', '2'];
+  const states = forces ? ['1', '2', '3'] : ['1', '2'];
   for (const s of states) {
     const sw = document.createElement('span');
     sw.className = 'sw';
     sw.style.background = css(STATE[s]);
-    legend.append(sw, document.createTextNode(planar ? STATE_NAME[s] : s === '1' ? 'swing' : 'stance'));
+    legend.append(sw, document.createTextNode(forces ? STATE_NAME[s] : s === '1' ? 'swing' : 'stance'));
   }
   const keys = planar
     ? [[CONTACT_FORCE, 'contact force'], [JOINT_FORCE, 'joint force'], [0x000000, 'centre of mass']]
-    : [[0x000000, 'centre of mass'], [0x2e7d32, 'support polygon']];
+    : forces
+      ? [[CONTACT_FORCE, 'ground force on the foot'], [JOINT_FORCE, 'hip and knee forces'], [0x000000, 'centre of mass'], [0x2e7d32, 'support polygon']]
+      : [[0x000000, 'centre of mass'], [0x2e7d32, 'support polygon']];
   for (const [c, label] of keys) {
     const sw = document.createElement('span');
     sw.className = 'sw';
     sw.style.background = css(c);
     legend.append(sw, document.createTextNode(label));
   }
-  if (!planar) { showJoint.parentElement.style.display = 'none'; showContact.parentElement.style.display = 'none'; }
+  if (!forces) { showJoint.parentElement.style.display = 'none'; showContact.parentElement.style.display = 'none'; }
 
   // ---- the test interface -------------------------------------------------
   function worldPoints() {
@@ -539,6 +546,9 @@
     get playing() { return playing; },
     seek, play, pause, worldPoints, screenPoints,
     state() { return N ? S.state[frame] : ''; },
+    dynamic: !!S.dynamic,
+    contactForces() { return N ? S.fc[frame].slice() : []; },
+    arrowsShown() { return contactArrows.filter((a) => a.visible).length; },
   };
   seek(0);
 })();

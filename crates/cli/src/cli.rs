@@ -54,6 +54,11 @@ pub enum Command {
     /// DIR/config.toml, DIR/trajectory.csv and DIR/events.csv (`fbd run`
     /// writes it too); open it in a browser, no network needed.
     View(ViewArgs),
+    /// Write a configuration's robot in another simulator's format:
+    /// `fbd export mjcf CONFIG [--out FILE]`, the hexapod as a MuJoCo
+    /// model (stdout by default).
+    #[command(subcommand)]
+    Export(crate::export::ExportFormat),
 }
 
 /// Arguments of `fbd view`.
@@ -93,5 +98,6 @@ pub fn dispatch(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         Some(Command::Kinematics(a)) => crate::kinematics::kinematics_command(&a.config, out),
         Some(Command::Sweep(a)) => crate::sweep::sweep_command(a, out),
         Some(Command::View(a)) => crate::viewer::view::view_command(&a.dir, out),
+        Some(Command::Export(f)) => crate::export::export_command(f, out),
     }
 }

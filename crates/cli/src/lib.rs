@@ -14,12 +14,14 @@ pub mod cli;
 /// The configuration: the `fbd-scenario` crate.
 pub use fbd_scenario as config;
 pub mod error;
+pub mod export;
 pub mod hexapod;
 pub mod interrupt;
 pub mod kinematics;
 pub mod output;
 pub mod plot;
 pub mod run;
+pub mod spatial;
 pub mod steptime;
 pub mod sweep;
 pub mod sweep_plot;

@@ -171,8 +171,9 @@ pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliEr
     Ok(dest)
 }
 
-/// Removes from `dir` every file that `fbd run` may write, for either
-/// model ([`FILES`], `torques.svg`, [`crate::hexapod::FILES`]), that the
+/// Removes from `dir` every file that `fbd run` may write, for any
+/// model ([`FILES`], `torques.svg`, [`crate::hexapod::FILES`],
+/// [`crate::spatial::FILES`]), that the
 /// run just finished did not write (`written`), so that no file of an
 /// earlier run (its `torques.svg`, or the planar plots after a hexapod run)
 /// is left beside the new ones looking current. A file that cannot be
@@ -181,7 +182,8 @@ pub fn remove_stale(dir: &Path, written: &[&str]) -> Result<(), CliError> {
     let known = FILES
         .iter()
         .chain(&["torques.svg"])
-        .chain(&crate::hexapod::FILES);
+        .chain(&crate::hexapod::FILES)
+        .chain(&crate::spatial::FILES);
     for name in known.filter(|n| !written.contains(n)) {
         let path = dir.join(name);
         match std::fs::remove_file(&path) {
@@ -479,6 +481,29 @@ pub fn run_events_csv(run: &RunSummary, dt: f64) -> String {
     s
 }
 
+/// Newton iterations per step (`summary.json`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct IterationsPerStep {
+    /// Mean over the solved steps (0 when none).
+    pub mean: f64,
+    /// Most of one step (all its state trials and substeps).
+    pub max: usize,
+}
+
+impl IterationsPerStep {
+    /// The figures of a run.
+    pub fn of(run: &fbd_sim::RunSummary) -> Self {
+        Self {
+            mean: if run.steps > 0 {
+                run.newton_iterations as f64 / run.steps as f64
+            } else {
+                0.0
+            },
+            max: run.max_newton_iterations,
+        }
+    }
+}
+
 /// Peak contact forces of one contact point over the run (N).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct PeakForce {
@@ -513,6 +538,16 @@ pub struct Summary {
     pub steps: usize,
     /// Newton iterations over the whole run.
     pub newton_iterations: usize,
+    /// Newton iterations per step: the mean and the most of one step.
+    pub newton_iterations_per_step: IterationsPerStep,
+    /// Of `newton_iterations`, the chord steps (a factorisation kept from
+    /// an earlier iterate or step).
+    pub chord_iterations: usize,
+    /// Of `newton_iterations`, the full Newton steps (the Jacobian factored
+    /// at the iterate).
+    pub full_newton_iterations: usize,
+    /// Numeric LU factorisations over the whole run.
+    pub numeric_factorizations: u64,
     /// Time in the stepping loop alone (s).
     pub wall_seconds: f64,
     /// `steps / wall_seconds` (null when not measurable).

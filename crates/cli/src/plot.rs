@@ -298,7 +298,7 @@ impl PlotRecorder {
     }
 }
 
-type PlotResult<T> = Result<T, String>;
+pub(crate) type PlotResult<T> = Result<T, String>;
 
 pub(crate) fn err<E: std::fmt::Debug>(e: E) -> String {
     format!("plotting failed: {e:?}")
@@ -539,57 +539,63 @@ fn draw_events<'a, DB: DrawingBackend + 'a>(
 }
 
 /// A chart of curves against time, legend beside it, events labelled.
-fn time_chart(
+pub(crate) fn time_chart(
     title: &str,
     y_desc: &str,
     series: &[(&Trace, Style)],
     events: &[EventMark],
     t_range: (f64, f64),
 ) -> PlotResult<String> {
+    stacked_time_chart(None, &[(title, y_desc, series)], events, t_range)
+}
+
+/// Charts of curves against one time axis, stacked top to bottom (each
+/// `(caption, y_desc, series)` 540 px high, the `title` above them all
+/// when given), one legend beside them listing every series, events
+/// labelled on every chart. Dashed styles must be unique over all charts.
+pub(crate) fn stacked_time_chart(
+    title: Option<&str>,
+    panels: &[(&str, &str, &[(&Trace, Style)])],
+    events: &[EventMark],
+    t_range: (f64, f64),
+) -> PlotResult<String> {
+    const PANEL_HEIGHT: u32 = 540;
+    const TITLE_HEIGHT: u32 = 40;
     let mut buf = String::new();
+    let head = if title.is_some() { TITLE_HEIGHT } else { 0 };
+    let height = head + PANEL_HEIGHT * panels.len().max(1) as u32;
     {
-        let root = SVGBackend::with_string(&mut buf, (960 + LEGEND_WIDTH, 540)).into_drawing_area();
+        let root =
+            SVGBackend::with_string(&mut buf, (960 + LEGEND_WIDTH, height)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let (left, right) = root.split_horizontally(960);
-        let (y0, y1) = range(series.iter().flat_map(|s| s.0.pts.iter().map(|p| &p.1)));
-        // Room above the curves for the event labels.
-        let y1 = if events.is_empty() {
-            y1
-        } else {
-            y1 + 0.18 * (y1 - y0)
+        let body = match title {
+            Some(title) => {
+                let (top, body) = root.split_vertically(head);
+                top.draw(&Text::new(
+                    title.to_owned(),
+                    (480, (head / 2) as i32),
+                    ("sans-serif", 24)
+                        .into_font()
+                        .color(&BLACK)
+                        .pos(Pos::new(HPos::Center, VPos::Center)),
+                ))
+                .map_err(err)?;
+                body
+            }
+            None => root.clone(),
         };
-        let mut chart = ChartBuilder::on(&left)
-            .caption(title, ("sans-serif", 22))
-            .margin(14)
-            .x_label_area_size(48)
-            .y_label_area_size(70)
-            .build_cartesian_2d(t_range.0..t_range.1, y0..y1)
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("time (s)")
-            .y_desc(y_desc)
-            .x_label_formatter(&tick)
-            .y_label_formatter(&tick)
-            .light_line_style(WHITE.mix(0.0))
-            .draw()
-            .map_err(err)?;
-        draw_events(&mut chart, events, (y0, y1))?;
-        // Solid curves first, dashed ones on top: coinciding curves show
-        // both colours.
-        for (trace, style) in series.iter().filter(|s| !s.1.dashed) {
-            draw_trace(&mut chart, &trace.pts, *style)?;
+        let (left, right) = body.split_horizontally(960);
+        let areas = left.split_evenly((panels.len().max(1), 1));
+        for ((caption, y_desc, series), area) in panels.iter().zip(&areas) {
+            time_panel(area, caption, y_desc, series, events, t_range)?;
         }
-        for (trace, style) in series.iter().filter(|s| s.1.dashed) {
-            draw_trace(&mut chart, &trace.pts, *style)?;
-        }
-        let mut entries: Vec<Entry> = series
-            .iter()
-            .map(|(t, s)| Entry {
+        let mut entries: Vec<Entry> = Vec::new();
+        for (_, _, series) in panels {
+            entries.extend(series.iter().map(|(t, s)| Entry {
                 label: t.label.clone(),
                 style: *s,
-            })
-            .collect();
+            }));
+        }
         if !events.is_empty() {
             entries.push(Entry {
                 label: "contact event".into(),
@@ -605,7 +611,12 @@ fn time_chart(
     }
     // Dashed curves interleave their dashes (a dash of each in turn), so
     // that coinciding dashed curves all show.
-    let dashed: Vec<Style> = series.iter().filter(|s| s.1.dashed).map(|s| s.1).collect();
+    let dashed: Vec<Style> = panels
+        .iter()
+        .flat_map(|p| p.2.iter())
+        .filter(|s| s.1.dashed)
+        .map(|s| s.1)
+        .collect();
     let phases = dashed.len().clamp(1, 3);
     for (j, s) in dashed.iter().enumerate() {
         let pattern = if phases == 1 {
@@ -621,6 +632,50 @@ fn time_chart(
     }
     dash(&mut buf, EVENT, 1, EVENT_DASH);
     Ok(buf)
+}
+
+/// One chart of [`stacked_time_chart`] in `area`.
+fn time_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    caption: &str,
+    y_desc: &str,
+    series: &[(&Trace, Style)],
+    events: &[EventMark],
+    t_range: (f64, f64),
+) -> PlotResult<()> {
+    let (y0, y1) = range(series.iter().flat_map(|s| s.0.pts.iter().map(|p| &p.1)));
+    // Room above the curves for the event labels.
+    let y1 = if events.is_empty() {
+        y1
+    } else {
+        y1 + 0.18 * (y1 - y0)
+    };
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(48)
+        .y_label_area_size(70)
+        .build_cartesian_2d(t_range.0..t_range.1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .y_desc(y_desc)
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(err)?;
+    draw_events(&mut chart, events, (y0, y1))?;
+    // Solid curves first, dashed ones on top: coinciding curves show
+    // both colours.
+    for (trace, style) in series.iter().filter(|s| !s.1.dashed) {
+        draw_trace(&mut chart, &trace.pts, *style)?;
+    }
+    for (trace, style) in series.iter().filter(|s| s.1.dashed) {
+        draw_trace(&mut chart, &trace.pts, *style)?;
+    }
+    Ok(())
 }
 
 /// The time axis: from the first to the last point of any curve.

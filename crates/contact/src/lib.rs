@@ -12,10 +12,12 @@
 
 pub mod error;
 pub mod mode;
+pub mod spatial;
 pub mod surface;
 pub mod terrain;
 
 pub use error::ContactError;
 pub use mode::{ContactParams, ContactState, Friction, StateCode, Trial, transition};
+pub use spatial::{SpatialState, SpatialTrial, transition_spatial};
 pub use surface::Surface;
 pub use terrain::{STEP_RAMP, Terrain, TerrainIssue};

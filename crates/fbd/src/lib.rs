@@ -40,6 +40,7 @@
 pub mod assemble;
 pub mod body;
 pub mod mechanism;
+pub mod spatial;
 
 pub use assemble::{
     ContactEquation, FbdData, History, JacobianSink, LimitEquation, LimitState, NoJacobian,

@@ -22,6 +22,9 @@ pub enum ControlKind {
     /// PD tracking of piecewise-linear joint trajectories (`times`,
     /// `target_deg = [[θ2, θ3], ...]`).
     Trajectory,
+    /// Hexapod dynamics: tracking of the `[gait]`'s joint angles and rates
+    /// (feed-forward rates + PD).
+    Gait,
 }
 
 /// `target_deg` of a leg: one `[θ2, θ3]` (pd) or a list of them
@@ -35,7 +38,8 @@ pub enum TargetDeg {
     Points(Vec<Vec<f64>>),
 }
 
-/// `[control.leg3]` / `[control.leg4]`.
+/// `[control.legN]`: legs 3 and 4 of the planar model, 1–6 of the
+/// hexapod (three angles per target there).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct ControlLegConfig {
@@ -61,10 +65,29 @@ pub struct ControlConfig {
     /// Torque saturation (N·m), > 0; omitted for none.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub torque_limit: Option<f64>,
+    /// Leg 1 targets (hexapod).
+    #[serde(skip_serializing_if = "ControlLegConfig::is_empty")]
+    pub leg1: ControlLegConfig,
+    /// Leg 2 targets (hexapod).
+    #[serde(skip_serializing_if = "ControlLegConfig::is_empty")]
+    pub leg2: ControlLegConfig,
     /// Leg 3 targets.
     pub leg3: ControlLegConfig,
     /// Leg 4 targets.
     pub leg4: ControlLegConfig,
+    /// Leg 5 targets (hexapod).
+    #[serde(skip_serializing_if = "ControlLegConfig::is_empty")]
+    pub leg5: ControlLegConfig,
+    /// Leg 6 targets (hexapod).
+    #[serde(skip_serializing_if = "ControlLegConfig::is_empty")]
+    pub leg6: ControlLegConfig,
+}
+
+impl ControlLegConfig {
+    /// No key given.
+    pub fn is_empty(&self) -> bool {
+        self.times.is_none() && self.target_deg.is_none()
+    }
 }
 
 fn semantic(
@@ -128,6 +151,15 @@ impl ControlConfig {
             semantic(file, &key, what, got, "see [control] in docs/reference.md")
         };
         let control = match self.kind {
+            ControlKind::Gait => {
+                return Err(semantic(
+                    file,
+                    "control.kind",
+                    "\"gait\" is for model = \"hexapod\"",
+                    "\"gait\"",
+                    "\"none\", \"pd\" or \"trajectory\"",
+                ));
+            }
             // Passive joints do not use the gains, but a value out of its
             // domain is still an error (the rule is the one of PD).
             ControlKind::None => {

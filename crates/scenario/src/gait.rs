@@ -477,11 +477,23 @@ pub fn default_stance(h: &HexapodConfig) -> Option<HexapodInitial> {
 /// The defaults of a hexapod file that depend on what else it gives,
 /// filled before [`Config::resolve`]; `table` is the file's (with its
 /// overrides): without `[initial]` the robot stands on its terrain
-/// ([`default_stance`]); with `[gait]` and without `[time] duration` it
-/// walks for [`GaitConfig::default_duration`].
-pub fn fill_hexapod_defaults(config: &mut Config, table: &toml::Table) {
-    let Config::Hexapod(h) = config else { return };
-    if !table.contains_key("initial")
+/// ([`default_stance`]) — unless it is a dynamic run without `[gait]`,
+/// which starts from [`fbd_sim::spatial::default_q0`]; with `[gait]` and
+/// without `[time] duration` it walks for
+/// [`GaitConfig::default_duration`]; a dynamic run also takes its Δt and
+/// leg angles ([`HexapodConfig::is_dynamic`]). Fails for
+/// `[initial.legN]`/`[control.legN]` of a leg not in `legs`.
+pub fn fill_hexapod_defaults(
+    config: &mut Config,
+    table: &toml::Table,
+    file: &str,
+) -> Result<(), ConfigError> {
+    let Config::Hexapod(h) = config else {
+        return Ok(());
+    };
+    let stands = !h.is_dynamic() || h.gait.is_some();
+    if stands
+        && !table.contains_key("initial")
         && let Some(initial) = default_stance(h)
     {
         h.initial = initial;
@@ -496,6 +508,7 @@ pub fn fill_hexapod_defaults(config: &mut Config, table: &toml::Table) {
             h.time.duration = d;
         }
     }
+    h.fill_dynamics_defaults(table, file)
 }
 
 impl HexapodConfig {
@@ -506,6 +519,11 @@ impl HexapodConfig {
     /// [`ConfigError::Semantic`] naming the key at fault.
     pub fn gait_model(&self, file: &str) -> Result<GaitModel, ConfigError> {
         self.validate(file)?;
+        self.build_gait_model(file)
+    }
+
+    /// [`HexapodConfig::gait_model`] of a validated configuration.
+    pub(crate) fn build_gait_model(&self, file: &str) -> Result<GaitModel, ConfigError> {
         let kin = HexapodModel::new(
             self.body.side,
             LegGeometry {
@@ -626,8 +644,10 @@ mod tests {
     }
 
     #[test]
-    fn a_bare_hexapod_stands_on_the_ground() {
-        let (h, s) = run("model = \"hexapod\"\n");
+    fn a_kinematic_hexapod_without_gait_stands_on_the_ground() {
+        // (A bare hexapod runs the 3D dynamics: `dynamics` asks for the
+        // kinematic stand.)
+        let (h, s) = run("model = \"hexapod\"\ndynamics = \"kinematic\"\n");
         assert!(h.gait.is_none());
         assert_eq!(h.time.duration, 1.0);
         assert!(s.error.is_none() && s.distance == 0.0, "{s:?}");
@@ -636,7 +656,9 @@ mod tests {
             assert!(f.y.abs() < 1e-9, "a foot off the ground: {f:?}");
         }
         // On a 10° slope the default stance puts every foot on the slope.
-        let (h, _) = run("model = \"hexapod\"\n[terrain]\nkind = \"slope\"\nangle_deg = 10.0\n");
+        let (h, _) = run(
+            "model = \"hexapod\"\ndynamics = \"kinematic\"\n[terrain]\nkind = \"slope\"\nangle_deg = 10.0\n",
+        );
         let model = h.gait_model("g.toml").unwrap();
         for f in &model.initial_feet {
             let g = model.surface.height(f.x, f.z);

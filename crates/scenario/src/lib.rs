@@ -68,7 +68,12 @@ pub use gait::{
     SpeedConfig, default_stance,
 };
 mod advice;
+pub mod mjcf;
+mod spatial;
 pub use actuation::{ControlConfig, ControlKind, ControlLegConfig, TargetDeg};
+pub use spatial::{
+    DynamicsKind, InertiaConfig, LOWER_RADIUS, PHI_Z_SINGULAR, UPPER_RADIUS, euler_rate_matrix,
+};
 
 /// Fixed-length arrays of numbers: serde's `[f64; N]` would silently
 /// ignore extra elements of a TOML array, so the length is checked here.
@@ -224,8 +229,13 @@ impl Default for WorldConfig {
 pub struct BodyConfig {
     /// Central body mass (kg).
     pub mass: f64,
-    /// Central body inertia about Z through its centre of mass (kg·m²).
-    pub inertia: f64,
+    /// Central body inertia (kg·m²): for the planar model one number, the
+    /// inertia about Z through the centre of mass; for the hexapod a number
+    /// (isotropic) or the tensor ([`InertiaConfig`]). `None` until
+    /// [`Config::resolve`]d (planar 0.3; hexapod dynamics the hexagonal
+    /// plate of [`fbd_sim::spatial::hexagon_inertia`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub inertia: Option<InertiaConfig>,
     /// Side `L` of the hexagonal body (m); hips at `d = L·cos(π/6)`.
     pub side: f64,
 }
@@ -235,7 +245,7 @@ impl Default for BodyConfig {
         let p = PlanarParams::default();
         Self {
             mass: p.body_mass,
-            inertia: p.body_inertia,
+            inertia: None,
             side: p.side,
         }
     }
@@ -253,6 +263,10 @@ pub struct LegConfig {
     /// [`Config::resolve`]d to the uniform rod `m·a²/12`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub upper_inertia: Option<f64>,
+    /// Upper link radius (m, hexapod dynamics): inertia about the link's
+    /// own axis `m·r²/2`; `None` until resolved to [`UPPER_RADIUS`] there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub upper_radius: Option<f64>,
     /// Upper link centre of mass, fraction of `a` from the hip.
     pub upper_com: f64,
     /// Lower link length `c` (m).
@@ -263,6 +277,10 @@ pub struct LegConfig {
     /// resolved to `m·c²/12`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lower_inertia: Option<f64>,
+    /// Lower link radius (m, hexapod dynamics); `None` until resolved to
+    /// [`LOWER_RADIUS`] there.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lower_radius: Option<f64>,
     /// Lower link centre of mass, fraction of `c` from the knee.
     pub lower_com: f64,
     /// θ1 range `[min, max]` (deg, hexapod); `None` until resolved to the
@@ -287,10 +305,12 @@ impl Default for LegConfig {
             upper_length: p.upper_length,
             upper_mass: p.upper_mass,
             upper_inertia: None,
+            upper_radius: None,
             upper_com: p.upper_com,
             lower_length: p.lower_length,
             lower_mass: p.lower_mass,
             lower_inertia: None,
+            lower_radius: None,
             lower_com: p.lower_com,
             theta1_deg: None,
             theta2_deg: None,
@@ -603,7 +623,8 @@ pub struct HexapodInitial {
     /// `(φx, φy, φz)` (deg).
     #[serde(deserialize_with = "fixed::de")]
     pub phi_deg: [f64; 3],
-    /// `(φ̇x, φ̇y, φ̇z)` (deg/s).
+    /// `(ωx, ωy, ωz)` (deg/s): the body's angular velocity in the
+    /// inertial frame (3D dynamics; `φ̇ = E(φ)⁻¹·ω`, [`euler_rate_matrix`]).
     #[serde(deserialize_with = "fixed::de")]
     pub omega_deg: [f64; 3],
     /// Leg 1 (front-left).
@@ -653,6 +674,14 @@ pub struct ConfigFile<I> {
     /// `"planar"` or `"hexapod"`.
     #[serde(default)]
     pub model: ModelKind,
+    /// `dynamics = "fbd" | "kinematic"` (hexapod): overrides the dispatch
+    /// rule of [`HexapodConfig::is_dynamic`]; resolved for every hexapod.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dynamics: Option<DynamicsKind>,
+    /// `legs = [3, 4]` (hexapod dynamics): the leg numbers of the model,
+    /// increasing; all six by default.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub legs: Option<Vec<usize>>,
     /// `[time]`.
     #[serde(default)]
     pub time: TimeConfig,
@@ -677,11 +706,11 @@ pub struct ConfigFile<I> {
     /// `[output]`.
     #[serde(default)]
     pub output: OutputConfig,
-    /// `[control]` (planar model).
+    /// `[control]`: the joint controller (planar model, hexapod dynamics).
     #[serde(default)]
     pub control: ControlConfig,
-    /// `[gait]` (hexapod model): the kinematic gait; without it a hexapod
-    /// run holds its initial pose.
+    /// `[gait]` (hexapod model): the kinematic gait, run kinematically, or
+    /// tracked by the dynamics with `[control] kind = "gait"`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gait: Option<GaitConfig>,
 }
@@ -696,6 +725,8 @@ impl Default for PlanarConfig {
     fn default() -> Self {
         let mut c = Self {
             model: ModelKind::Planar,
+            dynamics: None,
+            legs: None,
             time: TimeConfig::default(),
             world: WorldConfig::default(),
             body: BodyConfig::default(),
@@ -715,6 +746,9 @@ impl Default for PlanarConfig {
 
 impl<I> ConfigFile<I> {
     fn resolve_common(&mut self) {
+        self.body
+            .inertia
+            .get_or_insert(InertiaConfig::Scalar(PlanarParams::default().body_inertia));
         self.leg.upper_inertia = Some(self.leg.upper_inertia());
         self.leg.lower_inertia = Some(self.leg.lower_inertia());
         let [t1, t2, t3] = self.leg.limits_deg().map(|(_, r)| Some(r));
@@ -737,7 +771,11 @@ impl<I> ConfigFile<I> {
             duration: self.time.duration,
             gravity: self.world.gravity,
             body_mass: self.body.mass,
-            body_inertia: self.body.inertia,
+            body_inertia: self
+                .body
+                .inertia
+                .as_ref()
+                .map_or(PlanarParams::default().body_inertia, InertiaConfig::about_z),
             side: self.body.side,
             upper_length: self.leg.upper_length,
             upper_mass: self.leg.upper_mass,
@@ -864,6 +902,7 @@ impl PlanarConfig {
     /// The dynamic model may still reject the configuration (e.g. a tip
     /// below the terrain): see [`PlanarConfig::model`].
     pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        spatial::reject_hexapod_keys(self, file)?;
         self.validate_common(file)?;
         let i = &self.initial;
         check_finite(file, "initial.position", &i.position)?;
@@ -943,8 +982,10 @@ impl PlanarConfig {
 }
 
 impl HexapodConfig {
-    /// Checks every key, in the file's units.
+    /// Checks every key, in the file's units, for the run the dispatch
+    /// rule chooses ([`HexapodConfig::is_dynamic`]).
     pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
+        self.validate_dispatch(file)?;
         self.validate_common(file)?;
         let i = &self.initial;
         check_finite(file, "initial.position", &i.position)?;
@@ -1019,6 +1060,7 @@ impl Config {
             }
             Config::Hexapod(c) => {
                 c.model = ModelKind::Hexapod;
+                c.resolve_dynamics();
                 c.resolve_common();
                 let duration = c.time.duration;
                 if let Some(g) = &mut c.gait {
@@ -1048,6 +1090,7 @@ impl Config {
         // Serializing plain structs of numbers, strings and arrays cannot
         // fail; keep a readable fallback rather than a panic.
         let body = body.unwrap_or_else(|e| format!("# serialization failed: {e}\n"));
+        let body = spatial::drop_absent_legs(&c, body);
         format!("{HEADER}{body}")
     }
 }
@@ -1253,7 +1296,7 @@ pub fn parse_str(text: &str, file: &str, overrides: &[Override]) -> Result<Confi
         config = from_table(&table).map_err(|e| fail(describe(&e)))?;
         load_profile(&mut config, file)?;
     }
-    gait::fill_hexapod_defaults(&mut config, &table);
+    gait::fill_hexapod_defaults(&mut config, &table, file)?;
     config.resolve();
     config.validate(file)?;
     Ok(config)
@@ -1285,7 +1328,7 @@ pub fn parse_table(
         message: describe(&e),
     })?;
     load_profile(&mut config, file)?;
-    gait::fill_hexapod_defaults(&mut config, &table);
+    gait::fill_hexapod_defaults(&mut config, &table, file)?;
     config.resolve();
     config.validate(file)?;
     Ok(config)

@@ -35,8 +35,15 @@ pub struct Data {
     pub limit_events: Vec<LimitEvent>,
     /// Steps solved in substeps so far.
     pub retries: Vec<RetryEvent>,
-    /// Newton iterations so far.
+    /// Newton iterations so far (chord steps included).
     pub newton_iterations: usize,
+    /// Of [`Self::newton_iterations`], the chord steps (a factorisation
+    /// kept from an earlier iterate or step, see
+    /// [`fbd_solver::NewtonParams::chord_steps`]).
+    pub chord_iterations: usize,
+    /// Most Newton iterations of one step so far (all its state trials and
+    /// substeps).
+    pub max_step_iterations: usize,
     /// Joint torques (N·m, joint order) applied at the next step instead of
     /// the controller's, when `Some` ([`crate::control::joint_torques`]);
     /// kept until changed. For controllers outside the simulator.
@@ -105,6 +112,8 @@ impl Data {
             solver: NewtonSolver::new(model.newton),
             events: Vec::with_capacity(64),
             newton_iterations: 0,
+            chord_iterations: 0,
+            max_step_iterations: 0,
             external_torque: None,
             scales: vec![1.0; lay.dim()],
             trial: model.initial_states.clone(),

@@ -54,6 +54,17 @@ pub enum SimError {
         /// Scaled residual of the last solve.
         residual: f64,
     },
+    /// The controller could not compute its torques (e.g. the gait
+    /// generator cannot place a foot).
+    #[error("step {step} (t = {t:.6} s): control: {message}")]
+    Control {
+        /// Step index k.
+        step: usize,
+        /// Time k·Δt (s).
+        t: f64,
+        /// What failed.
+        message: String,
+    },
     /// The state became NaN or infinite.
     #[error("step {step} (t = {t:.6} s): the state is not finite (residual {residual:.3e})")]
     NonFinite {
@@ -73,7 +84,8 @@ impl SimError {
         match self {
             SimError::Newton { step, .. }
             | SimError::Cycling { step, .. }
-            | SimError::NonFinite { step, .. } => Some(*step),
+            | SimError::NonFinite { step, .. }
+            | SimError::Control { step, .. } => Some(*step),
             _ => None,
         }
     }

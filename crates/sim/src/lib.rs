@@ -31,6 +31,7 @@ mod model;
 mod params;
 pub mod record;
 mod run;
+pub mod spatial;
 pub mod step;
 mod system;
 

@@ -6,12 +6,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Outcome of [`run`].
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct RunSummary {
     /// Steps solved.
     pub steps: usize,
-    /// Newton iterations over all steps.
+    /// Newton iterations over all steps (chord steps included).
     pub newton_iterations: usize,
+    /// Most Newton iterations of one step (all its state trials and
+    /// substeps).
+    pub max_newton_iterations: usize,
+    /// Of [`Self::newton_iterations`], the chord steps: steps taken with a
+    /// factorisation kept from an earlier iterate or step.
+    pub chord_iterations: usize,
+    /// Numeric LU factorisations over all steps.
+    pub numeric_factorizations: u64,
     /// Wall time of the stepping loop alone (s): the time inside [`step`],
     /// not the observer's.
     pub wall_seconds: f64,
@@ -85,6 +93,9 @@ pub fn run_until(
     RunSummary {
         steps: data.k,
         newton_iterations: data.newton_iterations,
+        max_newton_iterations: data.max_step_iterations,
+        chord_iterations: data.chord_iterations,
+        numeric_factorizations: data.solver.numeric_factorizations(),
         wall_seconds: wall,
         symbolic_factorizations: data.symbolic_factorizations(),
         events: data.events,

@@ -77,6 +77,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     prepare(model, data);
     let first = match solve(model, data) {
         Ok((iterations, trials)) => {
+            data.max_step_iterations = data.max_step_iterations.max(iterations);
             let record = make_record(model, data, iterations, trials, model.dt());
             accept(model, data, t);
             data.k += 1;
@@ -95,6 +96,7 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
         data.last_resort = false;
         match result {
             Ok(record) => {
+                data.max_step_iterations = data.max_step_iterations.max(record.newton_iterations);
                 data.retries.push(RetryEvent {
                     t,
                     step: k,
@@ -139,6 +141,7 @@ fn solve(model: &Model, data: &mut Data) -> Result<(usize, usize), Failure> {
         let (mut sys, solver, z) = system(model, data);
         let report = solver.solve(&mut sys, z).map_err(Failure::Newton)?;
         newton_iterations += report.iterations;
+        data.chord_iterations += report.chord_iterations;
         if data.z.iter().any(|v| !v.is_finite()) {
             return Err(Failure::NonFinite {
                 residual: report.residual,
@@ -429,6 +432,7 @@ fn enumerate_states(
             continue;
         };
         *newton_iterations += report.iterations;
+        data.chord_iterations += report.chord_iterations;
         if data.z.iter().any(|v| !v.is_finite()) {
             continue;
         }

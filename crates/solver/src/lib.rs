@@ -12,6 +12,7 @@
 //!   After the first solve of a pattern, solving does not allocate.
 
 mod error;
+mod lu;
 mod newton;
 mod system;
 

@@ -1,43 +1,20 @@
-//! Damped Newton iteration with a per-pattern cached sparse LU (faer).
+//! Damped Newton iteration with a per-pattern cached sparse LU (faer),
+//! optionally with chord steps (a kept factorisation) between
+//! refactorisations.
 //!
 //! # Allocation behaviour
 //!
 //! The first solve of a pattern key allocates: the CSC structure, the dense
 //! slot map, faer's symbolic LU (column approximate minimum degree ordering),
-//! and, when the pattern needs more than any earlier one, the residual/step
-//! vectors, the Jacobian value array, the `MemBuffer` scratch and faer's
-//! numeric-LU storage. After that, solving a system with an already seen key
-//! performs **no heap allocation** (checked by `tests/no_alloc.rs`).
-//!
-//! Two faer 0.24.4 details make this hold, and are relied upon here:
-//!
-//! * The symbolic analysis is forced to the *simplicial* LU
-//!   ([`SupernodalThreshold::FORCE_SIMPLICIAL`]). faer's supernodal numeric
-//!   LU allocates fresh per-supernode work vectors on every call
-//!   (`contrib_work` in `factorize_supernodal_numeric_lu`), so it could never
-//!   be allocation-free; for the 20–60 unknown, very sparse systems of this
-//!   project the simplicial (left-looking, Gilbert–Peierls) LU is also the
-//!   faster choice.
-//! * faer's simplicial numeric LU stores `L`/`U` in `Vec`s that it grows
-//!   on demand (`resize_vec`, never shrinking). Their fill depends on the
-//!   numerical row pivoting, so a later refactorisation of the same pattern
-//!   could need more room than the first one and would then allocate. To
-//!   rule that out, when a pattern is registered the solver factors a fully
-//!   dense `n × n` matrix once into that pattern's own [`NumericLu`]: any
-//!   `n × n` factorisation needs at most the storage of the dense one, so
-//!   every later refactorisation fits. (The simplicial numeric LU reads only
-//!   the dimensions and the column permutation from the symbolic object, so
-//!   this warm-up is valid.) Each pattern keeps its own [`NumericLu`]:
-//!   faer's simplicial one cannot be reused for a smaller dimension.
+//! the pattern's numeric-LU storage (grown to the dense worst case, see
+//! [`crate::lu`]), and, when the pattern needs more than any earlier one,
+//! the residual/step vectors, the Jacobian value array and the `MemBuffer`
+//! scratch. After that, solving a system with an already seen key performs
+//! **no heap allocation** (checked by `tests/no_alloc.rs`).
 
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::sparse::linalg::lu::{
-    LuRef, LuSymbolicParams, NumericLu, SymbolicLu, factorize_symbolic_lu,
-};
-use faer::sparse::linalg::{LuError, SupernodalThreshold};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
-use faer::{Conj, MatMut, Par};
+use faer::dyn_stack::{MemBuffer, StackReq};
 
+use crate::lu::Pattern;
 use crate::{JacobianSink, NewtonSystem, SolverError};
 
 /// Tuning parameters of [`NewtonSolver`].
@@ -80,20 +57,25 @@ pub struct NewtonParams {
     /// with a non-finite residual counts as no decrease). `0` means pure
     /// Newton steps that must still decrease the residual. Default: `8`.
     pub max_backtracks: usize,
-    /// **Chord start** (simplified Newton): when the pattern already holds a
-    /// numeric LU from an earlier solve, first try up to this many steps
-    /// `Δx = −J_old⁻¹ r(x)` with that stale factorisation (residual-only
-    /// evaluations, no refactorisation). A chord step is kept only if it
-    /// shrinks the scaled residual max-norm by at least
-    /// [`Self::chord_contraction`]; otherwise — or when the steps run out —
-    /// the solve continues with the full damped Newton iteration below from
-    /// the last kept iterate. Convergence is still the residual test on the
-    /// true residual (tolerances unchanged); chord steps count as iterations
-    /// and in `max_iterations` only through the full-Newton part. `0`
-    /// disables it. Default: `0`.
+    /// **Chord steps** (simplified Newton): how many steps in a row may
+    /// reuse the pattern's last factorisation — kept from an earlier
+    /// iterate of this solve or from an earlier solve — instead of
+    /// factoring the Jacobian at the iterate. A chord step
+    /// `Δx = −J_old⁻¹ r(x)` costs one residual evaluation and one pair of
+    /// triangular solves. It is kept when it decreases the scaled residual
+    /// max-norm; the next step refactors (a full Newton step at the
+    /// iterate, then chord steps again with that factorisation) when it did
+    /// not decrease it, when it contracted by less than
+    /// [`Self::chord_contraction`], or when, at the observed contraction,
+    /// the tolerance would not be reached within the remaining chord steps.
+    /// Convergence is still the residual test on the true residual
+    /// (tolerances unchanged); `max_iterations` counts the full Newton
+    /// steps. `0` disables chord steps: every step refactors (pure Newton).
+    /// Default: `0`.
     pub chord_steps: usize,
-    /// Required contraction of a chord step: `‖r(x + Δx)‖ ≤ chord_contraction
-    /// · ‖r(x)‖`. Default: `0.1`.
+    /// Contraction a chord step must reach, `‖r(x + Δx)‖ ≤
+    /// chord_contraction · ‖r(x)‖`, for the next step to be a chord step
+    /// too. Default: `0.1`.
     pub chord_contraction: f64,
 }
 
@@ -114,82 +96,21 @@ impl Default for NewtonParams {
 /// Outcome of a successful [`NewtonSolver::solve`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonReport {
-    /// Newton steps applied to `x` (0 when the initial guess was converged).
+    /// Newton steps applied to `x` (0 when the initial guess was converged),
+    /// chord steps included.
     pub iterations: usize,
+    /// Of [`Self::iterations`], the chord steps: steps with a factorisation
+    /// kept from an earlier iterate or solve (see
+    /// [`NewtonParams::chord_steps`]). The others are full Newton steps.
+    pub chord_iterations: usize,
     /// Scaled residual max-norm `max_i |r_i| / residual_scale(i)` at the
     /// returned `x`.
     pub residual: f64,
     /// Numeric LU factorisations performed during this solve (without chord
     /// steps, see [`NewtonParams::chord_steps`]: equals `iterations`, plus
-    /// one when the step test ended the solve).
+    /// one when the step test ended the solve; with them, one per full
+    /// Newton step, plus one when the step test ended the solve).
     pub factorizations: usize,
-}
-
-/// Cached per-pattern data: CSC structure, dense slot map, symbolic LU.
-struct Pattern {
-    n: usize,
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
-    /// Dense `n × n` row-major map `(row, col) → index into the CSC values`,
-    /// `u32::MAX` where the entry is not in the pattern.
-    slot: Vec<u32>,
-    symbolic: SymbolicLu<usize>,
-    /// Numeric LU storage, reused by every refactorisation of this pattern.
-    /// (One per pattern: faer 0.24.4's simplicial `NumericLu` cannot be
-    /// reused for a smaller dimension, its `L`/`U` column pointer arrays
-    /// never shrink and the triangular solves then fail an assertion.)
-    numeric: NumericLu<usize, f64>,
-    /// `numeric` holds the factorisation of a Jacobian of this pattern (not
-    /// just the dense warm-up): usable for chord steps.
-    factored: bool,
-}
-
-impl Pattern {
-    fn build(n: usize, entries: &mut Vec<(usize, usize)>) -> Self {
-        for &(row, col) in entries.iter() {
-            assert!(
-                row < n && col < n,
-                "Jacobian pattern entry ({row}, {col}) is out of range for dimension {n}"
-            );
-        }
-        // Column-major order, rows sorted within a column, no duplicates.
-        entries.sort_unstable_by_key(|&(row, col)| (col, row));
-        entries.dedup();
-        let nnz = entries.len();
-        assert!(
-            nnz < u32::MAX as usize,
-            "Jacobian pattern has too many entries ({nnz})"
-        );
-
-        let mut col_ptr = vec![0usize; n + 1];
-        let mut row_idx = Vec::with_capacity(nnz);
-        let mut slot = vec![u32::MAX; n * n];
-        for (k, &(row, col)) in entries.iter().enumerate() {
-            col_ptr[col + 1] += 1;
-            row_idx.push(row);
-            slot[row * n + col] = k as u32;
-        }
-        for j in 0..n {
-            col_ptr[j + 1] += col_ptr[j];
-        }
-
-        let a = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-        let params = LuSymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
-            ..Default::default()
-        };
-        let symbolic = factorize_symbolic_lu(a, params)
-            .unwrap_or_else(|e| panic!("faer symbolic LU failed: {e:?}"));
-        Self {
-            n,
-            col_ptr,
-            row_idx,
-            slot,
-            symbolic,
-            numeric: NumericLu::new(),
-            factored: false,
-        }
-    }
 }
 
 /// Everything reused across solves (sized to the largest pattern seen).
@@ -356,6 +277,7 @@ impl NewtonSolver {
         if n == 0 {
             return Ok(NewtonReport {
                 iterations: 0,
+                chord_iterations: 0,
                 residual: 0.0,
                 factorizations: 0,
             });
@@ -432,14 +354,30 @@ impl NewtonSolver {
             .loaded
             .expect("factorize_loaded: call load_jacobian first");
         let pattern = &mut self.patterns[index].1;
-        let mut dx = dx;
-        if let Some(dx) = dx.as_deref_mut() {
+        pattern.factor(&self.ws.values, &mut self.ws.mem)?;
+        if let Some(dx) = dx {
             assert_eq!(dx.len(), pattern.n, "dx has the wrong length");
-            for (d, &ri) in dx.iter_mut().zip(&self.ws.r) {
-                *d = -ri;
-            }
+            negate(dx, &self.ws.r);
+            pattern.solve(dx);
         }
-        factor_and_solve(pattern, &self.ws.values, &mut self.ws.mem, dx)
+        Ok(())
+    }
+
+    /// **Benchmark / diagnostic hook** (the solve of a chord step): the
+    /// Newton step `J Δx = −r` into `dx` for the residual last loaded by
+    /// [`Self::load_jacobian`], with the last factorisation of its pattern
+    /// (no refactorisation).
+    ///
+    /// # Panics
+    /// If nothing was loaded, the pattern was never factored, or `dx` does
+    /// not have the system's dimension.
+    pub fn solve_loaded(&mut self, dx: &mut [f64]) {
+        let index = self.loaded.expect("solve_loaded: call load_jacobian first");
+        let pattern = &mut self.patterns[index].1;
+        assert!(pattern.factored, "solve_loaded: the pattern was never factored");
+        assert_eq!(dx.len(), pattern.n, "dx has the wrong length");
+        negate(dx, &self.ws.r);
+        pattern.solve(dx);
     }
 }
 
@@ -456,57 +394,22 @@ fn scaled_norm<S: NewtonSystem>(sys: &S, r: &[f64]) -> Option<f64> {
     Some(norm)
 }
 
-/// Numeric LU of `values` (CSC order of `pattern`) into the pattern's own
-/// storage, reusing its symbolic analysis; then, when `rhs` is given, solves
-/// `J x = rhs` in place.
-fn factor_and_solve(
-    pattern: &mut Pattern,
-    values: &[f64],
-    mem: &mut MemBuffer,
-    rhs: Option<&mut [f64]>,
-) -> Result<(), SolverError> {
-    let n = pattern.n;
-    let Pattern {
-        col_ptr,
-        row_idx,
-        symbolic,
-        numeric,
-        factored,
-        ..
-    } = pattern;
-    *factored = false;
-    let matrix = SparseColMatRef::new(
-        SymbolicSparseColMatRef::new_checked(n, n, col_ptr, None, row_idx),
-        values,
-    );
-    let lu = match symbolic.factorize_numeric_lu(
-        numeric,
-        matrix,
-        Par::Seq,
-        MemStack::new(mem),
-        Default::default(),
-    ) {
-        Ok(lu) => lu,
-        Err(LuError::SymbolicSingular { index }) => {
-            let equation = symbolic.col_perm().arrays().0[index];
-            return Err(SolverError::Singular { equation });
-        }
-        Err(LuError::Generic(e)) => panic!("faer numeric LU failed: {e:?}"),
-    };
-    *factored = true;
-    if let Some(rhs) = rhs {
-        lu.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            Par::Seq,
-            MemStack::new(mem),
-        );
-    }
-    Ok(())
-}
-
 fn set_len(v: &mut Vec<f64>, len: usize) {
     v.resize(len, 0.0);
+}
+
+/// `dx = −r`.
+fn negate(dx: &mut [f64], r: &[f64]) {
+    for (d, &ri) in dx.iter_mut().zip(r) {
+        *d = -ri;
+    }
+}
+
+/// `x_trial = x + alpha·dx`.
+fn trial(x_trial: &mut [f64], x: &[f64], dx: &[f64], alpha: f64) {
+    for ((xt, &xi), &d) in x_trial.iter_mut().zip(x).zip(dx) {
+        *xt = xi + alpha * d;
+    }
 }
 
 impl Workspace {
@@ -524,40 +427,12 @@ impl Workspace {
         ] {
             v.reserve(n.saturating_sub(v.len()));
         }
-
-        let sym = &pattern.symbolic;
-        let req = sym
-            .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default())
-            .or(sym.solve_in_place_scratch::<f64>(1, Par::Seq));
-        let grown = self.mem_req.or(req);
+        let grown = self.mem_req.or(pattern.scratch());
         if grown != self.mem_req {
             self.mem_req = grown;
             self.mem = MemBuffer::new(grown);
         }
-
-        {
-            // Dense warm-up (see the module docs): grows faer's L/U storage to
-            // the worst case for dimension n, so refactorisations never
-            // allocate. Diagonally dominant, hence nonsingular.
-            let col_ptr: Vec<usize> = (0..=n).map(|j| j * n).collect();
-            let row_idx: Vec<usize> = (0..n * n).map(|k| k % n).collect();
-            let values: Vec<f64> = (0..n * n)
-                .map(|k| if k % n == k / n { 2.0 * n as f64 } else { 1.0 })
-                .collect();
-            let sym_dense = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
-            let dense = SparseColMatRef::new(sym_dense, &values);
-            let stack = MemStack::new(&mut self.mem);
-            pattern
-                .symbolic
-                .factorize_numeric_lu(
-                    &mut pattern.numeric,
-                    dense,
-                    Par::Seq,
-                    stack,
-                    Default::default(),
-                )
-                .unwrap_or_else(|e| panic!("faer dense warm-up LU failed: {e:?}"));
-        }
+        pattern.warm_up(&mut self.mem);
     }
 
     /// Evaluates residual and Jacobian at `x` into `r` / `values`.
@@ -578,6 +453,12 @@ impl Workspace {
         sys.eval(x, r, Some(&mut sink));
     }
 
+    /// Evaluates the residual alone at `x` into `r`.
+    fn eval_residual<S: NewtonSystem>(sys: &mut S, x: &[f64], r: &mut [f64]) {
+        r.fill(0.0);
+        sys.eval(x, r, None);
+    }
+
     fn run<S: NewtonSystem>(
         &mut self,
         params: &NewtonParams,
@@ -593,102 +474,91 @@ impl Workspace {
         set_len(&mut self.x_trial, n);
         set_len(&mut self.r_trial, n);
 
-        // Every iteration factors once, so the number of numeric
-        // factorisations in this solve is `iter` at the top of the loop.
-        // Chord start with the pattern's last factorisation, see
-        // `NewtonParams::chord_steps`.
-        let mut chord = 0usize;
-        if params.chord_steps > 0 && pattern.factored {
-            self.r.fill(0.0);
-            sys.eval(x, &mut self.r, None);
-            if let Some(mut rnorm) = scaled_norm(sys, &self.r) {
-                loop {
-                    if rnorm <= params.residual_tol {
-                        return Ok(NewtonReport {
-                            iterations: chord,
-                            residual: rnorm,
-                            factorizations: 0,
-                        });
-                    }
-                    if chord == params.chord_steps {
-                        break;
-                    }
-                    for (d, &ri) in self.dx.iter_mut().zip(&self.r) {
-                        *d = -ri;
-                    }
-                    // `numeric` is the output of `factorize_numeric_lu` for
-                    // this pattern's `symbolic` (`factored`), as required.
-                    LuRef::new_unchecked(&pattern.symbolic, &pattern.numeric)
-                        .solve_in_place_with_conj(
-                            Conj::No,
-                            MatMut::from_column_major_slice_mut(&mut self.dx, n, 1),
-                            Par::Seq,
-                            MemStack::new(&mut self.mem),
-                        );
-                    for ((xt, &xi), &d) in self.x_trial.iter_mut().zip(x.iter()).zip(&self.dx) {
-                        *xt = xi + d;
-                    }
-                    self.r_trial.fill(0.0);
-                    sys.eval(&self.x_trial, &mut self.r_trial, None);
-                    match scaled_norm(sys, &self.r_trial) {
-                        Some(t) if t <= params.chord_contraction * rnorm => {
-                            x.copy_from_slice(&self.x_trial);
-                            std::mem::swap(&mut self.r, &mut self.r_trial);
-                            chord += 1;
-                            // At the observed contraction, would the chord
-                            // reach the tolerance within its budget? If not,
-                            // refactor now rather than spend the steps.
-                            let rate = t / rnorm;
-                            rnorm = t;
-                            if rnorm > params.residual_tol {
-                                let needed = (params.residual_tol / rnorm).ln() / rate.ln();
-                                // Negated so that a NaN estimate also stops.
-                                #[allow(clippy::neg_cmp_op_on_partial_ord)]
-                                let hopeless = !(needed <= (params.chord_steps - chord) as f64);
-                                if hopeless {
-                                    break;
-                                }
-                            }
-                        }
-                        _ => break,
-                    }
-                }
-            }
+        let chords = params.chord_steps > 0;
+        // Full Newton steps and chord steps applied to `x`, factorisations.
+        let (mut full, mut chord, mut factorizations) = (0usize, 0usize, 0usize);
+        // Chord steps since the last factorisation (or the start).
+        let mut run = 0usize;
+        // Whether the pattern's factorisation may serve the next step.
+        let mut usable = chords && pattern.factored;
+        // Whether `values` holds the Jacobian at `x` (`r` always holds the
+        // residual at `x`).
+        let mut have_jacobian = !usable;
+        if have_jacobian {
+            Self::eval_with_jacobian(&mut self.values, pattern, sys, x, &mut self.r);
+        } else {
+            Self::eval_residual(sys, x, &mut self.r);
         }
+        let Some(mut rnorm) = scaled_norm(sys, &self.r) else {
+            return Err(SolverError::NonFinite { iter: 0 });
+        };
 
-        // Whether `r` / `values` hold residual and Jacobian at `x`.
-        let mut have_jacobian = false;
-
-        for iter in 0..=params.max_iterations {
-            if !have_jacobian {
-                Self::eval_with_jacobian(&mut self.values, pattern, sys, x, &mut self.r);
-            }
-            let Some(rnorm) = scaled_norm(sys, &self.r) else {
-                return Err(SolverError::NonFinite { iter });
-            };
+        loop {
             if rnorm <= params.residual_tol {
                 return Ok(NewtonReport {
-                    iterations: chord + iter,
+                    iterations: chord + full,
+                    chord_iterations: chord,
                     residual: rnorm,
-                    factorizations: iter,
+                    factorizations,
                 });
-            }
-            if iter == params.max_iterations {
-                return Err(SolverError::Diverged {
-                    iter,
-                    residual: rnorm,
-                });
-            }
-            if self.values.iter().any(|v| !v.is_finite()) {
-                return Err(SolverError::NonFinite { iter });
             }
 
-            // Factor J and solve J Δx = −r.
-            for (d, &ri) in self.dx.iter_mut().zip(&self.r) {
-                *d = -ri;
+            if usable && run < params.chord_steps {
+                // Chord step with the kept factorisation.
+                negate(&mut self.dx, &self.r);
+                pattern.solve(&mut self.dx);
+                usable = false;
+                if self.dx.iter().all(|d| d.is_finite()) {
+                    trial(&mut self.x_trial, x, &self.dx, 1.0);
+                    Self::eval_residual(sys, &self.x_trial, &mut self.r_trial);
+                    if let Some(t) = scaled_norm(sys, &self.r_trial)
+                        && t < rnorm
+                    {
+                        x.copy_from_slice(&self.x_trial);
+                        std::mem::swap(&mut self.r, &mut self.r_trial);
+                        have_jacobian = false;
+                        chord += 1;
+                        run += 1;
+                        let rate = t / rnorm;
+                        rnorm = t;
+                        // Keep chord steps while they contract well and, at
+                        // the observed rate, reach the tolerance within the
+                        // steps left; otherwise refactor at the new iterate.
+                        let needed = (params.residual_tol / rnorm).ln() / rate.ln();
+                        // Negated so that a NaN estimate also refactors.
+                        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+                        let on_track = rate <= params.chord_contraction
+                            && (rnorm <= params.residual_tol
+                                || needed <= (params.chord_steps - run) as f64);
+                        usable = on_track;
+                    }
+                }
+                continue;
             }
-            factor_and_solve(pattern, &self.values, &mut self.mem, Some(&mut self.dx))?;
+
+            // Full Newton step: factor J at x and solve J Δx = −r.
+            if full == params.max_iterations {
+                return Err(SolverError::Diverged {
+                    iter: full,
+                    residual: rnorm,
+                });
+            }
+            if !have_jacobian {
+                Self::eval_with_jacobian(&mut self.values, pattern, sys, x, &mut self.r);
+                have_jacobian = true;
+                let Some(norm) = scaled_norm(sys, &self.r) else {
+                    return Err(SolverError::NonFinite { iter: full });
+                };
+                rnorm = norm;
+            }
+            if self.values.iter().any(|v| !v.is_finite()) {
+                return Err(SolverError::NonFinite { iter: full });
+            }
+            negate(&mut self.dx, &self.r);
+            pattern.factor(&self.values, &mut self.mem)?;
+            factorizations += 1;
             self.numeric_factorizations += 1;
+            pattern.solve(&mut self.dx);
             if let Some(equation) = self.dx.iter().position(|d| !d.is_finite()) {
                 // A zero pivot: 1/0 propagated through the triangular solves.
                 return Err(SolverError::Singular { equation });
@@ -702,25 +572,26 @@ impl Workspace {
                 .all(|(d, xi)| d.abs() <= params.step_tol * (1.0 + xi.abs()));
             if negligible && rnorm <= params.step_residual_factor * params.residual_tol {
                 return Ok(NewtonReport {
-                    iterations: chord + iter,
+                    iterations: chord + full,
+                    chord_iterations: chord,
                     residual: rnorm,
-                    factorizations: iter + 1,
+                    factorizations,
                 });
             }
 
-            // Backtracking line search on the scaled residual max-norm. The
-            // full step is evaluated with the Jacobian (the factored values
-            // are no longer needed), so an accepted full step — the usual
-            // case near a root — costs one evaluation per iteration;
-            // halved steps evaluate the residual only.
+            // Backtracking line search on the scaled residual max-norm.
+            // Without chord steps the full step is evaluated with the
+            // Jacobian (the factored values are no longer needed), so an
+            // accepted full step — the usual case near a root — costs one
+            // evaluation per iteration; with them the next step is a chord
+            // step, which needs the residual only. Halved steps evaluate the
+            // residual only.
             let mut alpha = 1.0;
-            let mut accepted = false;
+            let mut accepted = None;
             let mut any_finite = false;
             for k in 0..=params.max_backtracks {
-                for ((xt, &xi), &d) in self.x_trial.iter_mut().zip(x.iter()).zip(&self.dx) {
-                    *xt = xi + alpha * d;
-                }
-                if k == 0 {
+                trial(&mut self.x_trial, x, &self.dx, alpha);
+                if k == 0 && !chords {
                     Self::eval_with_jacobian(
                         &mut self.values,
                         pattern,
@@ -729,41 +600,45 @@ impl Workspace {
                         &mut self.r_trial,
                     );
                 } else {
-                    self.r_trial.fill(0.0);
-                    sys.eval(&self.x_trial, &mut self.r_trial, None);
+                    Self::eval_residual(sys, &self.x_trial, &mut self.r_trial);
                 }
                 if let Some(trial_norm) = scaled_norm(sys, &self.r_trial) {
                     any_finite = true;
                     if trial_norm < rnorm {
-                        have_jacobian = k == 0;
-                        accepted = true;
+                        have_jacobian = k == 0 && !chords;
+                        accepted = Some(trial_norm);
                         break;
                     }
                 }
                 alpha *= 0.5;
             }
-            if !accepted && rnorm <= params.step_residual_factor * params.residual_tol {
-                // No decrease is possible, and the residual is already within
-                // the round-off allowance of the step test: the floor.
-                return Ok(NewtonReport {
-                    iterations: chord + iter,
-                    residual: rnorm,
-                    factorizations: iter + 1,
-                });
-            }
-            if !accepted {
+            let Some(trial_norm) = accepted else {
+                if rnorm <= params.step_residual_factor * params.residual_tol {
+                    // No decrease is possible, and the residual is already
+                    // within the round-off allowance of the step test: the
+                    // floor.
+                    return Ok(NewtonReport {
+                        iterations: chord + full,
+                        chord_iterations: chord,
+                        residual: rnorm,
+                        factorizations,
+                    });
+                }
                 return Err(if any_finite {
                     SolverError::Diverged {
-                        iter,
+                        iter: full,
                         residual: rnorm,
                     }
                 } else {
-                    SolverError::NonFinite { iter }
+                    SolverError::NonFinite { iter: full }
                 });
-            }
+            };
             x.copy_from_slice(&self.x_trial);
             std::mem::swap(&mut self.r, &mut self.r_trial);
+            rnorm = trial_norm;
+            full += 1;
+            usable = chords;
+            run = 0;
         }
-        unreachable!("the loop returns at iter == max_iterations")
     }
 }

@@ -1,15 +1,21 @@
-//! The hexapod's scene: body hexagon, hips, knees and feet of the six legs
+//! The hexapod's scene: body hexagon, hips, knees and feet of the legs
 //! from the 24 coordinates with [`fbd_kinematics::hexapod::forward`], the
-//! feet coloured stance (ST2) or swing (ST1), the support polygon of the
-//! stance feet, the centre of mass; panels of body height, joint angles and
-//! the stability margin.
+//! feet coloured by state, the support polygon of the feet on the ground,
+//! the centre of mass; panels of body height, joint angles and the
+//! stability margin.
 //!
-//! A gait run (or the 3D dynamics, once they exist) fills one
-//! [`HexFrame`] per row of its `trajectory.csv` and calls
+//! A kinematic gait run colours the feet stance (ST2) or swing (ST1). A
+//! dynamic (3D FBD) run ([`HexapodScene::dynamic`], frames carrying
+//! [`HexDynamics`]) draws only the model's legs, colours each foot
+//! ST1/ST2/ST3, draws the ground force on every foot and the hip and knee
+//! forces as arrows, and adds panels of the feet's normal forces and the
+//! knee torques.
+//!
+//! A run fills one [`HexFrame`] per row of its `trajectory.csv` and calls
 //! [`HexapodScene::push`], then [`HexapodScene::finish`] and
 //! [`super::write`]; `fbd view DIR` does the same from the CSV.
 
-use fbd_contact::Surface;
+use fbd_contact::{StateCode, Surface};
 use fbd_kinematics::body::{GAMMA_DEG, LEG_COUNT};
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
 
@@ -31,6 +37,39 @@ pub struct HexFrame {
     pub com: [f64; 3],
     /// Stability margin (m), when the run computes one.
     pub margin: Option<f64>,
+    /// Contact states and forces of a dynamic run.
+    pub dynamics: Option<HexDynamics>,
+}
+
+/// What a dynamic run adds to a frame, indexed by leg number − 1 (legs
+/// outside the model are left at their defaults).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HexDynamics {
+    /// State of each foot.
+    pub state: [StateCode; LEG_COUNT],
+    /// Force of the ground on each foot, inertial (N).
+    pub foot_force: [[f64; 3]; LEG_COUNT],
+    /// Normal component of that force (N).
+    pub normal: [f64; LEG_COUNT],
+    /// Force of the body on the upper link at each hip (N).
+    pub hip_force: [[f64; 3]; LEG_COUNT],
+    /// Force of the upper on the lower link at each knee (N).
+    pub knee_force: [[f64; 3]; LEG_COUNT],
+    /// Actuator torques `(τ1, τ2, τ3)` of each leg (N·m).
+    pub torque: [[f64; 3]; LEG_COUNT],
+}
+
+impl Default for HexDynamics {
+    fn default() -> Self {
+        Self {
+            state: [StateCode::St1; LEG_COUNT],
+            foot_force: [[0.0; 3]; LEG_COUNT],
+            normal: [0.0; LEG_COUNT],
+            hip_force: [[0.0; 3]; LEG_COUNT],
+            knee_force: [[0.0; 3]; LEG_COUNT],
+            torque: [[0.0; 3]; LEG_COUNT],
+        }
+    }
 }
 
 impl HexFrame {
@@ -55,27 +94,31 @@ impl HexFrame {
             stance: d.stance(),
             com: [d.com.x, d.com.y, d.com.z],
             margin: d.margin.is_finite().then_some(d.margin),
+            dynamics: None,
         }
     }
 }
 
 /// Points per leg in the layout: hip, knee, foot.
 const PER_LEG: usize = 3;
-/// Index of leg `leg`'s first point (the hip): after the body centre and
-/// the six hexagon corners.
-const fn leg_point(leg: usize, k: usize) -> usize {
-    1 + LEG_COUNT + PER_LEG * leg + k
+/// Index of point `k` (hip, knee, foot) of the `slot`-th drawn leg: after
+/// the body centre and the six hexagon corners.
+const fn leg_point(slot: usize, k: usize) -> usize {
+    1 + LEG_COUNT + PER_LEG * slot + k
 }
 
 /// Builds the scene of a hexapod run row by row.
 pub struct HexapodScene {
     model: HexapodModel,
+    /// The drawn legs (leg number − 1), increasing.
+    legs: Vec<usize>,
+    dynamic: bool,
     surface: Surface,
     data: HexapodData,
     decimator: Decimator,
     rows_planned: usize,
     rows: usize,
-    last_stance: Option<[bool; LEG_COUNT]>,
+    last_state: Option<[StateCode; LEG_COUNT]>,
     /// The last row pushed, when it is not a frame (kept by `finish`).
     pending: Option<(usize, HexFrame)>,
     scene: Scene,
@@ -84,12 +127,45 @@ pub struct HexapodScene {
     theta3: [Vec<Option<f64>>; LEG_COUNT],
     margin: Vec<Option<f64>>,
     any_margin: bool,
+    normal: [Vec<Option<f64>>; LEG_COUNT],
+    tau3: [Vec<Option<f64>>; LEG_COUNT],
 }
 
 impl HexapodScene {
     /// A scene of `model` over `surface`, expecting about `rows_planned`
     /// rows (the last pushed row is always kept).
     pub fn new(model: HexapodModel, surface: Surface, rows_planned: usize, title: &str) -> Self {
+        let legs: Vec<usize> = (1..=LEG_COUNT).collect();
+        Self::with_legs(model, surface, &legs, false, rows_planned, title)
+    }
+
+    /// The scene of a dynamic (3D FBD) run of the legs `legs` (numbers
+    /// 1–6): feet coloured ST1/ST2/ST3, ground and joint forces as arrows.
+    pub fn dynamic(
+        model: HexapodModel,
+        surface: Surface,
+        legs: &[usize],
+        rows_planned: usize,
+        title: &str,
+    ) -> Self {
+        Self::with_legs(model, surface, legs, true, rows_planned, title)
+    }
+
+    fn with_legs(
+        model: HexapodModel,
+        surface: Surface,
+        leg_numbers: &[usize],
+        dynamic: bool,
+        rows_planned: usize,
+        title: &str,
+    ) -> Self {
+        let mut legs: Vec<usize> = leg_numbers
+            .iter()
+            .filter(|&&n| (1..=LEG_COUNT).contains(&n))
+            .map(|n| n - 1)
+            .collect();
+        legs.sort_unstable();
+        legs.dedup();
         let mut points = vec!["body".to_owned()];
         points.extend((1..=LEG_COUNT).map(|k| format!("corner{k}")));
         let mut lines: Vec<Line> = (0..LEG_COUNT)
@@ -99,29 +175,45 @@ impl HexapodScene {
                 group: 0,
             })
             .collect();
-        for leg in 0..LEG_COUNT {
+        for (slot, &leg) in legs.iter().enumerate() {
             let n = leg + 1;
             points.extend([format!("hip{n}"), format!("knee{n}"), format!("foot{n}")]);
             lines.push(Line {
-                a: leg_point(leg, 0),
-                b: leg_point(leg, 1),
+                a: leg_point(slot, 0),
+                b: leg_point(slot, 1),
                 group: n,
             });
             lines.push(Line {
-                a: leg_point(leg, 1),
-                b: leg_point(leg, 2),
+                a: leg_point(slot, 1),
+                b: leg_point(slot, 2),
                 group: n,
             });
         }
-        let contacts: Vec<Marker> = (0..LEG_COUNT)
-            .map(|leg| Marker {
+        let contacts: Vec<Marker> = legs
+            .iter()
+            .enumerate()
+            .map(|(slot, leg)| Marker {
                 name: format!("foot{}", leg + 1),
-                point: leg_point(leg, 2),
+                point: leg_point(slot, 2),
             })
             .collect();
+        // Joint-force arrows of a dynamic run: every hip and knee.
+        let joints: Vec<Marker> = if dynamic {
+            legs.iter()
+                .enumerate()
+                .flat_map(|(slot, leg)| {
+                    [("hip", 0), ("knee", 1)].map(|(name, k)| Marker {
+                        name: format!("{name}{}", leg + 1),
+                        point: leg_point(slot, k),
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         // The feet around the body, by mounting angle γ.
-        let mut ring: Vec<usize> = (0..LEG_COUNT).collect();
-        ring.sort_by(|&a, &b| GAMMA_DEG[a].total_cmp(&GAMMA_DEG[b]));
+        let mut ring: Vec<usize> = (0..legs.len()).collect();
+        ring.sort_by(|&a, &b| GAMMA_DEG[legs[a]].total_cmp(&GAMMA_DEG[legs[b]]));
         let scene = Scene {
             model: SceneKind::Hexapod,
             title: title.to_owned(),
@@ -129,18 +221,21 @@ impl HexapodScene {
             lines,
             trails: contacts.iter().map(|c| c.point).collect(),
             contacts,
-            joints: Vec::new(),
+            joints,
             ring,
+            dynamic,
             ..Scene::default()
         };
         Self {
             model,
+            legs,
+            dynamic,
             surface,
             data: HexapodData::new(),
             decimator: Decimator::new(rows_planned),
             rows_planned,
             rows: 0,
-            last_stance: None,
+            last_state: None,
             pending: None,
             scene,
             height: Vec::new(),
@@ -148,6 +243,19 @@ impl HexapodScene {
             theta3: Default::default(),
             margin: Vec::new(),
             any_margin: false,
+            normal: Default::default(),
+            tau3: Default::default(),
+        }
+    }
+
+    /// The state of each foot in frame `f`: ST1/ST2/ST3 from a dynamic
+    /// run, swing (ST1) or stance (ST2) from a kinematic one.
+    fn states(f: &HexFrame) -> [StateCode; LEG_COUNT] {
+        match &f.dynamics {
+            Some(d) => d.state,
+            None => f
+                .stance
+                .map(|on| if on { StateCode::St2 } else { StateCode::St1 }),
         }
     }
 
@@ -155,8 +263,9 @@ impl HexapodScene {
     pub fn push(&mut self, f: &HexFrame) {
         let row = self.rows;
         self.rows += 1;
-        let changed = self.last_stance.is_some_and(|s| s != f.stance);
-        self.last_stance = Some(f.stance);
+        let state = Self::states(f);
+        let changed = self.last_state.is_some_and(|s| s != state);
+        self.last_state = Some(state);
         let last = row + 1 >= self.rows_planned;
         if self.decimator.keep(row, changed, last) {
             self.frame(row, f);
@@ -182,7 +291,8 @@ impl HexapodScene {
             let c = d.body_com + side * (a.cos() * e_x - a.sin() * e_z);
             p.extend(c.iter().map(|v| round(*v)));
         }
-        for l in &d.legs {
+        for &leg in &self.legs {
+            let l = &d.legs[leg];
             for v in [l.hip, l.knee, l.tip] {
                 p.extend(v.iter().map(|x| round(*x)));
             }
@@ -191,19 +301,45 @@ impl HexapodScene {
         s.row.push(row);
         s.t.push(round_time(f.t));
         s.p.push(p);
+        let state = Self::states(f);
         s.state.push(
-            f.stance
+            self.legs
                 .iter()
-                .map(|&on| if on { '2' } else { '1' })
+                .map(|&leg| match state[leg] {
+                    StateCode::St1 => '1',
+                    StateCode::St2 => '2',
+                    StateCode::St3 => '3',
+                })
                 .collect(),
         );
-        s.fc.push(vec![0.0; 3 * LEG_COUNT]);
-        s.fj.push(Vec::new());
+        let dynamics = f.dynamics.unwrap_or_default();
+        s.fc.push(
+            self.legs
+                .iter()
+                .flat_map(|&leg| dynamics.foot_force[leg].map(round))
+                .collect(),
+        );
+        s.fj.push(if self.dynamic {
+            self.legs
+                .iter()
+                .flat_map(|&leg| {
+                    [dynamics.hip_force[leg], dynamics.knee_force[leg]]
+                        .into_iter()
+                        .flat_map(|v| v.map(round))
+                })
+                .collect()
+        } else {
+            Vec::new()
+        });
         s.com.push(f.com.map(round));
         self.height.push(value(f.q[1]));
-        for leg in 0..LEG_COUNT {
+        for &leg in &self.legs {
             self.theta2[leg].push(value(f.q[6 + 3 * leg + 1].to_degrees()));
             self.theta3[leg].push(value(f.q[6 + 3 * leg + 2].to_degrees()));
+            if self.dynamic {
+                self.normal[leg].push(value(dynamics.normal[leg]));
+                self.tau3[leg].push(value(dynamics.torque[leg][2]));
+            }
         }
         self.any_margin |= f.margin.is_some();
         self.margin.push(f.margin.and_then(value));
@@ -219,17 +355,21 @@ impl HexapodScene {
         s.terrain = surface_view(&self.surface, &s.p);
         for k in 1..s.state.len() {
             let (a, b) = (s.state[k - 1].as_bytes(), s.state[k].as_bytes());
-            for leg in 0..LEG_COUNT.min(a.len()).min(b.len()) {
-                if a[leg] != b[leg] {
-                    let what = if b[leg] == b'2' {
-                        "touchdown"
+            for slot in 0..self.legs.len().min(a.len()).min(b.len()) {
+                if a[slot] != b[slot] {
+                    let n = self.legs[slot] + 1;
+                    let label = if self.dynamic {
+                        let st = |c: u8| format!("ST{}", c as char);
+                        format!("leg {n} foot {}→{}", st(a[slot]), st(b[slot]))
+                    } else if b[slot] == b'2' {
+                        format!("leg {n} touchdown")
                     } else {
-                        "lift-off"
+                        format!("leg {n} lift-off")
                     };
                     s.events.push(EventMark {
                         t: s.t[k],
                         frame: k,
-                        label: format!("leg {} {what}", leg + 1),
+                        label,
                     });
                 }
             }
@@ -241,18 +381,23 @@ impl HexapodScene {
                 v: std::mem::take(&mut self.height),
             }],
         });
-        for (title, sym, series) in [
+        let mut series = vec![
             ("Hip-lift angles θ2 (°)", "θ2", &mut self.theta2),
             ("Knee angles θ3 (°)", "θ3", &mut self.theta3),
-        ] {
+        ];
+        if self.dynamic {
+            series.insert(0, ("Normal forces of the feet (N)", "n", &mut self.normal));
+            series.push(("Knee torques τ3 (N·m)", "τ3", &mut self.tau3));
+        }
+        for (title, sym, series) in series {
             s.panels.push(Panel {
                 title: title.into(),
-                curves: series
-                    .iter_mut()
-                    .enumerate()
-                    .map(|(leg, v)| Curve {
+                curves: self
+                    .legs
+                    .iter()
+                    .map(|&leg| Curve {
                         label: format!("{sym} leg {}", leg + 1),
-                        v: std::mem::take(v),
+                        v: std::mem::take(&mut series[leg]),
                     })
                     .collect(),
             });

@@ -181,6 +181,10 @@ pub struct Scene {
     pub events: Vec<EventMark>,
     /// Time-series panels.
     pub panels: Vec<Panel>,
+    /// A dynamic hexapod run: contact states ST1/ST2/ST3 and force arrows
+    /// (written only when true).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub dynamic: bool,
 }
 
 /// Rounds to 6 significant decimals of a metre / newton scale (1e-6): the

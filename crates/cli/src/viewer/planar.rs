@@ -123,6 +123,7 @@ impl<'a> PlanarScene<'a> {
             joints,
             trails,
             ring: Vec::new(),
+            dynamic: false,
             terrain: Default::default(),
             rows: 0,
             row: Vec::new(),

@@ -231,6 +231,7 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
             stance: [false; LEG_COUNT],
             com: [f64::NAN; 3],
             margin: None,
+            dynamics: None,
         };
         for (k, &c) in q_cols.iter().enumerate() {
             f.q[k] = table.number(row, r, c)?;

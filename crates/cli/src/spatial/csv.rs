@@ -1,0 +1,272 @@
+//! `trajectory.csv` of a 3D (spatial) hexapod run: the columns, named from
+//! the model's legs and contact points (`{leg, kind}` data), and the
+//! streaming writer.
+
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use fbd_dynamics::PointKind;
+use fbd_sim::spatial::{SpatialParams, SpatialRecord};
+use tempfile::NamedTempFile;
+
+use super::Layout;
+use crate::CliError;
+use crate::output;
+use crate::steptime::StepTimes;
+
+/// The body pose columns after `t`.
+pub const POSE_COLUMNS: [&str; 6] = ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"];
+
+/// The name prefix of a knee or hip contact point's columns
+/// (`kneepoint3_fx`): distinct from the joint columns (`knee3_fx`).
+pub fn point_prefix(kind: PointKind) -> &'static str {
+    match kind {
+        PointKind::Tip => "foot",
+        PointKind::Knee => "kneepoint",
+        PointKind::Hip => "hippoint",
+    }
+}
+
+/// The columns of `trajectory.csv`, in order, for the legs and contact
+/// points of `layout`:
+///
+/// * `t, rx, ry, rz, phi_x, phi_y, phi_z`;
+/// * `theta1_n, theta2_n, theta3_n` for each leg n of the model;
+/// * per leg n: `foot{n}_x, foot{n}_y, foot{n}_z, state{n}, foot{n}_fx,
+///   foot{n}_fy, foot{n}_fz, foot{n}_n`, `hip{n}_fx, hip{n}_fy, hip{n}_fz,
+///   hip{n}_mx, hip{n}_my, hip{n}_mz`, `knee{n}_fx, …, knee{n}_mz`,
+///   `tau1_{n}, tau2_{n}, tau3_{n}`;
+/// * per knee or hip contact point (leg by leg, knee before hip):
+///   `kneepoint{n}_state, kneepoint{n}_fx, kneepoint{n}_fy,
+///   kneepoint{n}_fz, kneepoint{n}_n` (`hippoint{n}_…` alike);
+/// * `kinetic, potential, newton_iterations`.
+pub fn columns(layout: &Layout) -> Vec<String> {
+    let mut c: Vec<String> = std::iter::once("t")
+        .chain(POSE_COLUMNS)
+        .map(str::to_owned)
+        .collect();
+    for n in &layout.legs {
+        for j in 1..=3 {
+            c.push(format!("theta{j}_{n}"));
+        }
+    }
+    for n in &layout.legs {
+        for a in ["x", "y", "z"] {
+            c.push(format!("foot{n}_{a}"));
+        }
+        c.push(format!("state{n}"));
+        for a in ["fx", "fy", "fz", "n"] {
+            c.push(format!("foot{n}_{a}"));
+        }
+        for joint in ["hip", "knee"] {
+            for a in ["fx", "fy", "fz", "mx", "my", "mz"] {
+                c.push(format!("{joint}{n}_{a}"));
+            }
+        }
+        for j in 1..=3 {
+            c.push(format!("tau{j}_{n}"));
+        }
+    }
+    for &(n, kind) in &layout.extra_points {
+        let p = point_prefix(kind);
+        for a in ["state", "fx", "fy", "fz", "n"] {
+            c.push(format!("{p}{n}_{a}"));
+        }
+    }
+    c.extend(["kinetic", "potential", "newton_iterations"].map(str::to_owned));
+    c
+}
+
+/// Where each column group of a row is found in a [`SpatialRecord`],
+/// matched by `{leg, kind}` on the first record.
+#[derive(Clone, Debug, Default)]
+pub struct Slots {
+    /// Per leg of the layout: its row in `record.legs`.
+    pub legs: Vec<Option<usize>>,
+    /// Per leg of the layout: its foot's row in `record.contacts`.
+    pub tips: Vec<Option<usize>>,
+    /// Per extra point of the layout: its row in `record.contacts`.
+    pub extras: Vec<Option<usize>>,
+}
+
+impl Slots {
+    /// The rows of `r` for `layout`.
+    pub fn of(layout: &Layout, r: &SpatialRecord) -> Self {
+        let contact = |leg: usize, kind: PointKind| {
+            r.contacts
+                .iter()
+                .position(|c| c.leg == leg && c.kind == kind)
+        };
+        Self {
+            legs: layout
+                .legs
+                .iter()
+                .map(|&n| r.legs.iter().position(|l| l.leg == n))
+                .collect(),
+            tips: layout
+                .legs
+                .iter()
+                .map(|&n| contact(n, PointKind::Tip))
+                .collect(),
+            extras: layout
+                .extra_points
+                .iter()
+                .map(|&(n, kind)| contact(n, kind))
+                .collect(),
+        }
+    }
+}
+
+/// Streams `trajectory.csv` through a buffer into a temporary file; no
+/// allocation per row.
+pub struct TrajectoryWriter {
+    out: BufWriter<NamedTempFile>,
+    dest: PathBuf,
+    num: ryu::Buffer,
+    times: StepTimes,
+    layout: Layout,
+    slots: Option<Slots>,
+    feet: super::Feet,
+    error: Option<io::Error>,
+    rows: usize,
+}
+
+impl TrajectoryWriter {
+    /// Opens the temporary file in `dir` and writes the header.
+    pub fn create(dir: &Path, params: &SpatialParams) -> Result<Self, CliError> {
+        let dest = dir.join("trajectory.csv");
+        let tmp = output::temp_in(dir, "trajectory.csv")?;
+        let layout = Layout::of(params);
+        let mut w = Self {
+            out: BufWriter::with_capacity(1 << 16, tmp),
+            dest,
+            num: ryu::Buffer::new(),
+            times: StepTimes::new(params.dt),
+            feet: super::Feet::new(params),
+            layout,
+            slots: None,
+            error: None,
+            rows: 0,
+        };
+        let header = columns(&w.layout).join(",");
+        if let Err(e) = writeln!(w.out, "{header}") {
+            return Err(CliError::io(w.dest.display(), &e));
+        }
+        Ok(w)
+    }
+
+    /// Rows written so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Appends the row of `r`. An I/O error is kept and reported by
+    /// [`TrajectoryWriter::finish`]; later rows are skipped.
+    pub fn write(&mut self, r: &SpatialRecord) {
+        if self.error.is_some() {
+            return;
+        }
+        if self.slots.is_none() {
+            self.slots = Some(Slots::of(&self.layout, r));
+        }
+        match self.write_row(r) {
+            Ok(()) => self.rows += 1,
+            Err(e) => self.error = Some(e),
+        }
+    }
+
+    fn f(&mut self, x: f64) -> io::Result<()> {
+        self.out.write_all(b",")?;
+        self.out.write_all(self.num.format(x).as_bytes())
+    }
+
+    fn s(&mut self, s: &str) -> io::Result<()> {
+        self.out.write_all(b",")?;
+        self.out.write_all(s.as_bytes())
+    }
+
+    fn write_row(&mut self, r: &SpatialRecord) -> io::Result<()> {
+        let slots = self.slots.take().unwrap_or_default();
+        let result = self.write_values(r, &slots);
+        self.slots = Some(slots);
+        result
+    }
+
+    fn write_values(&mut self, r: &SpatialRecord, slots: &Slots) -> io::Result<()> {
+        self.times.write(&mut self.out, r.step, r.t)?;
+        for &x in &r.q {
+            self.f(x)?;
+        }
+        self.feet.update(&r.q);
+        for i in 0..self.layout.legs.len() {
+            let tip = slots.tips[i].map(|c| &r.contacts[c]);
+            let p = tip.map_or_else(|| self.feet.tip(i), |c| c.point);
+            for x in p {
+                self.f(x)?;
+            }
+            self.s(tip.map_or("ST1", |c| c.state.as_str()))?;
+            let (f, n) = tip.map_or(([0.0; 3], 0.0), |c| (c.force, c.normal));
+            for x in f {
+                self.f(x)?;
+            }
+            self.f(n)?;
+            let leg = slots.legs[i].map(|l| &r.legs[l]);
+            let zero = [0.0; 3];
+            for v in [
+                leg.map_or(zero, |l| l.hip_force),
+                leg.map_or(zero, |l| l.hip_moment),
+                leg.map_or(zero, |l| l.knee_force),
+                leg.map_or(zero, |l| l.knee_moment),
+                leg.map_or(zero, |l| l.torque),
+            ] {
+                for x in v {
+                    self.f(x)?;
+                }
+            }
+        }
+        for slot in &slots.extras {
+            let c = slot.map(|c| &r.contacts[c]);
+            self.s(c.map_or("ST1", |c| c.state.as_str()))?;
+            let (f, n) = c.map_or(([0.0; 3], 0.0), |c| (c.force, c.normal));
+            for x in f {
+                self.f(x)?;
+            }
+            self.f(n)?;
+        }
+        self.f(r.kinetic)?;
+        self.f(r.potential)?;
+        write!(self.out, ",{}", r.newton_iterations)?;
+        self.out.write_all(b"\n")
+    }
+
+    /// Flushes and renames the file into place.
+    pub fn finish(self) -> Result<PathBuf, CliError> {
+        let dest = self.dest;
+        if let Some(e) = self.error {
+            return Err(CliError::io(dest.display(), &e));
+        }
+        let tmp = self
+            .out
+            .into_inner()
+            .map_err(|e| CliError::io(dest.display(), e.error()))?;
+        output::persist(tmp, &dest)?;
+        Ok(dest)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn joint_and_contact_point_columns_never_clash() {
+        let layout = Layout::of(&SpatialParams::default());
+        let c = columns(&layout);
+        let mut sorted = c.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), c.len(), "duplicate column names");
+        assert!(c.contains(&"kneepoint6_fz".to_owned()));
+        assert!(c.contains(&"hippoint1_state".to_owned()));
+    }
+}

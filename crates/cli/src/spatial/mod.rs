@@ -1,0 +1,583 @@
+//! `fbd run` of a dynamic hexapod configuration (the 3D FBD dynamics,
+//! [`fbd_sim::spatial`]): `trajectory.csv` ([`csv`]), `events.csv` (the
+//! planar run's writer), `summary.json` ([`summary`]), `config.toml`,
+//! `feet.svg`, `torques.svg`, `body.svg`, `energy.svg` ([`plots`]) and
+//! `viewer.html` (the hexapod viewer with contact states and forces).
+
+pub mod csv;
+pub mod plots;
+pub mod summary;
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use fbd_dynamics::PointKind;
+use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
+use fbd_kinematics::leg::LegGeometry;
+use fbd_sim::RunSummary;
+use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_until};
+
+use crate::CliError;
+use crate::config::ConfigError;
+use crate::output::{self, Ending};
+use crate::steptime::StepTimes;
+use crate::viewer::hexapod::{HexDynamics, HexFrame, HexapodScene};
+
+pub use csv::{TrajectoryWriter, columns};
+pub use summary::SpatialSummary;
+
+/// The files a dynamic hexapod run writes, in order.
+pub const FILES: [&str; 9] = [
+    "trajectory.csv",
+    "events.csv",
+    "summary.json",
+    "config.toml",
+    "feet.svg",
+    "torques.svg",
+    "body.svg",
+    "energy.svg",
+    "viewer.html",
+];
+
+/// The legs and contact points of a spatial model, as the output files
+/// name them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Layout {
+    /// Leg numbers (1–6), increasing.
+    pub legs: Vec<usize>,
+    /// The knee and hip contact points `(leg, kind)`: leg by leg, knee
+    /// before hip (the feet are in the per-leg columns).
+    pub extra_points: Vec<(usize, PointKind)>,
+}
+
+impl Layout {
+    /// The layout of `params`: its legs, and its knees and hips when they
+    /// are contact points.
+    pub fn of(params: &SpatialParams) -> Self {
+        let mut legs = params.legs.clone();
+        legs.sort_unstable();
+        legs.dedup();
+        let cp = params.contact_points;
+        let mut extra_points = Vec::new();
+        for &n in &legs {
+            if cp.knees {
+                extra_points.push((n, PointKind::Knee));
+            }
+            if cp.hips {
+                extra_points.push((n, PointKind::Hip));
+            }
+        }
+        Self { legs, extra_points }
+    }
+
+    /// The names of the contact points (`tip3`, `knee3`, `hip3`, …), leg by
+    /// leg, for messages and `summary.json`.
+    pub fn point_names(&self, params: &SpatialParams) -> Vec<String> {
+        let cp = params.contact_points;
+        let mut names = Vec::new();
+        for &n in &self.legs {
+            for (on, kind) in [
+                (cp.tips, PointKind::Tip),
+                (cp.knees, PointKind::Knee),
+                (cp.hips, PointKind::Hip),
+            ] {
+                if on {
+                    names.push(format!("{}{n}", kind.as_str()));
+                }
+            }
+        }
+        names
+    }
+}
+
+/// The forward kinematics of a spatial model's `q` (its legs only; the
+/// others are folded at zero and never reported): feet, link centres of
+/// mass, the whole robot's centre of mass.
+#[derive(Clone, Debug)]
+pub struct Feet {
+    model: HexapodModel,
+    data: HexapodData,
+    legs: Vec<usize>,
+    q: [f64; NQ],
+    masses: [f64; 3],
+}
+
+impl Feet {
+    /// For the geometry and masses of `params`.
+    pub fn new(params: &SpatialParams) -> Self {
+        Self {
+            model: kinematic_model(params),
+            data: HexapodData::new(),
+            legs: Layout::of(params).legs,
+            q: [0.0; NQ],
+            masses: [params.body_mass, params.upper_mass, params.lower_mass],
+        }
+    }
+
+    /// Evaluates the kinematics at the model's coordinates `q` (`6 + 3·legs`
+    /// values).
+    pub fn update(&mut self, q: &[f64]) {
+        self.q[..6].copy_from_slice(&q[..6]);
+        for (i, &n) in self.legs.iter().enumerate() {
+            let at = 6 + 3 * (n - 1);
+            self.q[at..at + 3].copy_from_slice(&q[6 + 3 * i..9 + 3 * i]);
+        }
+        forward(&self.model, &HexapodConfig::from_q(&self.q), &mut self.data);
+    }
+
+    /// The foot of the `i`-th leg of the layout at the last [`Feet::update`].
+    pub fn tip(&self, i: usize) -> [f64; 3] {
+        let t = self.data.legs[self.legs[i] - 1].tip;
+        [t.x, t.y, t.z]
+    }
+
+    /// The whole robot's centre of mass (body and the model's links).
+    pub fn com(&self) -> [f64; 3] {
+        let [mb, mu, ml] = self.masses;
+        let mut c = mb * self.data.body_com;
+        let mut m = mb;
+        for &n in &self.legs {
+            let l = &self.data.legs[n - 1];
+            c += mu * l.upper_com + ml * l.lower_com;
+            m += mu + ml;
+        }
+        let c = c / m;
+        [c.x, c.y, c.z]
+    }
+
+    /// The full 24-coordinate vector of the last update.
+    pub fn q(&self) -> &[f64; NQ] {
+        &self.q
+    }
+}
+
+/// The kinematic model (geometry and link centres of mass) of `params`.
+pub fn kinematic_model(params: &SpatialParams) -> HexapodModel {
+    HexapodModel::new(
+        params.side,
+        LegGeometry {
+            a: params.upper_length,
+            c: params.lower_length,
+        },
+        params.upper_com,
+        params.lower_com,
+    )
+}
+
+/// The viewer frame of a record.
+fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &SpatialRecord) -> HexFrame {
+    feet.update(&r.q);
+    let mut d = HexDynamics::default();
+    for (i, &n) in layout.legs.iter().enumerate() {
+        if let Some(c) = slots.tips[i] {
+            d.state[n - 1] = r.contacts[c].state;
+            d.foot_force[n - 1] = r.contacts[c].force;
+            d.normal[n - 1] = r.contacts[c].normal;
+        }
+        if let Some(l) = slots.legs[i] {
+            let l = &r.legs[l];
+            d.hip_force[n - 1] = l.hip_force;
+            d.knee_force[n - 1] = l.knee_force;
+            d.torque[n - 1] = l.torque;
+        }
+    }
+    HexFrame {
+        t: r.t,
+        q: *feet.q(),
+        stance: d.state.map(|s| s != fbd_contact::StateCode::St1),
+        com: feet.com(),
+        margin: None,
+        dynamics: Some(d),
+    }
+}
+
+/// What a dynamic hexapod run produced.
+pub struct SpatialRun {
+    /// The run: steps, events, and the error that stopped it, if any.
+    pub run: RunSummary,
+    /// The content of `summary.json`.
+    pub summary: SpatialSummary,
+    /// The first failure writing a file (every file is still attempted).
+    pub io_error: Option<CliError>,
+    /// The files written, in order (none without an output directory).
+    pub files: Vec<&'static str>,
+}
+
+/// Everything a run writes, fed one record per step ([`Outputs::push`])
+/// and completed by [`Outputs::finish`].
+pub struct Outputs {
+    layout: Layout,
+    stride: usize,
+    steps: usize,
+    dir: Option<PathBuf>,
+    traj: Option<TrajectoryWriter>,
+    plot: Option<plots::Recorder>,
+    view: Option<HexapodScene>,
+    collect: summary::Collector,
+    feet: Feet,
+    slots: Option<csv::Slots>,
+    rows: usize,
+}
+
+impl Outputs {
+    /// For a run of `params` solving `steps` steps; with `out_dir`, creates
+    /// it and opens `trajectory.csv` there.
+    pub fn new(
+        params: &SpatialParams,
+        steps: usize,
+        out_dir: Option<&Path>,
+    ) -> Result<Self, CliError> {
+        let layout = Layout::of(params);
+        let stride = params.stride.max(1);
+        let traj = match out_dir {
+            Some(dir) => {
+                output::prepare_dir(dir)?;
+                Some(TrajectoryWriter::create(dir, params)?)
+            }
+            None => None,
+        };
+        let t_end = (steps.max(1) - 1) as f64 * params.dt;
+        Ok(Self {
+            collect: summary::Collector::new(&layout),
+            plot: out_dir.map(|_| plots::Recorder::new(&layout, t_end)),
+            view: out_dir.map(|dir| {
+                HexapodScene::dynamic(
+                    kinematic_model(params),
+                    params.terrain.clone(),
+                    &layout.legs,
+                    steps.div_ceil(stride),
+                    &crate::viewer::title_of(dir),
+                )
+            }),
+            feet: Feet::new(params),
+            dir: out_dir.map(Path::to_owned),
+            traj,
+            layout,
+            stride,
+            steps,
+            slots: None,
+            rows: 0,
+        })
+    }
+
+    /// Adds the record of one solved step (every step: the plots and peaks
+    /// see them all; the files every `stride`-th), handing the written ones
+    /// to `on_row`.
+    pub fn push(&mut self, r: &SpatialRecord, on_row: &mut dyn FnMut(&SpatialRecord)) {
+        let s = self
+            .slots
+            .get_or_insert_with(|| csv::Slots::of(&self.layout, r));
+        if r.step.is_multiple_of(self.stride) {
+            if let Some(t) = self.traj.as_mut() {
+                t.write(r);
+            }
+            if let Some(v) = self.view.as_mut() {
+                v.push(&frame(&mut self.feet, &self.layout, s, r));
+            }
+            on_row(r);
+            self.rows += 1;
+        }
+        self.collect.push(r, s);
+        if let Some(p) = self.plot.as_mut() {
+            p.push(r, s);
+        }
+    }
+
+    /// Writes every file (each attempted, the first failure kept) and
+    /// removes those of an earlier run of another kind.
+    pub fn finish(self, params: &SpatialParams, run: RunSummary, config_toml: &str) -> SpatialRun {
+        let s = self
+            .collect
+            .finish(params, self.steps, &self.layout, &run, self.rows);
+        let (Some(out_dir), Some(traj), Some(plot), Some(view)) =
+            (self.dir, self.traj, self.plot, self.view)
+        else {
+            return SpatialRun {
+                run,
+                summary: s,
+                io_error: None,
+                files: Vec::new(),
+            };
+        };
+        let mut io_error: Option<CliError> = None;
+        let mut keep = |r: Result<PathBuf, CliError>| {
+            if let Err(e) = r
+                && io_error.is_none()
+            {
+                io_error = Some(e);
+            }
+        };
+        keep(traj.finish());
+        output::write_run_files(
+            &out_dir,
+            &output::run_events_csv(&run, params.dt),
+            &s,
+            config_toml,
+            &mut keep,
+        );
+        let plot = plot.finish(&run);
+        for (name, svg) in [
+            ("feet.svg", plots::feet_svg(&plot)),
+            ("torques.svg", plots::torques_svg(&plot)),
+            ("body.svg", plots::body_svg(&plot)),
+            ("energy.svg", plots::energy_svg(&plot)),
+        ] {
+            keep(
+                svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
+                    .and_then(|s| output::write_file(&out_dir, name, s.as_bytes())),
+            );
+        }
+        keep(crate::viewer::write(&out_dir, &view.finish()));
+        if io_error.is_none()
+            && let Err(e) = output::remove_stale(&out_dir, &FILES)
+        {
+            io_error = Some(e);
+        }
+        SpatialRun {
+            run,
+            summary: s,
+            io_error,
+            files: FILES.to_vec(),
+        }
+    }
+}
+
+/// Simulates `params` (read from `source`; `config_toml` is the complete
+/// configuration for `config.toml`), handing every `stride`-th record to
+/// `on_row`; when `out_dir` is given, writes every file of a dynamic
+/// hexapod run there, streaming `trajectory.csv`, even after a simulation
+/// error (which is in `run.error`). The run stops before its next step
+/// once `stop` is set (`run.interrupted`). Fails for an invalid model or
+/// an output directory that cannot be created.
+pub fn simulate(
+    params: &SpatialParams,
+    config_toml: &str,
+    source: &str,
+    out_dir: Option<&Path>,
+    stop: &AtomicBool,
+    on_row: &mut dyn FnMut(&SpatialRecord),
+) -> Result<SpatialRun, CliError> {
+    // The plots and peaks want every step: stride is applied by Outputs.
+    let mut every_step = params.clone();
+    every_step.stride = 1;
+    let model = SpatialModel::new(&every_step).map_err(|e| ConfigError::Semantic {
+        file: source.to_owned(),
+        message: e.to_string(),
+    })?;
+    let mut out = Outputs::new(params, model.steps, out_dir)?;
+    let run = run_until(&model, stop, |r: &SpatialRecord| out.push(r, on_row));
+    Ok(out.finish(params, run, config_toml))
+}
+
+/// `fbd run` of a dynamic hexapod configuration: simulates, writes the
+/// files, prints the events, the step count, the distance walked and the
+/// final height, and ends like every run ([`output::conclude`]).
+pub fn run_command(
+    params: &SpatialParams,
+    config_toml: &str,
+    source: &str,
+    out_dir: &Path,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let SpatialRun {
+        run,
+        summary,
+        io_error,
+        files,
+    } = simulate(
+        params,
+        config_toml,
+        source,
+        Some(out_dir),
+        crate::interrupt::flag(),
+        &mut |_| {},
+    )?;
+    let mut text = String::new();
+    let times = StepTimes::new(params.dt);
+    for (step, t, e) in output::run_events(&run, &times) {
+        text.push_str(&crate::run::event_line(&times.string(step, t), &e));
+        text.push('\n');
+    }
+    text.push_str(&format!(
+        "{} {}, {}, {:.3} s\n",
+        if run.error.is_some() || run.interrupted {
+            "stopped after"
+        } else {
+            "solved"
+        },
+        output::count(run.steps, "step", "steps"),
+        output::count(
+            run.newton_iterations,
+            "Newton iteration",
+            "Newton iterations"
+        ),
+        run.wall_seconds
+    ));
+    if let Some(h) = summary.final_height {
+        text.push_str(&format!(
+            "body moved {:.4} m (x {:.4} m, z {:.4} m), final height {:.4} m\n",
+            summary.distance, summary.displacement[0], summary.displacement[2], h
+        ));
+    }
+    let ending = if let Some(e) = &run.error {
+        Ending::Failed {
+            error: e.to_string(),
+            source: source.to_owned(),
+            advice: None,
+        }
+    } else if run.interrupted {
+        Ending::Interrupted(format!(
+            "interrupted after {} of {} steps (t = {} s)",
+            run.steps,
+            summary.steps_planned,
+            times.string(run.steps, run.steps as f64 * params.dt)
+        ))
+    } else {
+        Ending::Completed
+    };
+    output::conclude(out, text, out_dir, &files, io_error, ending)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use fbd_contact::StateCode;
+    use fbd_sim::Event;
+    use fbd_sim::spatial::{ContactRow, LegRow};
+
+    /// A made-up step `k` of `params`: the robot falling rigidly, foot 4
+    /// on the ground (ST2) from step 5.
+    fn record(p: &SpatialParams, k: usize) -> SpatialRecord {
+        let t = k as f64 * p.dt;
+        let mut q = p.q0.clone();
+        q[1] -= 0.5 * p.gravity * t * t;
+        let layout = Layout::of(p);
+        let mut contacts = Vec::new();
+        for &n in &layout.legs {
+            for kind in [PointKind::Tip, PointKind::Knee, PointKind::Hip] {
+                let down = n == 4 && kind == PointKind::Tip && k >= 5;
+                contacts.push(ContactRow {
+                    leg: n,
+                    kind,
+                    point: [n as f64, 0.0, 0.0],
+                    state: if down { StateCode::St2 } else { StateCode::St1 },
+                    force: if down { [1.0, 50.0, 0.0] } else { [0.0; 3] },
+                    normal: if down { 50.0 } else { 0.0 },
+                });
+            }
+        }
+        let legs = layout
+            .legs
+            .iter()
+            .map(|&n| LegRow {
+                leg: n,
+                torque: [0.1 * n as f64, -2.0, 3.0],
+                rate: [1.0, 2.0, -1.0],
+                ..LegRow::default()
+            })
+            .collect();
+        SpatialRecord {
+            step: k,
+            t,
+            q,
+            contacts,
+            legs,
+            kinetic: 1.0,
+            potential: 2.0,
+            momentum: [0.0; 3],
+            angular_momentum: [0.0; 3],
+            newton_iterations: 2 + k % 3,
+            state_trials: 1,
+        }
+    }
+
+    #[test]
+    fn a_run_writes_every_file_from_its_records() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = SpatialParams {
+            duration: 0.01,
+            legs: vec![3, 4],
+            q0: {
+                let mut q = vec![0.0, 0.6, 0.0, 0.0, 0.0, 0.0];
+                q.extend([0.0, 0.0, 4.3, 0.0, 0.0, 4.3]);
+                q
+            },
+            stride: 2,
+            ..SpatialParams::default()
+        };
+        let steps = 11;
+        let mut out = Outputs::new(&p, steps, Some(dir.path())).unwrap();
+        let mut written = 0;
+        for k in 0..steps {
+            out.push(&record(&p, k), &mut |_| written += 1);
+        }
+        let run = RunSummary {
+            steps,
+            newton_iterations: 30,
+            events: vec![Event {
+                t: 0.005,
+                step: 5,
+                contact: 3,
+                point: "tip",
+                leg: 4,
+                from: StateCode::St1,
+                to: StateCode::St2,
+            }],
+            ..RunSummary::default()
+        };
+        let r = out.finish(&p, run, "# config\n");
+        assert!(r.io_error.is_none(), "{:?}", r.io_error);
+        assert_eq!(written, 6);
+        for f in FILES {
+            assert!(dir.path().join(f).exists(), "{f}");
+        }
+        let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 7);
+        assert_eq!(lines[0], columns(&Layout::of(&p)).join(","));
+        assert!(lines[0].starts_with("t,rx,ry,rz,phi_x,phi_y,phi_z,theta1_3,"));
+        // Row 3 is step 6: foot 4 sticks with its force.
+        let row: Vec<&str> = lines[4].split(',').collect();
+        let header: Vec<&str> = lines[0].split(',').collect();
+        let at = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+        assert_eq!(at("t"), "0.006");
+        assert_eq!(at("state4"), "ST2");
+        assert_eq!(at("state3"), "ST1");
+        assert_eq!(at("foot4_fy"), "50.0");
+        assert_eq!(at("foot4_n"), "50.0");
+        assert_eq!(at("foot4_x"), "4.0");
+        assert_eq!(at("tau1_4"), "0.4");
+        assert_eq!(at("kneepoint3_state"), "ST1");
+        let events = std::fs::read_to_string(dir.path().join("events.csv")).unwrap();
+        assert_eq!(events, "t,leg,from,to,point\n0.005,4,ST1,ST2,tip\n");
+        let s = r.summary;
+        assert_eq!(s.rows_written, 6);
+        assert_eq!(s.newton_iterations_per_step.max, 4);
+        assert_eq!(s.first_touchdown["leg4"], Some(0.005));
+        assert_eq!(s.first_touchdown["leg3"], None);
+        let peak = &s.peak_actuation[5];
+        assert_eq!((peak.leg, peak.joint), (4, "theta3"));
+        assert_eq!((peak.torque, peak.power), (3.0, 3.0));
+        assert_eq!(s.peak_torque_max, 3.0);
+        assert_eq!(s.peak_power_max, 4.0);
+        assert_eq!(s.peak_contact_force["tip4"].n, 50.0);
+        assert_eq!(s.peak_contact_force["tip4"].fa, 1.0);
+        let fall = 0.5 * p.gravity * 0.01f64.powi(2);
+        assert!((s.displacement[1] + fall).abs() < 1e-15);
+        assert_eq!(s.final_height, Some(0.6 - fall));
+        let page = std::fs::read_to_string(dir.path().join("viewer.html")).unwrap();
+        assert!(page.contains("\"dynamic\":true"));
+        assert!(page.contains("\"foot4\""));
+        assert!(!page.contains("\"foot1\""));
+        for f in ["feet.svg", "torques.svg", "body.svg", "energy.svg"] {
+            let svg = std::fs::read_to_string(dir.path().join(f)).unwrap();
+            assert!(
+                svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+                "{f}"
+            );
+        }
+        let feet = std::fs::read_to_string(dir.path().join("feet.svg")).unwrap();
+        assert!(feet.contains("foot 4") && feet.contains("4 tip ST2"));
+    }
+}

@@ -1,0 +1,240 @@
+//! The plots of a dynamic hexapod run, drawn from every step (min/max
+//! reduced per time column, [`crate::plot::MinMax`]), one colour per leg
+//! (the plots' shared palette):
+//!
+//! * `feet.svg` — the normal force of every foot;
+//! * `torques.svg` — the actuator torques τ1, τ2, τ3 of every leg, one
+//!   chart per joint;
+//! * `body.svg` — the body height `Ry`, and the body angles φx, φy, φz;
+//! * `energy.svg` — kinetic, potential and total energy (as the planar
+//!   run draws it).
+
+use fbd_sim::RunSummary;
+use fbd_sim::spatial::SpatialRecord;
+use plotters::style::RGBColor;
+
+use super::Layout;
+use super::csv::Slots;
+use crate::plot::{
+    self, EventMark, MinMax, PALETTE, PlotData, PlotResult, Style, Trace, stacked_time_chart,
+};
+
+/// The colour of leg `n` (1–6): the palette's `n`-th colour, as in every
+/// hexapod plot.
+fn leg_color(n: usize) -> RGBColor {
+    PALETTE[(n + PALETTE.len() - 1) % PALETTE.len()]
+}
+
+/// Gathers the curves of a run step by step.
+pub struct Recorder {
+    legs: Vec<usize>,
+    normal: Vec<MinMax>,
+    torque: Vec<[MinMax; 3]>,
+    body: [MinMax; 4],
+    energy: [MinMax; 3],
+}
+
+impl Recorder {
+    /// For a run from `t = 0` to `t_end` of a model with `layout`.
+    pub fn new(layout: &Layout, t_end: f64) -> Self {
+        let m = || MinMax::new(0.0, t_end);
+        Self {
+            legs: layout.legs.clone(),
+            normal: layout.legs.iter().map(|_| m()).collect(),
+            torque: layout
+                .legs
+                .iter()
+                .map(|_| std::array::from_fn(|_| m()))
+                .collect(),
+            body: std::array::from_fn(|_| m()),
+            energy: std::array::from_fn(|_| m()),
+        }
+    }
+
+    /// Adds one step; `s` matches the record's rows to the layout.
+    pub fn push(&mut self, r: &SpatialRecord, s: &Slots) {
+        let t = r.t;
+        for (i, m) in self.normal.iter_mut().enumerate() {
+            m.push(t, s.tips[i].map_or(0.0, |c| r.contacts[c].normal));
+        }
+        for (i, ms) in self.torque.iter_mut().enumerate() {
+            let tau = s.legs[i].map_or([0.0; 3], |l| r.legs[l].torque);
+            for (m, v) in ms.iter_mut().zip(tau) {
+                m.push(t, v);
+            }
+        }
+        self.body[0].push(t, r.q[1]);
+        for k in 0..3 {
+            self.body[1 + k].push(t, r.q[3 + k].to_degrees());
+        }
+        self.energy[0].push(t, r.kinetic);
+        self.energy[1].push(t, r.potential);
+        self.energy[2].push(t, r.kinetic + r.potential);
+    }
+
+    /// The curves, with the contact events of `run`.
+    pub fn finish(self, run: &RunSummary) -> SpatialPlotData {
+        let trace = |label: String, m: MinMax| Trace {
+            label,
+            pts: m.finish(),
+        };
+        let mut torques: [Vec<Trace>; 3] = Default::default();
+        for (&n, ms) in self.legs.iter().zip(self.torque) {
+            for (j, m) in ms.into_iter().enumerate() {
+                torques[j].push(trace(format!("τ{} leg {n}", j + 1), m));
+            }
+        }
+        let [height, phi_x, phi_y, phi_z] = self.body;
+        let [kinetic, potential, total] = self.energy;
+        SpatialPlotData {
+            feet: self
+                .legs
+                .iter()
+                .zip(self.normal)
+                .map(|(n, m)| trace(format!("foot {n}"), m))
+                .collect(),
+            torques,
+            height: trace("Ry".into(), height),
+            angles: vec![
+                trace("φx".into(), phi_x),
+                trace("φy".into(), phi_y),
+                trace("φz".into(), phi_z),
+            ],
+            energy: vec![
+                trace("kinetic".into(), kinetic),
+                trace("potential".into(), potential),
+                trace("total".into(), total),
+            ],
+            legs: self.legs,
+            events: run.events.iter().map(EventMark::of).collect(),
+        }
+    }
+}
+
+/// Everything the plots of a dynamic hexapod run show.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SpatialPlotData {
+    /// Leg numbers, in the order of the per-leg curves.
+    pub legs: Vec<usize>,
+    /// Normal force of each leg's foot (N).
+    pub feet: Vec<Trace>,
+    /// Torques τ1, τ2, τ3 (one vector per joint), one curve per leg (N·m).
+    pub torques: [Vec<Trace>; 3],
+    /// Body height `Ry` (m).
+    pub height: Trace,
+    /// Body angles φx, φy, φz (degrees).
+    pub angles: Vec<Trace>,
+    /// Kinetic, potential and total energy (J).
+    pub energy: Vec<Trace>,
+    /// Contact events.
+    pub events: Vec<EventMark>,
+}
+
+impl SpatialPlotData {
+    fn t_range(&self) -> (f64, f64) {
+        let (lo, hi) = self
+            .height
+            .pts
+            .iter()
+            .map(|p| p.0)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), t| {
+                (a.min(t), b.max(t))
+            });
+        if lo < hi { (lo, hi) } else { (0.0, 1.0) }
+    }
+
+    /// One solid curve per leg, in the leg's colour.
+    fn per_leg<'a>(&self, traces: &'a [Trace]) -> Vec<(&'a Trace, Style)> {
+        traces
+            .iter()
+            .zip(&self.legs)
+            .map(|(t, &n)| {
+                (
+                    t,
+                    Style {
+                        color: leg_color(n),
+                        width: 2,
+                        dashed: false,
+                    },
+                )
+            })
+            .collect()
+    }
+}
+
+/// `feet.svg`: the normal force of every foot versus time.
+pub fn feet_svg(d: &SpatialPlotData) -> PlotResult<String> {
+    let series = d.per_leg(&d.feet);
+    stacked_time_chart(
+        None,
+        &[("Normal forces of the feet", "normal force (N)", &series)],
+        &d.events,
+        d.t_range(),
+    )
+}
+
+/// `torques.svg`: the actuator torques of every leg, one chart per joint
+/// (θ1, θ2, θ3).
+pub fn torques_svg(d: &SpatialPlotData) -> PlotResult<String> {
+    let series: Vec<Vec<(&Trace, Style)>> = d.torques.iter().map(|t| d.per_leg(t)).collect();
+    stacked_time_chart(
+        Some("Joint torques"),
+        &[
+            (
+                "τ1 (hip, about the body's vertical axis)",
+                "torque (N·m)",
+                &series[0],
+            ),
+            ("τ2 (hip, lift)", "torque (N·m)", &series[1]),
+            ("τ3 (knee)", "torque (N·m)", &series[2]),
+        ],
+        &d.events,
+        d.t_range(),
+    )
+}
+
+/// `body.svg`: the body height and the three body angles versus time.
+pub fn body_svg(d: &SpatialPlotData) -> PlotResult<String> {
+    let style = |k: usize| Style {
+        color: PALETTE[k],
+        width: 2,
+        dashed: false,
+    };
+    let height = [(&d.height, style(0))];
+    let angles: Vec<(&Trace, Style)> = d
+        .angles
+        .iter()
+        .enumerate()
+        .map(|(k, t)| (t, style(k + 1)))
+        .collect();
+    stacked_time_chart(
+        Some("Body pose"),
+        &[
+            ("Body height Ry", "height (m)", &height),
+            ("Body angles (Rx(φx)·Rz(φz)·Ry(φy))", "angle (°)", &angles),
+        ],
+        &d.events,
+        d.t_range(),
+    )
+}
+
+/// `energy.svg`: kinetic, potential and total energy, drawn as the planar
+/// run draws it.
+pub fn energy_svg(d: &SpatialPlotData) -> PlotResult<String> {
+    plot::energy_svg(&PlotData {
+        energy: d.energy.clone(),
+        events: d.events.clone(),
+        ..PlotData::default()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn leg_colours_follow_the_hexapod_palette() {
+        assert_eq!(leg_color(1), PALETTE[0]);
+        assert_eq!(leg_color(6), PALETTE[5]);
+    }
+}

@@ -1,0 +1,346 @@
+//! The ST1/ST2/ST3 machine of [`crate::mode`] on a surface `y = ϱ(x, z)`
+//! (the 3D hexapod): the same rules, with the tangential force and the slip
+//! as vectors of the tangent plane.
+//!
+//! The contact frame at a point is `(t1, n, t2)`: `n` the unit upward
+//! normal, `t1` the unit tangent along the profile direction `u` of the
+//! [`Surface`] (for ψ = 0: `(1, ϱ′, 0)/√(1+ϱ′²)`, the planar tangent) and
+//! `t2 = t1 × n` (for ψ = 0: `+Z`). Forces are `(Ft1, N, Ft2)` in it.
+//!
+//! | state | equations (3 per point) |
+//! |---|---|
+//! | ST1 | `F = 0` |
+//! | ST2 | the point held at its anchor `a` |
+//! | ST3 | the point on the surface, `Ft = −μD·N·û` |
+//!
+//! **Slip direction û** (a unit vector of the tangent plane, in `(t1, t2)`
+//! components). On ST2 → ST3 it is opposite to the tangential force that
+//! sticking needed (`û = −Ft/|Ft|`: friction keeps the force's direction,
+//! as in the plane). While sliding, the slip over the step
+//! `s = (p[k+1] − p[k])·(t1, t2)` decides:
+//! * `s·û ≤ speed_tol·Δt` — the slide stopped or turned back: ST3 → ST2,
+//!   anchored under `p[k]` (the planar rule: the sliding velocity reverses
+//!   or vanishes);
+//! * otherwise, if the slip's direction `ŝ = s/|s|` differs from û by more
+//!   than [`DIRECTION_TOL`] (rad), the step is solved again with `û = ŝ`
+//!   (friction opposes the slip over the step: a fixed point, found by
+//!   re-solving; not an event);
+//! * a vanishing slip (`|s| ≤ speed_tol·Δt`) is the first case: û is never
+//!   taken from a slip shorter than that.
+//!
+//! With motion in the X–Y plane every vector has a zero `t2` component, û
+//! is `(±1, 0)` and each rule is the planar one: the planar engine and this
+//! machine make the same switches (the planar consistency test checks it).
+
+use crate::mode::{ContactParams, Friction, StateCode};
+use crate::surface::Surface;
+
+/// Largest angle (rad) between the slip over the step and the assumed slip
+/// direction that is accepted without re-solving: `1e-6`.
+pub const DIRECTION_TOL: f64 = 1e-6;
+
+/// The state of one contact point on a surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SpatialState {
+    /// ST1: no contact.
+    Free,
+    /// ST2: held at `anchor` (a point of the surface).
+    Stick {
+        /// The contact point (m).
+        anchor: [f64; 3],
+    },
+    /// ST3: sliding along the unit tangent-plane direction `dir`
+    /// (components along `t1`, `t2`); friction `Ft = −μD·N·dir`.
+    Slide {
+        /// Unit slip direction `(u1, u2)`.
+        dir: [f64; 2],
+    },
+}
+
+impl SpatialState {
+    /// The state's code.
+    pub fn code(&self) -> StateCode {
+        match self {
+            SpatialState::Free => StateCode::St1,
+            SpatialState::Stick { .. } => StateCode::St2,
+            SpatialState::Slide { .. } => StateCode::St3,
+        }
+    }
+
+    /// The state at `t = 0`: within `tol` of the surface it starts in ST2
+    /// at its vertical projection, above it in ST1; `Err(depth)` below.
+    pub fn initial(p: [f64; 3], surface: &Surface, tol: f64) -> Result<Self, f64> {
+        let g = clearance(surface, p);
+        if g < -tol {
+            Err(-g)
+        } else if g <= tol {
+            Ok(SpatialState::Stick {
+                anchor: project(surface, p),
+            })
+        } else {
+            Ok(SpatialState::Free)
+        }
+    }
+}
+
+/// Height of `p` above the surface, measured vertically.
+#[inline]
+pub fn clearance(surface: &Surface, p: [f64; 3]) -> f64 {
+    p[1] - surface.height(p[0], p[2])
+}
+
+/// The point of the surface vertically below (or above) `p`.
+#[inline]
+pub fn project(surface: &Surface, p: [f64; 3]) -> [f64; 3] {
+    [p[0], surface.height(p[0], p[2]), p[2]]
+}
+
+/// The contact frame `(t1, n, t2)` at `(x, z)` (see the module docs).
+pub fn frame(surface: &Surface, x: f64, z: f64) -> [[f64; 3]; 3] {
+    let n = surface.normal(x, z);
+    let [ux, uz] = surface.direction();
+    let [gx, gz] = surface.gradient(x, z);
+    // Tangent along the profile: u + (∇ϱ·u)·Y, normalised.
+    let t = [ux, gx * ux + gz * uz, uz];
+    let k = 1.0 / (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+    let t1 = [t[0] * k, t[1] * k, t[2] * k];
+    let t2 = [
+        t1[1] * n[2] - t1[2] * n[1],
+        t1[2] * n[0] - t1[0] * n[2],
+        t1[0] * n[1] - t1[1] * n[0],
+    ];
+    [t1, n, t2]
+}
+
+/// Where the straight path `p0 → p1` first crosses the surface (the planar
+/// [`crate::Terrain::crossing`] in the profile's section, which holds the
+/// whole path's height profile), on the surface.
+pub fn crossing(surface: &Surface, p0: [f64; 3], p1: [f64; 3]) -> [f64; 3] {
+    let (s0, s1) = (surface.along(p0[0], p0[2]), surface.along(p1[0], p1[2]));
+    let c = surface.terrain.crossing([s0, p0[1]], [s1, p1[1]]);
+    // Fraction of the path at the crossing (along s, or along y when the
+    // path is vertical in the section).
+    let f = if (s1 - s0).abs() > 1e-300 {
+        (c[0] - s0) / (s1 - s0)
+    } else if (p1[1] - p0[1]).abs() > 1e-300 {
+        (c[1] - p0[1]) / (p1[1] - p0[1])
+    } else {
+        0.0
+    };
+    let f = f.clamp(0.0, 1.0);
+    let x = p0[0] + f * (p1[0] - p0[0]);
+    let z = p0[2] + f * (p1[2] - p0[2]);
+    [x, surface.height(x, z), z]
+}
+
+/// A trial solution of one step seen from one contact point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpatialTrial {
+    /// The point at the start of the step (m).
+    pub p_k: [f64; 3],
+    /// The point at the end of the step (m).
+    pub p_next: [f64; 3],
+    /// Tangential force `(Ft1, Ft2)` (N).
+    pub ft: [f64; 2],
+    /// Normal force (N).
+    pub n: f64,
+    /// The frame `(t1, n, t2)` the forces are expressed in.
+    pub frame: [[f64; 3]; 3],
+    /// Time step (s).
+    pub dt: f64,
+}
+
+impl SpatialTrial {
+    /// The slip over the step in `(t1, t2)` components (m).
+    pub fn slip(&self) -> [f64; 2] {
+        let d = [
+            self.p_next[0] - self.p_k[0],
+            self.p_next[1] - self.p_k[1],
+            self.p_next[2] - self.p_k[2],
+        ];
+        let dot = |t: [f64; 3]| d[0] * t[0] + d[1] * t[1] + d[2] * t[2];
+        [dot(self.frame[0]), dot(self.frame[2])]
+    }
+}
+
+/// The switching rules (module docs; the planar [`crate::transition`]
+/// generalised). `None` when `state` is consistent with the trial.
+pub fn transition_spatial(
+    state: &SpatialState,
+    trial: &SpatialTrial,
+    surface: &Surface,
+    friction: &Friction,
+    params: &ContactParams,
+) -> Option<SpatialState> {
+    match *state {
+        SpatialState::Free => {
+            (clearance(surface, trial.p_next) < -params.penetration_tol).then(|| {
+                SpatialState::Stick {
+                    anchor: crossing(surface, trial.p_k, trial.p_next),
+                }
+            })
+        }
+        SpatialState::Stick { .. } => {
+            let ft = trial.ft[0].hypot(trial.ft[1]);
+            if trial.n < -params.force_tol {
+                Some(SpatialState::Free)
+            } else if ft > friction.mu_static * trial.n + params.force_tol {
+                Some(SpatialState::Slide {
+                    dir: [-trial.ft[0] / ft, -trial.ft[1] / ft],
+                })
+            } else {
+                None
+            }
+        }
+        SpatialState::Slide { dir } => {
+            if trial.n < -params.force_tol {
+                return Some(SpatialState::Free);
+            }
+            let s = trial.slip();
+            let along = (s[0] * dir[0] + s[1] * dir[1]) / trial.dt;
+            if along <= params.speed_tol {
+                return Some(SpatialState::Stick {
+                    anchor: project(surface, trial.p_k),
+                });
+            }
+            let len = s[0].hypot(s[1]);
+            let u = [s[0] / len, s[1] / len];
+            // Angle between u and dir (both unit, within 90°).
+            let sin = (u[0] * dir[1] - u[1] * dir[0]).abs();
+            (sin > DIRECTION_TOL).then_some(SpatialState::Slide { dir: u })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Terrain;
+
+    fn flat() -> Surface {
+        Surface::default()
+    }
+
+    fn trial(p_k: [f64; 3], p_next: [f64; 3], ft: [f64; 2], n: f64) -> SpatialTrial {
+        SpatialTrial {
+            p_k,
+            p_next,
+            ft,
+            n,
+            frame: frame(&flat(), 0.0, 0.0),
+            dt: 0.01,
+        }
+    }
+
+    fn tr(s: SpatialState, t: SpatialTrial) -> Option<SpatialState> {
+        transition_spatial(
+            &s,
+            &t,
+            &flat(),
+            &Friction::default(),
+            &ContactParams::default(),
+        )
+    }
+
+    #[test]
+    fn frame_is_orthonormal_and_planar_at_zero_direction() {
+        let s = Surface::new(
+            Terrain::Slope {
+                slope: 0.3,
+                height: 0.1,
+            },
+            0.0,
+        );
+        let [t1, n, t2] = frame(&s, 0.4, -0.2);
+        let (pt, pn) = s.terrain.frame(0.4);
+        assert!((t1[0] - pt[0]).abs() < 1e-15 && (t1[1] - pt[1]).abs() < 1e-15 && t1[2] == 0.0);
+        assert!((n[0] - pn[0]).abs() < 1e-15 && (n[1] - pn[1]).abs() < 1e-15);
+        assert!((t2[2] - 1.0).abs() < 1e-15);
+        let s = Surface::new(
+            Terrain::Slope {
+                slope: 0.3,
+                height: 0.1,
+            },
+            0.7,
+        );
+        let f = frame(&s, 0.4, -0.2);
+        for i in 0..3 {
+            for j in 0..3 {
+                let d: f64 = (0..3).map(|k| f[i][k] * f[j][k]).sum();
+                assert!((d - f64::from(u8::from(i == j))).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn touchdown_at_the_crossing_in_3d() {
+        let s = tr(
+            SpatialState::Free,
+            trial([0.0, 0.01, 0.0], [0.02, -0.01, 0.04], [0.0; 2], 0.0),
+        );
+        let Some(SpatialState::Stick { anchor }) = s else {
+            panic!("{s:?}")
+        };
+        assert!((anchor[0] - 0.01).abs() < 1e-12 && (anchor[2] - 0.02).abs() < 1e-12);
+        assert_eq!(anchor[1], 0.0);
+    }
+
+    #[test]
+    fn cone_breaks_in_the_direction_of_the_needed_force() {
+        let st = SpatialState::Stick { anchor: [0.0; 3] };
+        // |Ft| = 5 > 0.4·10: slides against (3, 4)/5.
+        assert_eq!(
+            tr(st, trial([0.0; 3], [0.0; 3], [3.0, 4.0], 10.0)),
+            Some(SpatialState::Slide { dir: [-0.6, -0.8] })
+        );
+        assert_eq!(tr(st, trial([0.0; 3], [0.0; 3], [2.0, 3.4], 10.0)), None);
+        assert_eq!(
+            tr(st, trial([0.0; 3], [0.0; 3], [0.0, 0.0], -1.0)),
+            Some(SpatialState::Free)
+        );
+    }
+
+    #[test]
+    fn slide_turns_stops_and_reverses() {
+        let sl = SpatialState::Slide { dir: [1.0, 0.0] };
+        assert_eq!(
+            tr(sl, trial([0.0; 3], [0.001, 0.0, 0.0], [-3.0, 0.0], 10.0)),
+            None
+        );
+        // Turned: re-solved along the slip.
+        let s = tr(sl, trial([0.0; 3], [0.001, 0.0, 0.001], [-3.0, 0.0], 10.0));
+        let h = 0.5f64.sqrt();
+        assert!(
+            matches!(s, Some(SpatialState::Slide { dir }) if (dir[0] - h).abs() < 1e-12 && (dir[1] - h).abs() < 1e-12)
+        );
+        // Backwards: sticks under p[k].
+        assert_eq!(
+            tr(
+                sl,
+                trial([0.2, 0.0, 0.1], [0.199, 0.0, 0.1], [-3.0, 0.0], 10.0)
+            ),
+            Some(SpatialState::Stick {
+                anchor: [0.2, 0.0, 0.1]
+            })
+        );
+    }
+
+    #[test]
+    fn initial_states() {
+        let g = flat();
+        assert_eq!(
+            SpatialState::initial([0.0, 0.5, 0.0], &g, 1e-9),
+            Ok(SpatialState::Free)
+        );
+        assert_eq!(
+            SpatialState::initial([0.3, 5e-10, 0.2], &g, 1e-9),
+            Ok(SpatialState::Stick {
+                anchor: [0.3, 0.0, 0.2]
+            })
+        );
+        assert_eq!(
+            SpatialState::initial([0.0, -0.01, 0.0], &g, 1e-9),
+            Err(0.01)
+        );
+    }
+}

@@ -1,0 +1,183 @@
+//! The analytic Jacobian of the spatial (3D) FBD residual against central
+//! differences, through the shared checker: six legs, generic (tumbling,
+//! tilted) configurations, every contact state (free, sticking, sliding in
+//! a generic direction) on flat and tilted, rotated terrain, joint limits
+//! free and at a stop, at the first step (history from the initial
+//! velocities) and at a later one. The pattern declared by `pattern`
+//! covers every entry written.
+
+use fbd_contact::spatial::frame;
+use fbd_contact::{SpatialState, Surface, Terrain};
+use fbd_dynamics::mechanism::ContactPoints;
+use fbd_dynamics::spatial::{
+    SpatialContactEquation, SpatialFbdData, SpatialInertia, SpatialMechanism, eval, pattern,
+    prepare_step, set_configuration, set_previous,
+};
+use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
+use fbd_kinematics::fd::{FdTolerance, check_jacobian};
+use fbd_kinematics::hexapod::HexapodModel;
+use fbd_kinematics::nalgebra::Matrix3;
+use fbd_kinematics::{JointLimits, LimitSide};
+
+struct Dense<'a> {
+    n: usize,
+    m: &'a mut [f64],
+}
+impl JacobianSink for Dense<'_> {
+    const ACTIVE: bool = true;
+    fn add(&mut self, r: usize, c: usize, v: f64) {
+        self.m[r * self.n + c] += v;
+    }
+}
+
+fn mechanism(legs: &[usize]) -> SpatialMechanism {
+    let inertia = SpatialInertia {
+        body_mass: 10.0,
+        body_inertia: Matrix3::new(0.2, 0.01, -0.02, 0.01, 0.39, 0.015, -0.02, 0.015, 0.21),
+        upper_mass: 0.3,
+        upper_axial: 6e-5,
+        upper_transverse: 1.0e-3,
+        lower_mass: 1.1,
+        lower_axial: 1.2e-4,
+        lower_transverse: 1.6e-2,
+    };
+    let all = ContactPoints {
+        tips: true,
+        knees: true,
+        hips: true,
+    };
+    SpatialMechanism::new(
+        HexapodModel::default(),
+        legs,
+        &inertia,
+        9.81,
+        all,
+        &JointLimits::default(),
+    )
+}
+
+/// A generic configuration: tilted, turned body; every leg different.
+fn q_at(mech: &SpatialMechanism, shift: f64) -> Vec<f64> {
+    let nq = mech.layout().nq;
+    let mut q = vec![0.0; nq];
+    q[..6].copy_from_slice(&[0.1, 0.45, -0.05, 0.2, -0.4, 0.3]);
+    for s in 0..mech.legs.len() {
+        let f = s as f64;
+        q[6 + 3 * s] = 0.1 * f - 0.2;
+        q[7 + 3 * s] = -0.3 + 0.1 * f;
+        q[8 + 3 * s] = 4.2 + 0.05 * f;
+    }
+    for (i, v) in q.iter_mut().enumerate() {
+        *v += shift * (1.0 + 0.1 * i as f64) * if i % 2 == 0 { 1.0 } else { -0.7 };
+    }
+    q
+}
+
+fn check(surface: &Surface, first_step: bool, limits_at: bool) {
+    let mech = mechanism(&[1, 2, 3, 4, 5, 6]);
+    let lay = mech.layout();
+    let n = lay.dim();
+    let mut data = SpatialFbdData::new(&mech);
+    let q_prev = q_at(&mech, -0.004);
+    let q_k = q_at(&mech, 0.0);
+    set_previous(&mech, &mut data, &q_prev);
+    set_configuration(&mech, &mut data, &q_k);
+    let qdot: Vec<f64> = (0..lay.nq).map(|i| 0.3 - 0.05 * i as f64).collect();
+    let history = if first_step {
+        History::Initial { qdot: &qdot }
+    } else {
+        History::Previous
+    };
+    prepare_step(&mech, &mut data, history, 0.002);
+    for (s, t) in data.torque.iter_mut().enumerate() {
+        *t = [1.0 + s as f64, -2.0, 0.5];
+    }
+    for (c, eq) in data.contact.iter_mut().enumerate() {
+        let state = match c % 4 {
+            0 => SpatialState::Free,
+            1 => SpatialState::Stick {
+                anchor: [0.1 * c as f64, 0.01, -0.2],
+            },
+            2 => SpatialState::Slide { dir: [0.6, -0.8] },
+            _ => SpatialState::Slide { dir: [-1.0, 0.0] },
+        };
+        *eq = SpatialContactEquation {
+            state,
+            frame: frame(surface, 0.05 * c as f64, -0.1),
+            mu_dynamic: 0.3,
+            regularization: 1e-3,
+        };
+    }
+    if limits_at {
+        for (l, eq) in data.limit.iter_mut().enumerate() {
+            if l % 2 == 0 {
+                *eq = LimitEquation {
+                    state: LimitState::At {
+                        side: LimitSide::Lower,
+                        angle: 0.1,
+                    },
+                    regularization: 1e-3,
+                };
+            }
+        }
+    }
+    // A generic iterate.
+    let mut z: Vec<f64> = (0..n).map(|i| 3.0 * ((i as f64) * 0.37).sin()).collect();
+    z[..lay.nq].copy_from_slice(&q_at(&mech, 0.003));
+    let mut r = vec![0.0; n];
+    let mut jac = vec![0.0; n * n];
+    eval(&mech, surface, &mut data, &z, &mut r, &mut Dense { n, m: &mut jac });
+    // The declared pattern covers every non-zero entry.
+    let mut entries = Vec::new();
+    pattern(&mech, &data, &mut entries);
+    let mut declared = vec![false; n * n];
+    for (i, j) in entries {
+        declared[i * n + j] = true;
+    }
+    for i in 0..n {
+        for j in 0..n {
+            assert!(
+                declared[i * n + j] || jac[i * n + j] == 0.0,
+                "entry ({i}, {j}) = {} is not in the pattern",
+                jac[i * n + j]
+            );
+        }
+    }
+    let mut work = data.clone();
+    check_jacobian(
+        &z,
+        n,
+        |x, out| eval(&mech, surface, &mut work, x, out, &mut NoJacobian),
+        |i, j| jac[i * n + j],
+        FdTolerance {
+            step: 1e-6,
+            rel: 1e-6,
+            // Contact rows hold K·p with K = M/Δt² ≈ 3.5e6 N/m: their
+            // central differences carry K·ε·|p|/h ≈ 1e-3 of round-off.
+            abs: 2e-3,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn jacobian_on_flat_ground_later_step() {
+    check(&Surface::default(), false, false);
+}
+
+#[test]
+fn jacobian_at_the_first_step_with_limits_at_stops() {
+    check(&Surface::default(), true, true);
+}
+
+#[test]
+fn jacobian_on_a_rotated_slope() {
+    let s = Surface::new(
+        Terrain::Slope {
+            slope: 0.2,
+            height: 0.05,
+        },
+        0.6,
+    );
+    check(&s, false, true);
+}

@@ -1,0 +1,104 @@
+//! Stage 2 of a spatial step: the joint torques `τ = kp·(θ* − θ[k]) +
+//! kd·(θ̇* − θ̇[k])` of every joint, explicit in the state of step `k`
+//! (`θ̇[k] = (θ[k] − θ[k−1])/Δt`, the initial rates at k = 0), clamped to
+//! `±torque_limit`. Targets: fixed angles (`pd`, `θ̇* = 0`), a
+//! piecewise-linear trajectory (`trajectory`, `θ̇*` its slope) or the
+//! kinematic gait generator's angles and rates at step `k` (`gait`). A
+//! positive torque drives its joint angle towards larger values.
+
+use super::data::SpatialData;
+use super::model::SpatialModel;
+use super::params::SpatialControl;
+use crate::SimError;
+use fbd_dynamics::spatial::q_joint;
+
+/// The joint rates `θ̇[k]` of slot `s` (backward difference).
+pub fn joint_rates(model: &SpatialModel, data: &SpatialData, s: usize) -> [f64; 3] {
+    std::array::from_fn(|j| {
+        let i = q_joint(s, j);
+        if data.k == 0 {
+            model.params.qdot0[i]
+        } else {
+            (data.q[i] - data.q_prev[i]) / model.dt()
+        }
+    })
+}
+
+/// Fills `data.fbd.torque` for step `data.k`. No allocation.
+///
+/// # Errors
+/// [`SimError::Control`] when the gait generator cannot place a foot.
+pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimError> {
+    if let Some(tau) = &data.external_torque {
+        assert_eq!(
+            tau.len(),
+            data.fbd.torque.len(),
+            "one torque triple per leg"
+        );
+        data.fbd.torque.copy_from_slice(tau);
+        return Ok(());
+    }
+    let dt = model.dt();
+    let t = data.k as f64 * dt;
+    let (kp, kd, limit) = match &model.params.control {
+        SpatialControl::None => {
+            data.fbd.torque.fill([0.0; 3]);
+            return Ok(());
+        }
+        SpatialControl::Pd {
+            kp,
+            kd,
+            torque_limit,
+            ..
+        }
+        | SpatialControl::Trajectory {
+            kp,
+            kd,
+            torque_limit,
+            ..
+        }
+        | SpatialControl::Gait {
+            kp,
+            kd,
+            torque_limit,
+            ..
+        } => (*kp, *kd, *torque_limit),
+    };
+    if let (SpatialControl::Gait { gait, .. }, Some(g)) = (&model.params.control, &mut data.gait) {
+        let k = data.k.min(gait.steps);
+        crate::gait::step(gait, g, k).map_err(|e| SimError::Control {
+            step: data.k,
+            t,
+            message: e.to_string(),
+        })?;
+    }
+    for s in 0..model.mech.legs.len() {
+        let rate = joint_rates(model, data, s);
+        let (target, target_rate) = match &model.params.control {
+            SpatialControl::Pd { target, .. } => (target[s], [0.0; 3]),
+            SpatialControl::Trajectory { legs, .. } => {
+                let h = 1e-6;
+                let (a, b) = (legs[s].at(t - h), legs[s].at(t + h));
+                (
+                    legs[s].at(t),
+                    std::array::from_fn(|j| (b[j] - a[j]) / (2.0 * h)),
+                )
+            }
+            SpatialControl::Gait { .. } => {
+                let g = data.gait.as_ref().expect("gait workspace");
+                let leg = &g.legs[model.mech.legs[s] - 1];
+                (leg.theta, leg.rate)
+            }
+            SpatialControl::None => unreachable!("handled above"),
+        };
+        for j in 0..3 {
+            let theta = data.q[q_joint(s, j)];
+            let mut tau = kp * (target[j] - theta) + kd * (target_rate[j] - rate[j]);
+            if let Some(l) = limit {
+                tau = tau.clamp(-l, l);
+            }
+            data.fbd.torque[s][j] = tau;
+        }
+    }
+    Ok(())
+}

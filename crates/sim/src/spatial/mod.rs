@@ -1,0 +1,27 @@
+//! The 3D (spatial) FBD dynamics of the 24-DOF hexapod: 13 rigid bodies
+//! (the central body, and per leg the upper and the lower link), each with
+//! its six Newton–Euler equations in the inertial frame, every joint
+//! reaction and contact force an explicit unknown; see
+//! `fbd_dynamics::spatial` for the equations and the rotation scheme.
+//!
+//! * [`SpatialParams`] → [`SpatialModel`] (immutable) and [`SpatialData`]
+//!   (the workspace);
+//! * [`step()`] — one staged step (kinematics at k → torques → predictor →
+//!   solve → contact and limit check → accept);
+//! * [`run_until`] / [`run_collect`] — the loop, one [`SpatialRecord`] per
+//!   written step, and a [`crate::RunSummary`].
+
+pub mod control;
+mod data;
+mod model;
+pub mod params;
+pub mod record;
+mod run;
+pub mod step;
+
+pub use data::SpatialData;
+pub use model::SpatialModel;
+pub use params::{LegTrajectory3, SpatialControl, SpatialParams, default_q0, hexagon_inertia};
+pub use record::{ContactRow, LegRow, SpatialRecord};
+pub use run::{run_collect, run_until};
+pub use step::step;

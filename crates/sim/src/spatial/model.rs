@@ -1,0 +1,328 @@
+//! The immutable spatial model, validated from [`SpatialParams`].
+
+use super::params::{SpatialControl, SpatialParams};
+use crate::SimError;
+use crate::record::LimitCode;
+use fbd_contact::SpatialState;
+use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism};
+use fbd_dynamics::{LimitState, PointKind};
+use fbd_kinematics::hexapod::HexapodModel;
+use fbd_kinematics::leg::LegGeometry;
+use fbd_kinematics::nalgebra::{Matrix3, Vector3};
+use fbd_solver::NewtonParams;
+
+/// Everything fixed during a spatial run.
+#[derive(Clone, Debug)]
+pub struct SpatialModel {
+    /// The parameters it was built from.
+    pub params: SpatialParams,
+    /// Bodies, joints, contact points and limits.
+    pub mech: SpatialMechanism,
+    /// Newton tolerances.
+    pub newton: NewtonParams,
+    /// Steps to solve: `round(duration/dt) + 1`.
+    pub steps: usize,
+    /// Regularisation added to each contact point's position rows: 0 for
+    /// the feet, the bumper's for knees and hips (as in the planar model).
+    pub contact_bumper: Vec<f64>,
+    /// Contact state of each point at `t = 0`.
+    pub initial_states: Vec<SpatialState>,
+    /// Finest subdivision of a step that cannot be solved whole. Default 64.
+    pub max_substeps: usize,
+    /// A cycling state search is closed by its least inconsistent trial
+    /// when its violation is at most this force (N). Default `1e-7 ×`
+    /// weight.
+    pub cycle_tolerance: f64,
+}
+
+fn check(
+    ok: bool,
+    key: &str,
+    what: &str,
+    got: impl std::fmt::Display,
+    expected: &str,
+) -> Result<(), SimError> {
+    if ok {
+        Ok(())
+    } else {
+        Err(SimError::InvalidParameter {
+            key: key.into(),
+            what: what.into(),
+            got: got.to_string(),
+            expected: expected.into(),
+        })
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<(), SimError> {
+    check(
+        v.is_finite() && v > 0.0,
+        key,
+        "must be positive and finite",
+        v,
+        "a finite value > 0",
+    )
+}
+
+/// The body's inertia tensor from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`.
+pub fn inertia_matrix(i: &[f64; 6]) -> Matrix3<f64> {
+    Matrix3::new(i[0], i[3], i[4], i[3], i[1], i[5], i[4], i[5], i[2])
+}
+
+impl SpatialParams {
+    /// Checks every parameter's domain (the one source of these rules; the
+    /// configuration loader calls it). Errors name the configuration key.
+    pub fn validate(&self) -> Result<(), SimError> {
+        let p = self;
+        positive("time.dt", p.dt)?;
+        check(
+            p.duration.is_finite() && p.duration >= 0.0,
+            "time.duration",
+            "must be finite and not negative",
+            p.duration,
+            "a finite value ≥ 0",
+        )?;
+        check(
+            p.gravity.is_finite() && p.gravity >= 0.0,
+            "world.gravity",
+            "is a magnitude (gravity acts along −Y)",
+            p.gravity,
+            "a finite value ≥ 0",
+        )?;
+        for (key, v) in [
+            ("body.mass", p.body_mass),
+            ("body.side", p.side),
+            ("leg.upper_length", p.upper_length),
+            ("leg.upper_mass", p.upper_mass),
+            ("leg.upper_radius", p.upper_radius),
+            ("leg.upper_inertia", p.upper_inertia),
+            ("leg.lower_length", p.lower_length),
+            ("leg.lower_mass", p.lower_mass),
+            ("leg.lower_radius", p.lower_radius),
+            ("leg.lower_inertia", p.lower_inertia),
+        ] {
+            positive(key, v)?;
+        }
+        for (key, v) in [
+            ("leg.upper_com", p.upper_com),
+            ("leg.lower_com", p.lower_com),
+        ] {
+            check(
+                (0.0..=1.0).contains(&v),
+                key,
+                "is a fraction of the link",
+                v,
+                "0 ≤ value ≤ 1",
+            )?;
+        }
+        let m = inertia_matrix(&p.body_inertia);
+        let eig = m.symmetric_eigenvalues();
+        let (e0, e1, e2) = (eig[0], eig[1], eig[2]);
+        let triangle = e0 + e1 >= e2 * (1.0 - 1e-12)
+            && e1 + e2 >= e0 * (1.0 - 1e-12)
+            && e0 + e2 >= e1 * (1.0 - 1e-12);
+        check(
+            p.body_inertia.iter().all(|v| v.is_finite()) && eig.min() > 0.0 && triangle,
+            "body.inertia",
+            "must be a physical inertia tensor (positive definite, principal moments obeying the triangle inequality)",
+            format!("{:?}", p.body_inertia),
+            "e.g. [Ixx, Iyy, Izz] > 0 with Ixx + Iyy ≥ Izz",
+        )?;
+        check(
+            !p.legs.is_empty()
+                && p.legs.windows(2).all(|w| w[0] < w[1])
+                && p.legs.iter().all(|l| (1..=6).contains(l)),
+            "legs",
+            "must be increasing leg numbers 1–6 without repeats",
+            format!("{:?}", p.legs),
+            "e.g. [1, 2, 3, 4, 5, 6] or [3, 4]",
+        )?;
+        let nq = 6 + 3 * p.legs.len();
+        assert_eq!(p.q0.len(), nq, "q0 has the wrong length for the legs");
+        assert_eq!(p.qdot0.len(), nq, "qdot0 has the wrong length for the legs");
+        check(
+            p.q0.iter().chain(&p.qdot0).all(|v| v.is_finite()),
+            "initial",
+            "must be finite",
+            "a non-finite value",
+            "finite numbers",
+        )?;
+        check(
+            p.q0[5].cos().abs() > 1e-6,
+            "initial.phi_deg",
+            "φz = ±90° is the singularity of the body angles (rotation sequence Y, Z, X)",
+            format!("{}°", p.q0[5].to_degrees()),
+            "|φz| away from 90°",
+        )?;
+        p.friction
+            .validate()
+            .map_err(|e| SimError::InvalidParameter {
+                key: "terrain.mu_dynamic".into(),
+                what: e.to_string(),
+                got: format!(
+                    "μS = {}, μD = {}",
+                    p.friction.mu_static, p.friction.mu_dynamic
+                ),
+                expected: "0 ≤ μD ≤ μS".into(),
+            })?;
+        check(
+            p.joint_limits.is_valid(),
+            "leg.theta1_deg",
+            "joint limits must be ranges [min, max] with min < max",
+            format!("{:?}", p.joint_limits),
+            "min < max",
+        )?;
+        check(
+            p.stride >= 1,
+            "output.stride",
+            "must be at least 1",
+            p.stride,
+            "≥ 1",
+        )?;
+        let (kp, kd, limit, nlegs) = match &p.control {
+            SpatialControl::None => return Ok(()),
+            SpatialControl::Pd {
+                kp,
+                kd,
+                torque_limit,
+                target,
+            } => (*kp, *kd, *torque_limit, target.len()),
+            SpatialControl::Trajectory {
+                kp,
+                kd,
+                torque_limit,
+                legs,
+            } => (*kp, *kd, *torque_limit, legs.len()),
+            SpatialControl::Gait {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            } => (*kp, *kd, *torque_limit, p.legs.len()),
+        };
+        assert_eq!(nlegs, p.legs.len(), "one control entry per leg");
+        for (key, v) in [("control.kp", kp), ("control.kd", kd)] {
+            check(
+                v.is_finite() && v >= 0.0,
+                key,
+                "must be finite and not negative",
+                v,
+                "a finite value ≥ 0",
+            )?;
+        }
+        if let Some(l) = limit {
+            positive("control.torque_limit", l)?;
+        }
+        Ok(())
+    }
+}
+
+impl SpatialModel {
+    /// Validates `params` and builds the model.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidParameter`] naming the configuration key,
+    /// [`SimError::InitialPenetration`] for a point starting below ground.
+    pub fn new(params: &SpatialParams) -> Result<Self, SimError> {
+        let p = params;
+        p.validate()?;
+        let geometry = HexapodModel::new(
+            p.side,
+            LegGeometry {
+                a: p.upper_length,
+                c: p.lower_length,
+            },
+            p.upper_com,
+            p.lower_com,
+        );
+        let inertia = SpatialInertia {
+            body_mass: p.body_mass,
+            body_inertia: inertia_matrix(&p.body_inertia),
+            upper_mass: p.upper_mass,
+            upper_axial: 0.5 * p.upper_mass * p.upper_radius * p.upper_radius,
+            upper_transverse: p.upper_inertia,
+            lower_mass: p.lower_mass,
+            lower_axial: 0.5 * p.lower_mass * p.lower_radius * p.lower_radius,
+            lower_transverse: p.lower_inertia,
+        };
+        let mech = SpatialMechanism::new(
+            geometry,
+            &p.legs,
+            &inertia,
+            p.gravity,
+            p.contact_points,
+            &p.joint_limits,
+        );
+        for lim in &mech.limits {
+            if let Err(e) = p.joint_limits.check(lim.joint, p.q0[lim.q_index]) {
+                check(
+                    false,
+                    &format!("initial.leg{}.theta_deg", mech.legs[lim.slot]),
+                    "outside the joint limits",
+                    e,
+                    &format!("angles inside [leg] {}_deg", lim.joint.name()),
+                )?;
+            }
+        }
+        let contact = p.contact;
+        let contact_bumper = mech
+            .contacts
+            .iter()
+            .map(|c| match c.kind {
+                PointKind::Tip => 0.0,
+                PointKind::Knee | PointKind::Hip => contact.bumper_regularization,
+            })
+            .collect();
+        let mut kin = SpatialKin::new(&mech);
+        kin.eval(&mech, &p.q0);
+        let mut initial_states = Vec::with_capacity(mech.contacts.len());
+        for c in &mech.contacts {
+            let pt = kin.point(&mech, c.point / 3, c.kind);
+            let state = SpatialState::initial([pt.x, pt.y, pt.z], &p.terrain, contact.initial_tol)
+                .map_err(|depth| SimError::InitialPenetration {
+                    leg: format!("leg{}", c.leg),
+                    point: c.name.clone(),
+                    depth,
+                })?;
+            initial_states.push(state);
+        }
+        let total_mass = mech.total_mass();
+        Ok(Self {
+            params: p.clone(),
+            steps: (p.duration / p.dt).round() as usize + 1,
+            newton: NewtonParams {
+                chord_steps: 6,
+                ..NewtonParams::default()
+            },
+            contact_bumper,
+            initial_states,
+            max_substeps: 64,
+            cycle_tolerance: 1e-7 * total_mass * p.gravity.abs().max(1.0),
+            mech,
+        })
+    }
+
+    /// Time step (s).
+    pub fn dt(&self) -> f64 {
+        self.params.dt
+    }
+
+    /// Generalised coordinates.
+    pub fn nq(&self) -> usize {
+        self.mech.layout().nq
+    }
+
+    /// Gravity vector (m/s²).
+    pub fn gravity(&self) -> Vector3<f64> {
+        Vector3::new(0.0, -self.params.gravity, 0.0)
+    }
+}
+
+/// The limit code of a limit state.
+pub(crate) fn limit_code(s: &LimitState) -> LimitCode {
+    match s.key() {
+        0 => LimitCode::Free,
+        1 => LimitCode::Min,
+        _ => LimitCode::Max,
+    }
+}

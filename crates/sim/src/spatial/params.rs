@@ -1,0 +1,209 @@
+//! Physical and numerical parameters of a 3D (spatial) hexapod run, in SI
+//! units and radians. `fbd-scenario` fills them from a TOML configuration
+//! (degrees there).
+
+use crate::gait::GaitModel;
+use fbd_contact::{ContactParams, Friction, Surface};
+use fbd_dynamics::mechanism::ContactPoints;
+use fbd_kinematics::JointLimits;
+
+/// A joint-space target trajectory of one leg: `(θ1, θ2, θ3)` (rad) at
+/// `times` (s), linear in between, held before the first and after the last.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LegTrajectory3 {
+    /// Strictly increasing times (s), at least one.
+    pub times: Vec<f64>,
+    /// `(θ1, θ2, θ3)` (rad) at each time.
+    pub targets: Vec<[f64; 3]>,
+}
+
+impl LegTrajectory3 {
+    /// The target at time `t`.
+    pub fn at(&self, t: f64) -> [f64; 3] {
+        let (ts, xs) = (&self.times, &self.targets);
+        let n = ts.len().min(xs.len());
+        if n == 0 {
+            return [0.0; 3];
+        }
+        if t <= ts[0] {
+            return xs[0];
+        }
+        if t >= ts[n - 1] {
+            return xs[n - 1];
+        }
+        let i = ts[..n].partition_point(|&s| s <= t) - 1;
+        let u = (t - ts[i]) / (ts[i + 1] - ts[i]);
+        std::array::from_fn(|j| xs[i][j] + u * (xs[i + 1][j] - xs[i][j]))
+    }
+}
+
+/// The joint controller of a spatial run: torques at step `k` computed
+/// explicitly from `q[k]` and `q[k−1]`, `τ = kp·(θ* − θ) + kd·(θ̇* − θ̇)`,
+/// clamped to `±torque_limit`.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum SpatialControl {
+    /// Passive joints: no torque.
+    #[default]
+    None,
+    /// PD regulation to fixed joint angles (`θ̇* = 0`).
+    Pd {
+        /// Stiffness (N·m/rad), ≥ 0.
+        kp: f64,
+        /// Damping (N·m·s/rad), ≥ 0.
+        kd: f64,
+        /// Saturation `|τ| ≤ limit` (N·m), > 0; `None` for no limit.
+        torque_limit: Option<f64>,
+        /// `(θ1, θ2, θ3)` targets (rad), one per leg of the model, in the
+        /// order of [`SpatialParams::legs`].
+        target: Vec<[f64; 3]>,
+    },
+    /// PD tracking of a piecewise-linear joint trajectory per leg
+    /// (`θ̇*` = the trajectory's slope).
+    Trajectory {
+        /// Stiffness (N·m/rad), ≥ 0.
+        kp: f64,
+        /// Damping (N·m·s/rad), ≥ 0.
+        kd: f64,
+        /// Saturation `|τ| ≤ limit` (N·m), > 0; `None` for no limit.
+        torque_limit: Option<f64>,
+        /// One trajectory per leg of the model, order of
+        /// [`SpatialParams::legs`].
+        legs: Vec<LegTrajectory3>,
+    },
+    /// Tracking of the kinematic gait generator's joint angles and rates
+    /// (feed-forward rates + PD): `θ*`, `θ̇*` of step `k` of `gait`.
+    Gait {
+        /// Stiffness (N·m/rad), ≥ 0.
+        kp: f64,
+        /// Damping (N·m·s/rad), ≥ 0.
+        kd: f64,
+        /// Saturation `|τ| ≤ limit` (N·m), > 0; `None` for no limit.
+        torque_limit: Option<f64>,
+        /// The kinematic gait (same Δt and duration as the run; all six
+        /// legs).
+        gait: Box<GaitModel>,
+    },
+}
+
+/// Everything that defines a spatial (3D) simulation of the hexapod.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SpatialParams {
+    /// Time step Δt (s). Default 0.001.
+    pub dt: f64,
+    /// Simulated duration (s); `round(duration/dt) + 1` rows. Default 1.0.
+    pub duration: f64,
+    /// Gravitational acceleration (m/s², along −Y). Default 9.81.
+    pub gravity: f64,
+    /// Central body mass (kg). Default 10.0.
+    pub body_mass: f64,
+    /// Central body inertia tensor about its centre of mass in the body
+    /// frame, `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]` (kg·m²). Default: a thin
+    /// uniform hexagonal plate of side `L` in the body's x–z plane,
+    /// `Ixx = Izz = 5/16·m·L²`, `Iyy = 5/8·m·L²` (0.195, 0.391, 0.195).
+    pub body_inertia: [f64; 6],
+    /// Side `L` of the hexagonal body (m). Default 0.25.
+    pub side: f64,
+    /// Upper link length `a` (m). Default 0.2.
+    pub upper_length: f64,
+    /// Upper link mass (kg). Default 0.3.
+    pub upper_mass: f64,
+    /// Upper link radius (m): inertia about the link's own axis
+    /// `m·r²/2`. Default 0.02.
+    pub upper_radius: f64,
+    /// Upper link inertia about an axis through its centre of mass
+    /// perpendicular to the link (kg·m²). Default: the solid cylinder
+    /// `m·(3r² + a²)/12`.
+    pub upper_inertia: f64,
+    /// Upper link centre of mass, fraction of `a` from the hip. Default 0.5.
+    pub upper_com: f64,
+    /// Lower link length `c` (m). Default 0.42.
+    pub lower_length: f64,
+    /// Lower link mass (kg). Default 1.1.
+    pub lower_mass: f64,
+    /// Lower link radius (m). Default 0.015.
+    pub lower_radius: f64,
+    /// Lower link transverse inertia about its centre of mass (kg·m²).
+    /// Default: the solid cylinder `m·(3r² + c²)/12`.
+    pub lower_inertia: f64,
+    /// Lower link centre of mass, fraction of `c` from the knee. Default 0.75.
+    pub lower_com: f64,
+    /// Leg numbers (1–6) that the model has, increasing. Default all six;
+    /// `[3, 4]` is the planar model's pair.
+    pub legs: Vec<usize>,
+    /// Joint limits of θ1, θ2, θ3 (one-sided stops). Default
+    /// [`JointLimits::default`].
+    pub joint_limits: JointLimits,
+    /// Initial generalised coordinates (m, rad):
+    /// `(Rx, Ry, Rz, φx, φy, φz, θ1, θ2, θ3 of each leg in `legs`)`.
+    pub q0: Vec<f64>,
+    /// Initial generalised velocities (m/s, rad/s), same layout; the body's
+    /// angular velocity enters as `φ̇ = E(φ)⁻¹·ω`.
+    pub qdot0: Vec<f64>,
+    /// Terrain surface `y = ϱ(x, z)`. Default flat ground at y = 0.
+    pub terrain: Surface,
+    /// Soil friction. Default μS = 0.4, μD = 0.3.
+    pub friction: Friction,
+    /// Which points of each leg can touch the terrain. Default tips, knees
+    /// and hips.
+    pub contact_points: ContactPoints,
+    /// Switching tolerances and regularisation of the contact rows.
+    pub contact: ContactParams,
+    /// Joint controller. Default passive.
+    pub control: SpatialControl,
+    /// Write every `stride`-th step. Default 1.
+    pub stride: usize,
+}
+
+/// `[Ixx, Iyy, Izz]` of a thin uniform hexagonal plate of side `side` and
+/// mass `m` lying in the body's x–z plane.
+pub fn hexagon_inertia(m: f64, side: f64) -> [f64; 6] {
+    let i = 5.0 / 16.0 * m * side * side;
+    [i, 2.0 * i, i, 0.0, 0.0, 0.0]
+}
+
+impl Default for SpatialParams {
+    fn default() -> Self {
+        let (upper_mass, upper_radius, upper_length) = (0.3, 0.02, 0.2);
+        let (lower_mass, lower_radius, lower_length) = (1.1, 0.015, 0.42);
+        let cyl = |m: f64, r: f64, l: f64| m * (3.0 * r * r + l * l) / 12.0;
+        Self {
+            dt: 0.001,
+            duration: 1.0,
+            gravity: 9.81,
+            body_mass: 10.0,
+            body_inertia: hexagon_inertia(10.0, 0.25),
+            side: 0.25,
+            upper_length,
+            upper_mass,
+            upper_radius,
+            upper_inertia: cyl(upper_mass, upper_radius, upper_length),
+            upper_com: 0.5,
+            lower_length,
+            lower_mass,
+            lower_radius,
+            lower_inertia: cyl(lower_mass, lower_radius, lower_length),
+            lower_com: 0.75,
+            legs: (1..=6).collect(),
+            joint_limits: JointLimits::default(),
+            q0: default_q0(),
+            qdot0: vec![0.0; 24],
+            terrain: Surface::default(),
+            friction: Friction::default(),
+            contact_points: ContactPoints::default(),
+            contact: ContactParams::default(),
+            control: SpatialControl::None,
+            stride: 1,
+        }
+    }
+}
+
+/// The default initial state: body 0.6 m up, level; every leg
+/// `(θ1, θ2, θ3) = (0°, 0°, 250°)`.
+pub fn default_q0() -> Vec<f64> {
+    let mut q = vec![0.0; 24];
+    q[1] = 0.6;
+    for leg in 0..6 {
+        q[6 + 3 * leg + 2] = 250f64.to_radians();
+    }
+    q
+}

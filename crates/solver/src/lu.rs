@@ -1,0 +1,335 @@
+//! The sparse LU of one Jacobian pattern: its CSC structure, faer's
+//! symbolic analysis (COLAMD column ordering), faer's simplicial numeric LU
+//! with partial pivoting, and the triangular solves with those factors.
+//!
+//! # Why faer's simplicial LU, called directly
+//!
+//! * The symbolic analysis is forced to the *simplicial* LU
+//!   ([`SupernodalThreshold::FORCE_SIMPLICIAL`]). faer 0.24.4's supernodal
+//!   numeric LU allocates fresh per-supernode work vectors on every call
+//!   (`contrib_work` in `factorize_supernodal_numeric_lu`), so it could
+//!   never be allocation-free; on the 20–60 unknown, very sparse systems of
+//!   this project the simplicial (left-looking, Gilbert–Peierls) LU is also
+//!   the faster one (`cargo bench -p fbd-suite --bench factorization`).
+//! * The numeric LU is faer's
+//!   [`simplicial::factorize_simplicial_numeric_lu`], called on a
+//!   [`SimplicialLu`] owned here, so that its `L` and `U` factors are at
+//!   hand. The Newton step `J Δx = −r` is solved with them by the plain
+//!   loops of [`Pattern::solve`] (row permutation, unit-lower and upper
+//!   column sweeps with the reciprocal pivots computed once per
+//!   factorisation, column permutation): the same arithmetic as faer's
+//!   `solve_in_place_with_conj`, without its generic multi-column
+//!   machinery, which cost about six times as much on these sizes — it
+//!   matters because a chord step (a step with a kept factorisation) is
+//!   one residual and one solve.
+//! * faer's simplicial numeric LU stores `L`/`U` in `Vec`s that it grows on
+//!   demand (never shrinking). Their fill depends on the numerical row
+//!   pivoting, so a later refactorisation of the same pattern could need
+//!   more room than the first one and would then allocate. To rule that
+//!   out, [`Pattern::warm_up`] factors a fully dense `n × n` matrix once
+//!   into the pattern's own storage: any `n × n` factorisation needs at
+//!   most the storage of the dense one, so every later one fits. Each
+//!   pattern keeps its own storage: a simplicial LU cannot be reused for a
+//!   smaller dimension.
+
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::perm::PermRef;
+use faer::sparse::linalg::LuError;
+use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::lu::simplicial::{
+    SimplicialLu, factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
+};
+use faer::sparse::linalg::lu::{LuSymbolicParams, SymbolicLu, factorize_symbolic_lu};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+
+use crate::SolverError;
+
+/// Cached per-pattern data: CSC structure, dense slot map, column ordering
+/// and the numeric LU of the last factorisation.
+pub(crate) struct Pattern {
+    pub(crate) n: usize,
+    pub(crate) col_ptr: Vec<usize>,
+    pub(crate) row_idx: Vec<usize>,
+    /// Dense `n × n` row-major map `(row, col) → index into the CSC values`,
+    /// `u32::MAX` where the entry is not in the pattern.
+    pub(crate) slot: Vec<u32>,
+    /// faer's symbolic LU: the fill-reducing column permutation.
+    symbolic: SymbolicLu<usize>,
+    /// Numeric `L`, `U` of the last factorisation (see the module docs).
+    lu: SimplicialLu<usize, f64>,
+    row_perm: Vec<usize>,
+    row_perm_inv: Vec<usize>,
+    /// `1 / U[j, j]` of the last factorisation.
+    pivot_inv: Vec<f64>,
+    /// Scratch of [`Self::solve`].
+    work: Vec<f64>,
+    /// `lu` holds the factorisation of a Jacobian of this pattern (not just
+    /// the dense warm-up): usable for chord steps.
+    pub(crate) factored: bool,
+}
+
+impl Pattern {
+    /// The CSC structure of `entries` (any order, duplicates allowed) and
+    /// its symbolic analysis. Allocates.
+    pub(crate) fn build(n: usize, entries: &mut Vec<(usize, usize)>) -> Self {
+        for &(row, col) in entries.iter() {
+            assert!(
+                row < n && col < n,
+                "Jacobian pattern entry ({row}, {col}) is out of range for dimension {n}"
+            );
+        }
+        // Column-major order, rows sorted within a column, no duplicates.
+        entries.sort_unstable_by_key(|&(row, col)| (col, row));
+        entries.dedup();
+        let nnz = entries.len();
+        assert!(
+            nnz < u32::MAX as usize,
+            "Jacobian pattern has too many entries ({nnz})"
+        );
+
+        let mut col_ptr = vec![0usize; n + 1];
+        let mut row_idx = Vec::with_capacity(nnz);
+        let mut slot = vec![u32::MAX; n * n];
+        for (k, &(row, col)) in entries.iter().enumerate() {
+            col_ptr[col + 1] += 1;
+            row_idx.push(row);
+            slot[row * n + col] = k as u32;
+        }
+        for j in 0..n {
+            col_ptr[j + 1] += col_ptr[j];
+        }
+
+        let a = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let params = LuSymbolicParams {
+            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
+            ..Default::default()
+        };
+        let symbolic = factorize_symbolic_lu(a, params)
+            .unwrap_or_else(|e| panic!("faer symbolic LU failed: {e:?}"));
+        Self {
+            n,
+            col_ptr,
+            row_idx,
+            slot,
+            symbolic,
+            lu: SimplicialLu::new(),
+            row_perm: vec![0; n],
+            row_perm_inv: vec![0; n],
+            pivot_inv: vec![0.0; n],
+            work: vec![0.0; n],
+            factored: false,
+        }
+    }
+
+    /// Scratch that [`Self::factor`] and [`Self::warm_up`] need.
+    pub(crate) fn scratch(&self) -> StackReq {
+        factorize_simplicial_numeric_lu_scratch::<usize, f64>(self.n, self.n)
+    }
+
+    fn col_perm(&self) -> PermRef<'_, usize> {
+        self.symbolic.col_perm()
+    }
+
+    /// Grows the numeric storage to that of a dense `n × n` LU (see the
+    /// module docs). Allocates; `mem` must hold [`Self::scratch`].
+    pub(crate) fn warm_up(&mut self, mem: &mut MemBuffer) {
+        let n = self.n;
+        // Diagonally dominant, hence nonsingular.
+        let col_ptr: Vec<usize> = (0..=n).map(|j| j * n).collect();
+        let row_idx: Vec<usize> = (0..n * n).map(|k| k % n).collect();
+        let values: Vec<f64> = (0..n * n)
+            .map(|k| if k % n == k / n { 2.0 * n as f64 } else { 1.0 })
+            .collect();
+        let dense = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx),
+            &values,
+        );
+        let col_perm = self.symbolic.col_perm();
+        factorize_simplicial_numeric_lu(
+            &mut self.row_perm,
+            &mut self.row_perm_inv,
+            &mut self.lu,
+            dense,
+            col_perm,
+            MemStack::new(mem),
+        )
+        .unwrap_or_else(|e| panic!("faer dense warm-up LU failed: {e:?}"));
+        self.factored = false;
+    }
+
+    /// Numeric LU of `values` (CSC order of this pattern) into the
+    /// pattern's storage, reusing its column ordering. `mem` must hold
+    /// [`Self::scratch`]. Allocation-free after [`Self::warm_up`].
+    ///
+    /// # Errors
+    /// [`SolverError::Singular`] when faer finds no structurally non-zero
+    /// pivot for a column. (A numerically zero pivot shows up as a
+    /// non-finite solution of [`Self::solve`].)
+    pub(crate) fn factor(&mut self, values: &[f64], mem: &mut MemBuffer) -> Result<(), SolverError> {
+        let n = self.n;
+        self.factored = false;
+        let matrix = SparseColMatRef::new(
+            SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx),
+            values,
+        );
+        let col_perm = self.symbolic.col_perm();
+        match factorize_simplicial_numeric_lu(
+            &mut self.row_perm,
+            &mut self.row_perm_inv,
+            &mut self.lu,
+            matrix,
+            col_perm,
+            MemStack::new(mem),
+        ) {
+            Ok(()) => {}
+            Err(LuError::SymbolicSingular { index }) => {
+                let equation = self.col_perm().arrays().0[index];
+                return Err(SolverError::Singular { equation });
+            }
+            Err(LuError::Generic(e)) => panic!("faer numeric LU failed: {e:?}"),
+        }
+        // faer stores each column's diagonal of U last (the contract of its
+        // own upper-triangular solve).
+        let u = self.lu.u_factor_unsorted();
+        let (u_ptr, u_val) = (u.symbolic().col_ptr(), u.val());
+        for (j, p) in self.pivot_inv.iter_mut().enumerate() {
+            *p = u_val[u_ptr[j + 1] - 1].recip();
+        }
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Solves `J x = rhs` in place with the last factorisation
+    /// `P·J·Q = L·U` (`P`: row pivoting, `Q`: column ordering). A zero pivot
+    /// gives non-finite entries. No allocation.
+    pub(crate) fn solve(&mut self, rhs: &mut [f64]) {
+        let n = self.n;
+        assert_eq!(rhs.len(), n, "right-hand side has the wrong length");
+        let w = &mut self.work[..n];
+        for (wi, &p) in w.iter_mut().zip(&self.row_perm) {
+            *wi = rhs[p];
+        }
+        // L: unit lower triangular, the unit diagonal first in each column.
+        let l = self.lu.l_factor_unsorted();
+        let (l_ptr, l_row, l_val) = (l.symbolic().col_ptr(), l.symbolic().row_idx(), l.val());
+        for j in 0..n {
+            let xj = w[j];
+            if xj != 0.0 {
+                for p in l_ptr[j] + 1..l_ptr[j + 1] {
+                    w[l_row[p]] -= l_val[p] * xj;
+                }
+            }
+        }
+        // U: upper triangular, the diagonal last in each column.
+        let u = self.lu.u_factor_unsorted();
+        let (u_ptr, u_row, u_val) = (u.symbolic().col_ptr(), u.symbolic().row_idx(), u.val());
+        for j in (0..n).rev() {
+            let xj = w[j] * self.pivot_inv[j];
+            w[j] = xj;
+            if xj != 0.0 {
+                for p in u_ptr[j]..u_ptr[j + 1] - 1 {
+                    w[u_row[p]] -= u_val[p] * xj;
+                }
+            }
+        }
+        let (col_fwd, _) = self.symbolic.col_perm().arrays();
+        for (&c, &wj) in col_fwd.iter().zip(w.iter()) {
+            rhs[c] = wj;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use faer::sparse::linalg::lu::NumericLu;
+    use faer::{Conj, MatMut, Par};
+
+    /// A sparse, nonsymmetric test matrix with some zero diagonal entries
+    /// (pivoting needed), as `(row, col, value)`.
+    fn matrix(n: usize, seed: u64) -> Vec<(usize, usize, f64)> {
+        let mut s = seed;
+        let mut next = || {
+            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+        };
+        let mut e = Vec::new();
+        for i in 0..n {
+            if i % 3 != 1 {
+                e.push((i, i, 3.0 + next()));
+            }
+            e.push((i, (i + 1) % n, next()));
+            e.push(((i + 2) % n, i, 2.0 + next()));
+            e.push(((i * 7 + 3) % n, i, next()));
+        }
+        e
+    }
+
+    #[test]
+    fn solve_matches_faer() {
+        for (n, seed) in [(5, 1), (19, 2), (31, 3), (64, 4)] {
+            let triplets = matrix(n, seed);
+            let mut entries: Vec<(usize, usize)> = triplets.iter().map(|t| (t.0, t.1)).collect();
+            let mut pattern = Pattern::build(n, &mut entries);
+            let mut values = vec![0.0; pattern.row_idx.len()];
+            for &(i, j, v) in &triplets {
+                values[pattern.slot[i * n + j] as usize] += v;
+            }
+            let mut mem = MemBuffer::new(pattern.scratch().or(
+                pattern.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq).or(
+                    pattern
+                        .symbolic
+                        .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+                ),
+            ));
+            pattern.warm_up(&mut mem);
+            pattern.factor(&values, &mut mem).expect("nonsingular");
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+            let mut ours = b.clone();
+            pattern.solve(&mut ours);
+
+            let mut numeric = NumericLu::new();
+            let a = SparseColMatRef::new(
+                SymbolicSparseColMatRef::new_checked(
+                    n,
+                    n,
+                    &pattern.col_ptr,
+                    None,
+                    &pattern.row_idx,
+                ),
+                &values[..],
+            );
+            let lu = pattern
+                .symbolic
+                .factorize_numeric_lu(
+                    &mut numeric,
+                    a,
+                    Par::Seq,
+                    MemStack::new(&mut mem),
+                    Default::default(),
+                )
+                .expect("nonsingular");
+            let mut theirs = b.clone();
+            lu.solve_in_place_with_conj(
+                Conj::No,
+                MatMut::from_column_major_slice_mut(&mut theirs, n, 1),
+                Par::Seq,
+                MemStack::new(&mut mem),
+            );
+            // And the residual of ours.
+            let mut r = b.clone();
+            for &(i, j, v) in &triplets {
+                r[i] -= v * ours[j];
+            }
+            for i in 0..n {
+                assert!(
+                    (ours[i] - theirs[i]).abs() <= 1e-12 * (1.0 + theirs[i].abs()),
+                    "n = {n}, x[{i}]: ours {} faer {}",
+                    ours[i],
+                    theirs[i]
+                );
+                assert!(r[i].abs() < 1e-10, "n = {n}, residual[{i}] = {}", r[i]);
+            }
+        }
+    }
+}

@@ -1,6 +1,6 @@
 //! Bad walks stop with a one-line error naming the leg, the time and by how
-//! much, and the steps computed so far are written; a hexapod without
-//! `[gait]` stands.
+//! much, and the steps computed so far are written; a kinematic hexapod
+//! without `[gait]` stands.
 
 use std::path::Path;
 
@@ -59,9 +59,11 @@ fn joint_limit_names_the_joint_and_degrees() {
 }
 
 #[test]
-fn hexapod_without_gait_stands() {
+fn kinematic_hexapod_without_gait_stands() {
     let dir = tempfile::tempdir().unwrap();
-    let (r, summary) = run(dir.path(), BASE);
+    // (Without `dynamics = "kinematic"` it would run the 3D dynamics.)
+    let text = BASE.replacen('\n', "\ndynamics = \"kinematic\"\n", 1);
+    let (r, summary) = run(dir.path(), &text);
     r.unwrap();
     let s: serde_json::Value = serde_json::from_str(&summary).unwrap();
     assert_eq!(s["status"], "ok");

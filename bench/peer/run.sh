@@ -131,7 +131,8 @@ if case == "stand":
     print(f"{'foot':>6} {'fbd':>10} {'MuJoCo':>10}")
     total = 0.0
     for n in range(1, 7):
-        f = float(last.get(f"foot{n}_fy", "nan"))
+        # foot{n}_n: the normal component (= foot{n}_fy on flat ground).
+        f = float(last.get(f"foot{n}_n", last.get(f"foot{n}_fy", "nan")))
         total += f
         m = mj["normal"].get(f"tip{n}", 0.0)
         print(f"{n:>6} {f:>10.3f} {m:>10.3f}")

@@ -6,6 +6,7 @@ For random poses (seeded) of a hexapod configuration:
 * MuJoCo loads the exported model and its keyframe "initial";
 * forward kinematics: MuJoCo's sites hip{n}, knee{n}, tip{n} equal the
   points `fbd kinematics` prints, to 1e-9 m;
+* the same with a model of three legs (`legs = [2, 3, 6]`);
 * the body's angular velocity (inertial) is the configuration's
   `omega_deg`, and every hinge's qvel its `rate_deg`, to 1e-9;
 * total mass equal to the configuration's (body + six legs), and the
@@ -44,13 +45,14 @@ def fbd_bin():
     return str(Path(target) / "release" / "fbd")
 
 
-def random_config(rng, points='["tips", "knees", "hips"]'):
+def random_config(rng, points='["tips", "knees", "hips"]', legs=(1, 2, 3, 4, 5, 6)):
     """A hexapod configuration with a random pose, spin and joint rates."""
     r = lambda lo, hi: round(rng.uniform(lo, hi), 6)  # noqa: E731
     ixx, izz = r(0.17, 0.2), r(0.17, 0.2)
     lines = [
         'model = "hexapod"',
         'dynamics = "fbd"',
+        f"legs = {list(legs)}",
         "[body]",
         "mass = 9.0",
         # A valid tensor: Iyy below Ixx + Izz, small products of inertia.
@@ -71,7 +73,7 @@ def random_config(rng, points='["tips", "knees", "hips"]'):
         f"phi_deg = [{r(-40, 40)}, {r(-170, 170)}, {r(-40, 40)}]",
         f"omega_deg = [{r(-200, 200)}, {r(-200, 200)}, {r(-200, 200)}]",
     ]
-    for n in range(1, 7):
+    for n in legs:
         lines += [
             f"[initial.leg{n}]",
             f"theta_deg = [{r(-60, 60)}, {r(-90, 90)}, {r(190, 320)}]",
@@ -107,18 +109,19 @@ def values(text, key):
 def test_forward_kinematics_masses_and_velocities():
     fbd = fbd_bin()
     rng = random.Random(20261122)
-    for _ in range(5):
-        text = random_config(rng)
+    for legs in [(1, 2, 3, 4, 5, 6)] * 4 + [(2, 3, 6)]:
+        text = random_config(rng, legs=legs)
         with tempfile.TemporaryDirectory() as tmp:
             model, data, kin = load(fbd, text, tmp)
         worst = 0.0
-        for leg in kin["legs"]:
+        assert model.nbody == 1 + 1 + 2 * len(legs) and model.njnt == 1 + 3 * len(legs)
+        for leg in (leg for leg in kin["legs"] if leg["leg"] in legs):
             for point in ("hip", "knee", "tip"):
                 got = data.site(f"{point}{leg['leg']}").xpos
                 err = float(np.abs(got - np.array(leg[point])).max())
                 worst = max(worst, err)
                 assert err < TOL, f"leg {leg['leg']} {point}: MuJoCo {got} vs fbd {leg[point]}"
-        mass = 9.0 + 6 * (0.35 + 1.2)
+        mass = 9.0 + len(legs) * (0.35 + 1.2)
         assert abs(model.body_mass.sum() - mass) < 1e-12, (model.body_mass.sum(), mass)
         # The central body's inertia tensor (MuJoCo stores it diagonalised).
         b = model.body("body").id
@@ -137,7 +140,7 @@ def test_forward_kinematics_masses_and_velocities():
         assert np.abs(vel[3:] - np.array(values(text, "velocity")[0])).max() < TOL
         rates = np.radians(np.array(values(text, "rate_deg")).ravel())
         assert np.abs(data.qvel[6:] - rates).max() < TOL
-        print(f"pose ok: max |site − fbd point| = {worst:.1e} m")
+        print(f"legs {legs}: max |MuJoCo site − fbd point| = {worst:.1e} m")
 
 
 def test_contact_spheres():

@@ -367,6 +367,17 @@ pub(crate) fn tick(v: &f64) -> String {
     s.to_owned()
 }
 
+/// Tick label of an axis spanning `span`, less than 1e-3: three
+/// significant digits in scientific notation (`-1.25e-8`), so that the
+/// ticks stay distinct; 0 for rounding noise (below 1e-6 of the span).
+pub(crate) fn tick_small(v: f64, span: f64) -> String {
+    if v.abs() <= 1e-6 * span {
+        "0".to_owned()
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
 /// Finite min/max of `values`, widened when degenerate; `(0, 1)` when
 /// nothing is finite.
 pub(crate) fn range<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
@@ -538,6 +549,10 @@ fn draw_events<'a, DB: DrawingBackend + 'a>(
     Ok(())
 }
 
+/// One chart of [`stacked_time_chart`]: caption, y-axis description and
+/// its curves.
+pub(crate) type ChartSpec<'a> = (&'a str, &'a str, &'a [(&'a Trace, Style)]);
+
 /// A chart of curves against time, legend beside it, events labelled.
 pub(crate) fn time_chart(
     title: &str,
@@ -555,7 +570,7 @@ pub(crate) fn time_chart(
 /// labelled on every chart. Dashed styles must be unique over all charts.
 pub(crate) fn stacked_time_chart(
     title: Option<&str>,
-    panels: &[(&str, &str, &[(&Trace, Style)])],
+    panels: &[ChartSpec<'_>],
     events: &[EventMark],
     t_range: (f64, f64),
 ) -> PlotResult<String> {
@@ -589,12 +604,16 @@ pub(crate) fn stacked_time_chart(
         for ((caption, y_desc, series), area) in panels.iter().zip(&areas) {
             time_panel(area, caption, y_desc, series, events, t_range)?;
         }
+        // One entry per label and style (a curve of the same leg in each
+        // chart is listed once).
         let mut entries: Vec<Entry> = Vec::new();
-        for (_, _, series) in panels {
-            entries.extend(series.iter().map(|(t, s)| Entry {
-                label: t.label.clone(),
-                style: *s,
-            }));
+        for (t, s) in panels.iter().flat_map(|p| p.2.iter()) {
+            if !entries.iter().any(|e| e.label == t.label && e.style == *s) {
+                entries.push(Entry {
+                    label: t.label.clone(),
+                    style: *s,
+                });
+            }
         }
         if !events.is_empty() {
             entries.push(Entry {
@@ -662,7 +681,13 @@ fn time_panel<DB: DrawingBackend>(
         .x_desc("time (s)")
         .y_desc(y_desc)
         .x_label_formatter(&tick)
-        .y_label_formatter(&tick)
+        .y_label_formatter(&|v: &f64| {
+            if y1 - y0 < 1e-3 {
+                tick_small(*v, y1 - y0)
+            } else {
+                tick(v)
+            }
+        })
         .light_line_style(WHITE.mix(0.0))
         .draw()
         .map_err(err)?;

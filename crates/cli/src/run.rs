@@ -347,6 +347,14 @@ pub fn run_command(
         Some(p) => (config::load(p)?, p.display().to_string()),
         None => (Config::default(), "the built-in default".to_owned()),
     };
+    if let Config::Hexapod(h) = &config
+        && h.is_dynamic()
+    {
+        // The 3D FBD dynamics: every file, and the removal of an earlier
+        // run's, in `spatial`.
+        let params = h.spatial_params(&source)?;
+        return crate::spatial::run_command(&params, &config.to_toml(), &source, out_dir, out);
+    }
     if let Config::Hexapod(h) = &config {
         let r = crate::hexapod::run_command(h, &config, &source, out_dir, out);
         // Every file was written (also after a simulation error or an

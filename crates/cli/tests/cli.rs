@@ -64,7 +64,7 @@ fn kinematics_reproduces_the_spec_test_vector() {
 
 #[test]
 fn kinematics_of_the_standing_hexapod_has_six_level_tips() {
-    let o = fbd(&["kinematics", &example("hexapod_stand.toml")]);
+    let o = fbd(&["kinematics", &example("hexapod_pose.toml")]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     let legs = v["legs"].as_array().unwrap();
@@ -350,12 +350,12 @@ fn output_directory_problems_are_io_errors() {
 
 #[test]
 fn hexapod_run_writes_its_files() {
-    // The hexapod is simulated by the kinematic gait (its own tests are in
-    // tests/gait_*.rs); here only the command's contract: exit 0, the files
+    // A kinematic hexapod run (`dynamics = "kinematic"`; the gait's own
+    // tests are in tests/gait_*.rs); here only the command's contract: exit 0, the files
     // in DIR, summary.json ok.
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("hex");
-    let o = fbd(&["run", &example("hexapod_stand.toml"), "--out", s(&out)]);
+    let o = fbd(&["run", &example("hexapod_pose.toml"), "--out", s(&out)]);
     assert!(o.status.success(), "{}", stderr(&o));
     for f in [
         "trajectory.csv",

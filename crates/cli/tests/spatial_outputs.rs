@@ -178,7 +178,7 @@ fn every_file_is_written_with_one_row_per_step() {
         expected_columns(&[1, 2, 3, 4, 5, 6], true, true)
     );
     assert_eq!(csv.rows.len(), 121);
-    assert_eq!(csv.rows[0][0], "0");
+    assert_eq!(csv.rows[0][0], "0.0");
     assert_eq!(csv.rows[120][0], "0.12");
     assert_eq!(csv.rows[35][0], "0.035");
     for row in &csv.rows {
@@ -414,4 +414,110 @@ fn every_body_obeys_newtons_second_law_from_the_csv() {
         "no foot touched: the check saw no contact"
     );
     eprintln!("largest relative force imbalance: {worst:e}");
+}
+
+/// A dynamic hexapod configuration of legs 3 and 4 dropped 5 mm.
+const SMALL: &str = "model = \"hexapod\"\nlegs = [3, 4]\n[time]\ndt = 0.001\nduration = 0.08\n\
+[initial]\nposition = [0.0, 0.4, 0.0]\n[initial.leg3]\ntheta_deg = [0.0, 0.0, 250.0]\n\
+[initial.leg4]\ntheta_deg = [0.0, 0.0, 250.0]\n";
+
+fn fbd(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_fbd"))
+        .args(args)
+        .output()
+        .expect("the fbd binary runs")
+}
+
+fn arg(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+#[test]
+fn fbd_run_of_a_dynamic_config_writes_its_files_and_view_repeats_the_page() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("small.toml");
+    std::fs::write(&cfg, SMALL).unwrap();
+    let out = dir.path().join("out");
+    // An earlier kinematic run's plot in the same folder is removed.
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("gait.svg"), "<svg/>").unwrap();
+    let o = fbd(&["run", arg(&cfg), "--out", arg(&out)]);
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout.contains("solved 81 steps"), "{stdout}");
+    assert!(stdout.contains(&FILES.join(" ")), "{stdout}");
+    for f in FILES {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    assert!(!out.join("gait.svg").exists(), "stale gait.svg kept");
+    let csv = Csv::read(&out.join("trajectory.csv"));
+    assert_eq!(csv.header, expected_columns(&[3, 4], true, true));
+    // `fbd view` writes the same page from the files.
+    let page = std::fs::read(out.join("viewer.html")).unwrap();
+    let o = fbd(&["view", arg(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(std::fs::read(out.join("viewer.html")).unwrap() == page);
+    // config.toml repeats the run byte for byte.
+    let again = dir.path().join("again");
+    let o = fbd(&["run", arg(&out.join("config.toml")), "--out", arg(&again)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["trajectory.csv", "events.csv", "feet.svg", "torques.svg"] {
+        assert!(
+            std::fs::read(out.join(f)).unwrap() == std::fs::read(again.join(f)).unwrap(),
+            "{f} differs when rerun from config.toml"
+        );
+    }
+}
+
+#[test]
+fn sigint_stops_a_dynamic_run_and_keeps_its_rows() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = dir.path().join("long.toml");
+    std::fs::write(
+        &cfg,
+        SMALL.replace("duration = 0.08", "duration = 100000.0") + "[output]\nstride = 100\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let child = Command::new(env!("CARGO_BIN_EXE_fbd"))
+        .args(["run", arg(&cfg), "--out", arg(&out)])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Stepping once the trajectory's temporary file exists.
+    let start = Instant::now();
+    let stepping = || {
+        std::fs::read_dir(&out).is_ok_and(|d| {
+            d.flatten()
+                .any(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        })
+    };
+    while !stepping() {
+        assert!(start.elapsed() < Duration::from_secs(60), "never started");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{stderr}");
+    assert!(stderr.contains("error: interrupted after "), "{stderr}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["status"], "interrupted");
+    let steps = s["steps"].as_u64().unwrap();
+    assert!(steps > 0);
+    let csv = Csv::read(&out.join("trajectory.csv"));
+    assert_eq!(csv.rows.len() as u64, (steps - 1) / 100 + 1);
+    assert_eq!(csv.rows.len() as u64, s["rows_written"].as_u64().unwrap());
+    for f in FILES {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
 }

@@ -44,7 +44,7 @@ fn each_run_leaves_exactly_its_own_files() {
     assert!(!stdout(&o).contains("torques.svg"), "{}", stdout(&o));
 
     // A hexapod run: no planar plot is left.
-    let o = fbd(&["run", &example("hexapod_stand.toml"), "--out", s(&out)]);
+    let o = fbd(&["run", &example("hexapod_pose.toml"), "--out", s(&out)]);
     assert!(o.status.success(), "{o:?}");
     assert_eq!(names(&out), sorted(&hexapod));
 

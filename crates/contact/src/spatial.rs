@@ -133,6 +133,36 @@ pub fn crossing(surface: &Surface, p0: [f64; 3], p1: [f64; 3]) -> [f64; 3] {
     [x, surface.height(x, z), z]
 }
 
+/// The point of the surface at straight-line distance `dist` from `from`
+/// (a point on the surface) in the horizontal direction `dir` (unit, in
+/// `(x, z)`), by bisection: two points of a rigid body that both rest on
+/// the surface are this far apart (the planar
+/// [`crate::Terrain::point_at_distance`] along any horizontal direction).
+pub fn point_at_distance(surface: &Surface, from: [f64; 3], dist: f64, dir: [f64; 2]) -> [f64; 3] {
+    let at = |s: f64| {
+        let (x, z) = (from[0] + s * dir[0], from[2] + s * dir[1]);
+        [x, surface.height(x, z), z]
+    };
+    let gap = |s: f64| {
+        let p = at(s);
+        let d = [p[0] - from[0], p[1] - from[1], p[2] - from[2]];
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() - dist
+    };
+    let (mut lo, mut hi) = (0.0, dist);
+    if gap(hi) < 0.0 {
+        return at(hi);
+    }
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if gap(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    at(0.5 * (lo + hi))
+}
+
 /// A trial solution of one step seen from one contact point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SpatialTrial {

@@ -91,7 +91,7 @@ def test_hexapod_simulator_is_a_config_error_naming_model(examples):
     # fbd.run simulates the hexapod's kinematic gait (test_hexapod.py); the
     # step-wise Simulator is the planar dynamics only.
     with pytest.raises(fbd.ConfigError) as info:
-        fbd.Simulator(examples / "hexapod_stand.toml")
+        fbd.Simulator(examples / "hexapod_pose.toml")
     assert info.value.key == "model"
 
 

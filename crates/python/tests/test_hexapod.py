@@ -44,12 +44,13 @@ def test_hexapod_walk_equals_cli_csv_bit_for_bit(cli, examples, tmp):
     assert stance.sum(axis=0).min() == 3
 
 
-def test_a_gait_table_alone_walks_and_a_bare_hexapod_stands(tmp):
+def test_a_gait_table_alone_walks_and_a_kinematic_hexapod_stands(tmp):
     walk = fbd.run({"model": "hexapod", "gait": {}})
     assert walk.error is None
     assert walk.summary["run"] == "walking" and walk.summary["distance"] > 0.4
     assert walk["t"][-1] == 6.0
-    stand = fbd.run('model = "hexapod"\n', out=tmp / "stand")
+    # Without [gait] a hexapod runs the 3D dynamics unless told otherwise.
+    stand = fbd.run('model = "hexapod"\ndynamics = "kinematic"\n', out=tmp / "stand")
     assert stand.summary["run"] == "standing"
     # Every foot on the ground and still.
     for n in range(1, 7):

@@ -12,7 +12,7 @@ import fbd
 from conftest import run_cli
 
 
-@pytest.mark.parametrize("example", ["paper.toml", "hexapod_stand.toml"])
+@pytest.mark.parametrize("example", ["paper.toml", "hexapod_pose.toml"])
 def test_kinematics_equals_cli_json(cli, examples, example):
     p = run_cli(cli, "kinematics", str(examples / example))
     assert p.returncode == 0, p.stderr
@@ -43,7 +43,7 @@ def hexapod_q(position, phi_deg, joints_deg):
 
 
 def test_hexapod_fk_matches_kinematics(examples):
-    cfg = examples / "hexapod_stand.toml"
+    cfg = examples / "hexapod_pose.toml"
     k = fbd.kinematics(cfg)
     q = hexapod_q([0.0, 0.36, 0.0], [0, 0, 0], [[0.0, -20.0, 290.0]] * 6)
     pts = fbd.hexapod_fk(q, cfg)

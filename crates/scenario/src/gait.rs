@@ -1,7 +1,7 @@
 //! `[gait]` of the hexapod model: the kinematic gait (schema, defaults,
 //! validation) and the conversion of a hexapod configuration into a
-//! [`GaitModel`]. Without `[gait]` a hexapod run stands: the initial pose
-//! is held for the duration.
+//! [`GaitModel`]. A kinematic run without `[gait]` (`dynamics =
+//! "kinematic"`) stands: the initial pose is held for the duration.
 
 use fbd_contact::Surface;
 use fbd_kinematics::hexapod::{HexapodData, HexapodModel, forward};

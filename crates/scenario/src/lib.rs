@@ -71,9 +71,7 @@ mod advice;
 pub mod mjcf;
 mod spatial;
 pub use actuation::{ControlConfig, ControlKind, ControlLegConfig, TargetDeg};
-pub use spatial::{
-    DynamicsKind, InertiaConfig, LOWER_RADIUS, PHI_Z_SINGULAR, UPPER_RADIUS, euler_rate_matrix,
-};
+pub use spatial::{DynamicsKind, InertiaConfig, PHI_Z_SINGULAR, euler_rate_matrix};
 
 /// Fixed-length arrays of numbers: serde's `[f64; N]` would silently
 /// ignore extra elements of a TOML array, so the length is checked here.
@@ -264,7 +262,8 @@ pub struct LegConfig {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub upper_inertia: Option<f64>,
     /// Upper link radius (m, hexapod dynamics): inertia about the link's
-    /// own axis `m·r²/2`; `None` until resolved to [`UPPER_RADIUS`] there.
+    /// own axis `m·r²/2`; `None` until resolved to the default of
+    /// [`fbd_sim::spatial::SpatialParams`] there (0.02).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub upper_radius: Option<f64>,
     /// Upper link centre of mass, fraction of `a` from the hip.
@@ -278,7 +277,7 @@ pub struct LegConfig {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lower_inertia: Option<f64>,
     /// Lower link radius (m, hexapod dynamics); `None` until resolved to
-    /// [`LOWER_RADIUS`] there.
+    /// the default of [`fbd_sim::spatial::SpatialParams`] there (0.015).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub lower_radius: Option<f64>,
     /// Lower link centre of mass, fraction of `c` from the knee.

@@ -102,40 +102,59 @@ fn body_omega_local(phi: [f64; 3], rate: [f64; 3]) -> Vector3<f64> {
     rot.inverse() * w
 }
 
-/// Gains, torque limit and the t = 0 targets (rad) of the controller, or
-/// `None` for passive joints.
-fn servo(p: &SpatialParams) -> Option<(f64, f64, Option<f64>, Vec<[f64; 3]>)> {
-    let initial = || -> Vec<[f64; 3]> {
-        (0..p.legs.len())
-            .map(|i| std::array::from_fn(|j| p.q0[6 + 3 * i + j]))
-            .collect()
-    };
-    match &p.control {
-        SpatialControl::None => None,
+/// The position servos of a controlled model.
+struct Servo {
+    /// Stiffness (N·m/rad).
+    kp: f64,
+    /// Damping (N·m·s/rad), MuJoCo's `kv`.
+    kd: f64,
+    /// `|τ| ≤ limit` (N·m), if any.
+    torque_limit: Option<f64>,
+    /// `(θ1, θ2, θ3)` targets at t = 0 (rad), per leg of the model.
+    targets: Vec<[f64; 3]>,
+}
+
+/// The servos of the controller, or `None` for passive joints.
+fn servo(p: &SpatialParams) -> Option<Servo> {
+    let (kp, kd, torque_limit, targets) = match &p.control {
+        SpatialControl::None => return None,
         SpatialControl::Pd {
             kp,
             kd,
             torque_limit,
             target,
-        } => Some((*kp, *kd, *torque_limit, target.clone())),
+        } => (kp, kd, torque_limit, target.clone()),
         SpatialControl::Trajectory {
             kp,
             kd,
             torque_limit,
             legs,
-        } => Some((
-            *kp,
-            *kd,
-            *torque_limit,
+        } => (
+            kp,
+            kd,
+            torque_limit,
             legs.iter().map(|l| l.at(0.0)).collect(),
-        )),
+        ),
         SpatialControl::Gait {
             kp,
             kd,
             torque_limit,
             ..
-        } => Some((*kp, *kd, *torque_limit, initial())),
-    }
+        } => (
+            kp,
+            kd,
+            torque_limit,
+            (0..p.legs.len())
+                .map(|i| std::array::from_fn(|j| p.q0[6 + 3 * i + j]))
+                .collect(),
+        ),
+    };
+    Some(Servo {
+        kp: *kp,
+        kd: *kd,
+        torque_limit: *torque_limit,
+        targets,
+    })
 }
 
 /// The robot of `params` as a MuJoCo MJCF document (see the module docs).
@@ -352,9 +371,15 @@ pub fn mjcf(params: &SpatialParams, file: &str) -> Result<String, ConfigError> {
     }
     let _ = writeln!(w, "    </body>\n  </worldbody>");
 
-    if let Some((kp, kd, limit, _)) = &servo {
+    if let Some(Servo {
+        kp,
+        kd,
+        torque_limit,
+        ..
+    }) = &servo
+    {
         let _ = writeln!(w, "  <actuator>");
-        let force = limit
+        let force = torque_limit
             .map(|l| format!(" forcerange=\"{}\"", nums(&[-l, l])))
             .unwrap_or_default();
         for &n in &p.legs {
@@ -380,8 +405,8 @@ pub fn mjcf(params: &SpatialParams, file: &str) -> Result<String, ConfigError> {
     let mut qvel = vec![v[0], v[1], v[2], om.x, om.y, om.z];
     qvel.extend_from_slice(&v[6..]);
     let ctrl = servo
-        .map(|(_, _, _, t)| {
-            let flat: Vec<f64> = t.iter().flatten().copied().collect();
+        .map(|s| {
+            let flat: Vec<f64> = s.targets.iter().flatten().copied().collect();
             format!(" ctrl=\"{}\"", nums(&flat))
         })
         .unwrap_or_default();

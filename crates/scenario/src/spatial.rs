@@ -146,11 +146,6 @@ pub fn euler_rate_matrix(phi: [f64; 3]) -> Matrix3<f64> {
 /// Distance (rad) from `φz = ±90°` within which `E(φ)` counts as singular.
 pub const PHI_Z_SINGULAR: f64 = 1e-6;
 
-/// Default `[leg] upper_radius` of the dynamics (m).
-pub const UPPER_RADIUS: f64 = 0.02;
-/// Default `[leg] lower_radius` of the dynamics (m).
-pub const LOWER_RADIUS: f64 = 0.015;
-
 /// All six legs.
 const ALL_LEGS: [usize; 6] = [1, 2, 3, 4, 5, 6];
 
@@ -199,35 +194,26 @@ fn triple(file: &str, key: &str, v: &[f64]) -> Result<[f64; 3], ConfigError> {
     }
 }
 
-fn sub(table: &toml::Table, key: &str) -> Option<toml::Table> {
-    table.get(key).and_then(toml::Value::as_table).cloned()
+/// The value at the dotted `path` of `table`, if given.
+fn lookup<'a>(table: &'a toml::Table, path: &[&str]) -> Option<&'a toml::Value> {
+    let (last, tables) = path.split_last()?;
+    let mut cur = table;
+    for p in tables {
+        cur = cur.get(*p)?.as_table()?;
+    }
+    cur.get(*last)
 }
 
 /// Whether the dotted `path` of `table` is given.
 fn given(table: &toml::Table, path: &[&str]) -> bool {
-    let mut cur = table.clone();
-    for (i, p) in path.iter().enumerate() {
-        if i + 1 == path.len() {
-            return cur.contains_key(*p);
-        }
-        match sub(&cur, p) {
-            Some(t) => cur = t,
-            None => return false,
-        }
-    }
-    false
+    lookup(table, path).is_some()
 }
 
 /// Whether the dotted `path` of `table` is a table with at least one key.
 fn non_empty_table(table: &toml::Table, path: &[&str]) -> bool {
-    let mut cur = table.clone();
-    for p in path {
-        match sub(&cur, p) {
-            Some(t) => cur = t,
-            None => return false,
-        }
-    }
-    !cur.is_empty()
+    lookup(table, path)
+        .and_then(toml::Value::as_table)
+        .is_some_and(|t| !t.is_empty())
 }
 
 impl HexapodConfig {
@@ -324,9 +310,10 @@ impl HexapodConfig {
         self.body.inertia.get_or_insert_with(|| {
             InertiaConfig::Components(hexagon_inertia(m, side)[..3].to_vec())
         });
+        let d = SpatialParams::default();
         let l = &mut self.leg;
-        let ru = *l.upper_radius.get_or_insert(UPPER_RADIUS);
-        let rl = *l.lower_radius.get_or_insert(LOWER_RADIUS);
+        let ru = *l.upper_radius.get_or_insert(d.upper_radius);
+        let rl = *l.lower_radius.get_or_insert(d.lower_radius);
         let (mu, a, ml, c) = (l.upper_mass, l.upper_length, l.lower_mass, l.lower_length);
         l.upper_inertia.get_or_insert(cylinder(mu, ru, a));
         l.lower_inertia.get_or_insert(cylinder(ml, rl, c));
@@ -594,6 +581,7 @@ impl HexapodConfig {
         self.validate(file)?;
         let mut c = self.clone();
         c.resolve_dynamics();
+        let d = SpatialParams::default();
         let legs = c.leg_numbers();
         let i = &c.initial;
         let phi = i.phi_deg.map(f64::to_radians);
@@ -636,12 +624,12 @@ impl HexapodConfig {
             side: c.body.side,
             upper_length: l.upper_length,
             upper_mass: l.upper_mass,
-            upper_radius: l.upper_radius.unwrap_or(UPPER_RADIUS),
+            upper_radius: l.upper_radius.unwrap_or(d.upper_radius),
             upper_inertia: l.upper_inertia(),
             upper_com: l.upper_com,
             lower_length: l.lower_length,
             lower_mass: l.lower_mass,
-            lower_radius: l.lower_radius.unwrap_or(LOWER_RADIUS),
+            lower_radius: l.lower_radius.unwrap_or(d.lower_radius),
             lower_inertia: l.lower_inertia(),
             lower_com: l.lower_com,
             legs,

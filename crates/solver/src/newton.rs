@@ -492,6 +492,11 @@ impl Workspace {
         let Some(mut rnorm) = scaled_norm(sys, &self.r) else {
             return Err(SolverError::NonFinite { iter: 0 });
         };
+        if std::env::var_os("NDEBUG_CHORD").is_some() {
+            let (mut bi, mut bv) = (0, 0.0);
+            for i in 0..n { let v = self.r[i].abs() / sys.residual_scale(i); if v > bv { bv = v; bi = i; } }
+            eprintln!("S {rnorm:.3e} row {bi} {usable}");
+        }
 
         loop {
             if rnorm <= params.residual_tol {
@@ -531,6 +536,7 @@ impl Workspace {
                             && (rnorm <= params.residual_tol
                                 || needed <= (params.chord_steps - run) as f64);
                         usable = on_track;
+                        if std::env::var_os("NDEBUG_CHORD").is_some() { eprintln!("C {run} {rate:.3e} {rnorm:.3e} {on_track}"); }
                     }
                 }
                 continue;

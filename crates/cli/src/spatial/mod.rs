@@ -239,7 +239,7 @@ impl Outputs {
         };
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
         Ok(Self {
-            collect: summary::Collector::new(&layout),
+            collect: summary::Collector::new(&layout, &params.terrain),
             plot: out_dir.map(|_| plots::Recorder::new(&layout, t_end)),
             view: out_dir.map(|dir| {
                 HexapodScene::dynamic(
@@ -578,6 +578,6 @@ mod tests {
             );
         }
         let feet = std::fs::read_to_string(dir.path().join("feet.svg")).unwrap();
-        assert!(feet.contains("foot 4") && feet.contains("4 tip ST2"));
+        assert!(feet.contains("leg 4") && feet.contains("4 tip ST2"));
     }
 }

@@ -81,7 +81,7 @@ impl Recorder {
         let mut torques: [Vec<Trace>; 3] = Default::default();
         for (&n, ms) in self.legs.iter().zip(self.torque) {
             for (j, m) in ms.into_iter().enumerate() {
-                torques[j].push(trace(format!("τ{} leg {n}", j + 1), m));
+                torques[j].push(trace(format!("leg {n}"), m));
             }
         }
         let [height, phi_x, phi_y, phi_z] = self.body;
@@ -91,7 +91,7 @@ impl Recorder {
                 .legs
                 .iter()
                 .zip(self.normal)
-                .map(|(n, m)| trace(format!("foot {n}"), m))
+                .map(|(n, m)| trace(format!("leg {n}"), m))
                 .collect(),
             torques,
             height: trace("Ry".into(), height),
@@ -116,9 +116,10 @@ impl Recorder {
 pub struct SpatialPlotData {
     /// Leg numbers, in the order of the per-leg curves.
     pub legs: Vec<usize>,
-    /// Normal force of each leg's foot (N).
+    /// Normal force of each leg's foot, labelled `leg n` (N).
     pub feet: Vec<Trace>,
-    /// Torques τ1, τ2, τ3 (one vector per joint), one curve per leg (N·m).
+    /// Torques τ1, τ2, τ3 (one vector per joint), one curve per leg,
+    /// labelled `leg n` (N·m).
     pub torques: [Vec<Trace>; 3],
     /// Body height `Ry` (m).
     pub height: Trace,

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use fbd_contact::StateCode;
+use fbd_contact::{StateCode, Surface};
 use fbd_dynamics::PointKind;
 use fbd_sim::spatial::{SpatialControl, SpatialParams, SpatialRecord};
 use fbd_sim::{Event, RunSummary};
@@ -119,6 +119,7 @@ pub struct SpatialSummary {
 
 /// What the summary needs, gathered at every step without allocating.
 pub(crate) struct Collector {
+    surface: Surface,
     iter_max: usize,
     /// `|τ|` and `|τ·θ̇|` peaks per leg of the layout and joint.
     torque: Vec<[f64; 3]>,
@@ -137,9 +138,10 @@ fn norm(v: [f64; 3]) -> f64 {
 }
 
 impl Collector {
-    pub fn new(layout: &Layout) -> Self {
+    pub fn new(layout: &Layout, surface: &Surface) -> Self {
         let n = layout.legs.len();
         Self {
+            surface: surface.clone(),
             iter_max: 0,
             torque: vec![[0.0; 3]; n],
             power: vec![[0.0; 3]; n],
@@ -173,8 +175,10 @@ impl Collector {
                 .collect();
         }
         for (p, c) in self.contact.iter_mut().zip(&r.contacts) {
-            let f = norm(c.force);
-            let ft = (f * f - c.normal * c.normal).max(0.0).sqrt();
+            // The tangential part: the force less its normal component
+            // along the terrain normal at the point.
+            let nu = self.surface.normal(c.point[0], c.point[2]);
+            let ft = norm(std::array::from_fn(|i| c.force[i] - c.normal * nu[i]));
             p.2.n = p.2.n.max(c.normal.abs());
             p.2.fa = p.2.fa.max(ft);
         }

@@ -11,7 +11,7 @@ use fbd_kinematics::body::LEG_COUNT;
 use fbd_kinematics::hexapod::NQ;
 use fbd_sim::{Event, Model, StepRecord};
 
-use super::hexapod::{HexFrame, HexapodScene};
+use super::hexapod::{HexDynamics, HexFrame, HexapodScene};
 use super::planar::PlanarScene;
 use crate::CliError;
 use crate::config::{self, Config};
@@ -267,6 +267,97 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
     Ok(out)
 }
 
+/// The frames of a dynamic (3D FBD) hexapod run's `trajectory.csv` for
+/// the model of `params`: pose, joint angles, each foot's state and ground
+/// force, the hip and knee forces and the torques of the model's legs.
+pub fn spatial_frames(
+    table_file: &Path,
+    params: &fbd_sim::spatial::SpatialParams,
+) -> Result<Vec<HexFrame>, CliError> {
+    let table = Table::read(table_file)?;
+    let layout = crate::spatial::Layout::of(params);
+    let t_col = table.column("t")?;
+    let mut q_cols = Vec::with_capacity(6 + 3 * layout.legs.len());
+    for c in crate::spatial::csv::POSE_COLUMNS {
+        q_cols.push(table.column(c)?);
+    }
+    for n in &layout.legs {
+        for j in 1..=3 {
+            q_cols.push(table.column(&format!("theta{j}_{n}"))?);
+        }
+    }
+    let triple = |name: &str, a: [&str; 3]| -> Result<[usize; 3], CliError> {
+        Ok([
+            table.column(&format!("{name}{}", a[0]))?,
+            table.column(&format!("{name}{}", a[1]))?,
+            table.column(&format!("{name}{}", a[2]))?,
+        ])
+    };
+    let f = ["_fx", "_fy", "_fz"];
+    let legs: Vec<[[usize; 3]; 5]> = layout
+        .legs
+        .iter()
+        .map(|n| {
+            Ok([
+                [
+                    table.column(&format!("state{n}"))?,
+                    table.column(&format!("foot{n}_n"))?,
+                    0,
+                ],
+                triple(&format!("foot{n}"), f)?,
+                triple(&format!("hip{n}"), f)?,
+                triple(&format!("knee{n}"), f)?,
+                [
+                    table.column(&format!("tau1_{n}"))?,
+                    table.column(&format!("tau2_{n}"))?,
+                    table.column(&format!("tau3_{n}"))?,
+                ],
+            ])
+        })
+        .collect::<Result<_, CliError>>()?;
+    let mut feet = crate::spatial::Feet::new(params);
+    let mut q = vec![0.0; q_cols.len()];
+    let mut out = Vec::with_capacity(table.rows.len());
+    for (r, row) in table.rows.iter().enumerate() {
+        for (v, &c) in q.iter_mut().zip(&q_cols) {
+            *v = table.number(row, r, c)?;
+        }
+        feet.update(&q);
+        let mut d = HexDynamics::default();
+        let v3 = |c: [usize; 3]| -> Result<[f64; 3], CliError> {
+            Ok([
+                table.number(row, r, c[0])?,
+                table.number(row, r, c[1])?,
+                table.number(row, r, c[2])?,
+            ])
+        };
+        for (&n, cols) in layout.legs.iter().zip(&legs) {
+            let s = cell(row, cols[0][0]);
+            d.state[n - 1] = state(s).ok_or_else(|| {
+                CliError::Io(format!(
+                    "{}: line {}: state{n} = `{s}`: expected ST1, ST2 or ST3",
+                    table.file.display(),
+                    r + 2
+                ))
+            })?;
+            d.normal[n - 1] = table.number(row, r, cols[0][1])?;
+            d.foot_force[n - 1] = v3(cols[1])?;
+            d.hip_force[n - 1] = v3(cols[2])?;
+            d.knee_force[n - 1] = v3(cols[3])?;
+            d.torque[n - 1] = v3(cols[4])?;
+        }
+        out.push(HexFrame {
+            t: table.number(row, r, t_col)?,
+            q: *feet.q(),
+            stance: d.state.map(|s| s != StateCode::St1),
+            com: feet.com(),
+            margin: None,
+            dynamics: Some(d),
+        });
+    }
+    Ok(out)
+}
+
 /// Writes `dir/viewer.html` from the files of a finished run; returns its
 /// path.
 pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
@@ -292,6 +383,21 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
                 scene.push(r);
             }
             scene.finish(&events)
+        }
+        Config::Hexapod(c) if c.is_dynamic() => {
+            let params = c.spatial_params(&source)?;
+            let frames = spatial_frames(&traj, &params)?;
+            let mut scene = HexapodScene::dynamic(
+                crate::spatial::kinematic_model(&params),
+                params.terrain.clone(),
+                &params.legs,
+                frames.len(),
+                &title,
+            );
+            for f in &frames {
+                scene.push(f);
+            }
+            scene.finish()
         }
         Config::Hexapod(c) => {
             let model = c.gait_model(&source)?;

@@ -292,6 +292,10 @@ impl SpatialModel {
             steps: (p.duration / p.dt).round() as usize + 1,
             newton: NewtonParams {
                 chord_steps: 6,
+                // Ten times the planar tolerance: the tumbling robot's
+                // angular momentum is then kept to 1e-9 relative over
+                // thousands of steps (its drift is the residual's).
+                residual_tol: 1e-10,
                 ..NewtonParams::default()
             },
             contact_bumper,

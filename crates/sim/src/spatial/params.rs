@@ -207,3 +207,82 @@ pub fn default_q0() -> Vec<f64> {
     }
     q
 }
+
+impl SpatialParams {
+    /// The spatial twin of a planar run: legs 3 and 4 only, θ1 = 0, the
+    /// planar initial state in the X–Y plane, the same masses (the body's
+    /// inertia isotropic with the planar value about Z, each link's
+    /// transverse inertia the planar one), terrain (profile along X),
+    /// friction, contact points, joint limits and step. Its motion stays
+    /// in the plane and must reproduce the planar engine's (the two engines
+    /// check each other). A planar PD or trajectory controller becomes the
+    /// same controller with θ1 held at 0.
+    pub fn planar_twin(p: &crate::PlanarParams) -> Self {
+        let mut q0 = vec![0.0; 12];
+        let mut qdot0 = vec![0.0; 12];
+        // Planar q = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄).
+        let map = [(0, 0), (1, 1), (2, 5), (3, 7), (4, 8), (5, 10), (6, 11)];
+        for (from, to) in map {
+            q0[to] = p.q0[from];
+            qdot0[to] = p.qdot0[from];
+        }
+        let three = |t: [f64; 2]| [0.0, t[0], t[1]];
+        let control = match &p.control {
+            crate::Control::None => SpatialControl::None,
+            crate::Control::Pd {
+                kp,
+                kd,
+                torque_limit,
+                target,
+            } => SpatialControl::Pd {
+                kp: *kp,
+                kd: *kd,
+                torque_limit: *torque_limit,
+                target: target.iter().map(|t| three(*t)).collect(),
+            },
+            crate::Control::Trajectory {
+                kp,
+                kd,
+                torque_limit,
+                legs,
+            } => SpatialControl::Trajectory {
+                kp: *kp,
+                kd: *kd,
+                torque_limit: *torque_limit,
+                legs: legs
+                    .iter()
+                    .map(|l| LegTrajectory3 {
+                        times: l.times.clone(),
+                        targets: l.targets.iter().map(|t| three(*t)).collect(),
+                    })
+                    .collect(),
+            },
+        };
+        Self {
+            dt: p.dt,
+            duration: p.duration,
+            gravity: p.gravity,
+            body_mass: p.body_mass,
+            body_inertia: [p.body_inertia, p.body_inertia, p.body_inertia, 0.0, 0.0, 0.0],
+            side: p.side,
+            upper_length: p.upper_length,
+            upper_mass: p.upper_mass,
+            upper_inertia: p.upper_inertia,
+            upper_com: p.upper_com,
+            lower_length: p.lower_length,
+            lower_mass: p.lower_mass,
+            lower_inertia: p.lower_inertia,
+            lower_com: p.lower_com,
+            legs: vec![3, 4],
+            joint_limits: p.joint_limits,
+            q0,
+            qdot0,
+            terrain: Surface::new(p.terrain.clone(), 0.0),
+            friction: p.friction,
+            contact_points: p.contact_points,
+            control,
+            stride: p.stride,
+            ..Self::default()
+        }
+    }
+}

@@ -25,7 +25,7 @@ use super::data::SpatialData;
 use super::model::{SpatialModel, limit_code};
 use crate::SimError;
 use crate::record::{Event, LimitEvent, RetryEvent};
-use fbd_contact::spatial::{clearance, frame, project};
+use fbd_contact::spatial::{clearance, frame, point_at_distance, project};
 use fbd_contact::{SpatialState, SpatialTrial, transition_spatial};
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
@@ -484,8 +484,8 @@ fn check_states(model: &SpatialModel, data: &mut SpatialData, allow_turn: bool) 
 
 /// Anchors of points that share a rigid body (as in the planar model): on
 /// each body the first point to stick keeps its anchor; every other point
-/// anchored now is placed at its rigid offset from that reference,
-/// projected vertically onto the surface.
+/// anchored now is placed on the surface at its rigid distance from that
+/// reference, in the horizontal direction it lies in.
 fn rigid_anchors(model: &SpatialModel, data: &mut SpatialData) {
     let mech = &model.mech;
     for body in 0..mech.bodies.len() {
@@ -511,10 +511,17 @@ fn rigid_anchors(model: &SpatialModel, data: &mut SpatialData) {
             let sc = &mech.contacts[c];
             let p = data.fbd.kin.point(mech, sc.point / 3, sc.kind);
             let d = p - p_ref;
-            let anchor = project(
-                &model.params.terrain,
-                [from[0] + d.x, from[1] + d.y, from[2] + d.z],
-            );
+            let horizontal = d.x.hypot(d.z);
+            let anchor = if horizontal > 1e-12 {
+                point_at_distance(
+                    &model.params.terrain,
+                    from,
+                    d.norm(),
+                    [d.x / horizontal, d.z / horizontal],
+                )
+            } else {
+                project(&model.params.terrain, [from[0], from[1], from[2]])
+            };
             data.trial[c] = SpatialState::Stick { anchor };
         }
     }

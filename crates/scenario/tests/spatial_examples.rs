@@ -1,0 +1,135 @@
+//! The hexapod dynamics examples do what their headers say: the stand and
+//! the slope come to rest with every foot sticking and the normal forces
+//! carrying the weight, the drop lands on its feet and body, the walk
+//! walks without a loaded stance foot slipping, on ice the feet slip, and
+//! the slope slides with μS = 0.1.
+
+use std::path::Path;
+
+use fbd_contact::StateCode;
+use fbd_dynamics::PointKind;
+use fbd_scenario::{Config, Override, load_with_overrides};
+use fbd_sim::spatial::{SpatialModel, SpatialRecord, run_collect};
+
+fn run(name: &str, overrides: &[&str]) -> (SpatialModel, Vec<SpatialRecord>) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../examples")
+        .join(name);
+    let o: Vec<Override> = overrides
+        .iter()
+        .map(|s| Override::parse(s).unwrap())
+        .collect();
+    let Config::Hexapod(h) = load_with_overrides(&path, &o).unwrap() else {
+        panic!("{name}: not a hexapod")
+    };
+    assert!(h.is_dynamic(), "{name}");
+    let model = h.spatial_model(name).unwrap();
+    let (records, summary) = run_collect(&model);
+    assert!(summary.error.is_none(), "{name}: {:?}", summary.error);
+    assert_eq!(records.len(), model.steps, "{name}");
+    (model, records)
+}
+
+/// Total mass (kg) and weight (N) of the model.
+fn weight(m: &SpatialModel) -> f64 {
+    let p = &m.params;
+    (p.body_mass + p.legs.len() as f64 * (p.upper_mass + p.lower_mass)) * p.gravity
+}
+
+fn tips(r: &SpatialRecord) -> impl Iterator<Item = &fbd_sim::spatial::ContactRow> {
+    r.contacts.iter().filter(|c| c.kind == PointKind::Tip)
+}
+
+/// At the last step: at rest, every touching point sticking, and the
+/// ground's forces (all points) adding up to the weight.
+fn at_rest_on_the_ground(name: &str, m: &SpatialModel, last: &SpatialRecord) {
+    assert!(last.kinetic < 1e-9, "{name}: kinetic {}", last.kinetic);
+    let fy: f64 = last.contacts.iter().map(|c| c.force[1]).sum();
+    let w = weight(m);
+    assert!((fy - w).abs() < 1e-6 * w, "{name}: Σ fy {fy} vs weight {w}");
+    for c in &last.contacts {
+        assert_ne!(c.state, StateCode::St3, "{name}: {c:?}");
+    }
+}
+
+#[test]
+fn stand_comes_to_rest_on_six_sticking_feet() {
+    let (m, rec) = run("hexapod_stand.toml", &[]);
+    let last = rec.last().unwrap();
+    at_rest_on_the_ground("stand", &m, last);
+    for c in tips(last) {
+        assert_eq!(c.state, StateCode::St2, "{c:?}");
+        // Lower links vertical: little tangential force.
+        let ft = c.force[0].hypot(c.force[2]);
+        assert!(ft < 0.2 * c.normal, "{c:?}");
+    }
+    // No foot slips at any step.
+    assert!(rec.iter().flat_map(tips).all(|c| c.state != StateCode::St3));
+    // The body settles within 2 mm of the touchdown height 0.3516 m.
+    assert!((last.q[1] - 0.3516).abs() < 2e-3, "{}", last.q[1]);
+}
+
+#[test]
+fn drop_lands_on_its_feet_and_body() {
+    let (m, rec) = run("hexapod_drop.toml", &[]);
+    let last = rec.last().unwrap();
+    at_rest_on_the_ground("drop", &m, last);
+    for kind in [PointKind::Tip, PointKind::Hip] {
+        let n = last
+            .contacts
+            .iter()
+            .filter(|c| c.kind == kind && c.state == StateCode::St2)
+            .count();
+        assert_eq!(n, 6, "{kind:?} sticking at the end");
+    }
+    // The first touchdown of the feet (all six at once): the free fall of
+    // the feet from 0.85 − c·cos 35°, within a step.
+    let h = 0.85 - 0.42 * 35f64.to_radians().cos();
+    let t_fall = (2.0 * h / m.params.gravity).sqrt();
+    let first = rec
+        .iter()
+        .find(|r| tips(r).any(|c| c.state != StateCode::St1))
+        .unwrap();
+    assert!((first.t - t_fall).abs() < 2e-3, "{} vs {t_fall}", first.t);
+    assert!(tips(first).all(|c| c.state != StateCode::St1));
+}
+
+#[test]
+fn slope_sticks_with_04_and_slides_with_01() {
+    let (m, rec) = run("hexapod_slope.toml", &[]);
+    let last = rec.last().unwrap();
+    at_rest_on_the_ground("slope", &m, last);
+    assert!(rec.iter().flat_map(tips).all(|c| c.state != StateCode::St3));
+    assert!(last.q[0].abs() < 1e-3, "rx {}", last.q[0]);
+    let (_, rec) = run(
+        "hexapod_slope.toml",
+        &["terrain.mu_static=0.1", "terrain.mu_dynamic=0.08"],
+    );
+    let last = rec.last().unwrap();
+    assert!(last.q[0] < -0.3, "rx {}", last.q[0]);
+    assert!(tips(last).all(|c| c.state == StateCode::St3));
+}
+
+/// Loaded (normal force above 5 N) foot rows, and those sliding.
+fn loaded_slips(rec: &[SpatialRecord]) -> (usize, usize) {
+    let loaded: Vec<_> = rec
+        .iter()
+        .flat_map(tips)
+        .filter(|c| c.normal > 5.0)
+        .collect();
+    let slipping = loaded.iter().filter(|c| c.state == StateCode::St3).count();
+    (loaded.len(), slipping)
+}
+
+#[test]
+fn walk_keeps_its_stance_feet_and_ice_slips() {
+    let (_, dry) = run("hexapod_walk.toml", &[]);
+    let (loaded, slipping) = loaded_slips(&dry);
+    assert!(loaded > 10_000 && slipping == 0, "{slipping} of {loaded}");
+    // 0.1 m/s for 2 s less the two half-ramps: 0.15 m forward (−Z).
+    let rz = dry.last().unwrap().q[2];
+    assert!((rz + 0.15).abs() < 5e-3, "rz {rz}");
+    let (_, ice) = run("hexapod_walk_ice.toml", &[]);
+    let (loaded, slipping) = loaded_slips(&ice);
+    assert!(slipping > loaded / 10, "{slipping} of {loaded}");
+}

@@ -1,11 +1,12 @@
 #!/usr/bin/env bash
-# The browser test of viewer.html: runs the default experiment and the
-# hexapod tripod gait, opens each run's viewer.html in headless Chromium
-# (Debian's package, driven by playwright-core from npm) and checks what it
-# draws against trajectory.csv (tests/browser/viewer.test.mjs). Installs
-# chromium with apt-get when it is missing (needs root), and the pinned
-# playwright-core with `npm ci`. Saves the screenshots docs/viewer.png and
-# docs/viewer_hexapod.png.
+# The browser test of viewer.html: runs the default experiment, the
+# hexapod tripod gait and the dynamic hexapod walk, opens each run's
+# viewer.html in headless Chromium (Debian's package, driven by
+# playwright-core from npm) and checks what it draws against
+# trajectory.csv (tests/browser/viewer.test.mjs). Installs chromium with
+# apt-get when it is missing (needs root), and the pinned playwright-core
+# with `npm ci`. Saves the screenshots docs/viewer.png,
+# docs/viewer_hexapod.png and docs/viewer_hexapod_walk.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -30,7 +31,9 @@ trap 'rm -rf "$runs"' EXIT
 # The folder names are the viewer's page titles.
 "$fbd" run --out "$runs/paper-fall" >/dev/null
 "$fbd" run examples/hexapod_tripod.toml --out "$runs/hexapod-tripod" >/dev/null
+"$fbd" run examples/hexapod_walk.toml --out "$runs/hexapod-walk" >/dev/null
 
 cd tests/browser
 CHROMIUM="$chromium" FBD_PLANAR_DIR="$runs/paper-fall" FBD_HEXAPOD_DIR="$runs/hexapod-tripod" \
+  FBD_DYNAMIC_DIR="$runs/hexapod-walk" \
   FBD_SCREENSHOT_DIR="$PWD/../../docs" node --test

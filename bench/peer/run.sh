@@ -28,10 +28,23 @@ trap 'rm -rf "$out"' EXIT
 pin=()
 if command -v taskset > /dev/null; then pin=(taskset -c 0); fi
 
-python3 -c 'import mujoco' 2> /dev/null || {
-    echo "installing MuJoCo: pip install -r $here/requirements.txt" >&2
-    python3 -m pip install -q -r "$here/requirements.txt"
-}
+# MuJoCo: python3's own if it imports, else a virtual environment
+# (PEER_VENV, default ~/.cache/fbd-peer-venv) with requirements.txt.
+py=python3
+if ! python3 -c 'import mujoco' 2> /dev/null; then
+    venv="${PEER_VENV:-${XDG_CACHE_HOME:-$HOME/.cache}/fbd-peer-venv}"
+    if ! "$venv/bin/python" -c 'import mujoco' 2> /dev/null; then
+        echo "installing MuJoCo in $venv: pip install -r $here/requirements.txt" >&2
+        python3 -m venv "$venv"
+        "$venv/bin/python" -m pip install -q --disable-pip-version-check -r "$here/requirements.txt"
+    fi
+    py="$venv/bin/python"
+fi
+want=$(sed -n 's/^mujoco==//p' "$here/requirements.txt")
+have=$("$py" -c 'import mujoco; print(mujoco.__version__)')
+if [ "$have" != "$want" ]; then
+    echo "note: MuJoCo $have, the table in README.md was measured with $want" >&2
+fi
 
 (cd "$root" && cargo build --release -q --bin fbd)
 fbd="${CARGO_TARGET_DIR:-$root/target}/release/fbd"
@@ -98,16 +111,16 @@ for row in "${all[@]}"; do
     esac
     read -r steps best mean mx split <<< "$result"
     if [ "$model" = planar ]; then
-        mujoco=$("${pin[@]}" python3 "$here/mujoco_planar.py" "$mj" --steps "$steps" --repeat "$repeat")
+        mujoco=$("${pin[@]}" "$py" "$here/mujoco_planar.py" "$mj" --steps "$steps" --repeat "$repeat")
     else
         "$fbd" export mjcf "$config" --out "$out/$name.xml"
         extra=()
         if [ "$mj" = walk ]; then
-            python3 "$here/mujoco_hexapod.py" twin "$config" "$out/${name}_kinematic.toml"
+            "$py" "$here/mujoco_hexapod.py" twin "$config" "$out/${name}_kinematic.toml"
             "$fbd" run "$out/${name}_kinematic.toml" --out "$out/${name}_kinematic" > /dev/null
             extra=(--targets "$out/${name}_kinematic/trajectory.csv")
         fi
-        mujoco=$("${pin[@]}" python3 "$here/mujoco_hexapod.py" "$mj" "$out/$name.xml" \
+        mujoco=$("${pin[@]}" "$py" "$here/mujoco_hexapod.py" "$mj" "$out/$name.xml" \
             --steps "$steps" --repeat "$repeat" "${extra[@]}")
         notes+=("$name|$mj|$mujoco")
     fi

@@ -4,7 +4,9 @@
 //
 //   FBD_PLANAR_DIR   output folder of `fbd run` (the default experiment)
 //   FBD_HEXAPOD_DIR  output folder of a hexapod run
-//   FBD_SCREENSHOT_DIR  where viewer.png / viewer_hexapod.png are saved
+//   FBD_DYNAMIC_DIR  output folder of a dynamic (3D FBD) hexapod run
+//   FBD_SCREENSHOT_DIR  where viewer.png / viewer_hexapod.png /
+//                       viewer_hexapod_walk.png are saved
 //                       (optional)
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -277,4 +279,72 @@ test('hexapod run', async (t) => {
     screenshot: shots && join(shots, 'viewer_hexapod.png'),
     shotFrame: (v) => Math.floor(v.n / 3),
   });
+});
+
+test('dynamic hexapod run (3D FBD)', async (t) => {
+  const dir = process.env.FBD_DYNAMIC_DIR;
+  assert.ok(dir, 'FBD_DYNAMIC_DIR is not set (run scripts/test-browser.sh)');
+  const csv = readCsv(join(dir, 'trajectory.csv'));
+  // The model's legs: those with a state column.
+  const legs = [1, 2, 3, 4, 5, 6].filter((n) => csv.header.includes(`state${n}`));
+  await checkRun(t, dir, {
+    expect: (row, csv) => {
+      const e = { body: [num(row, csv, 'rx'), num(row, csv, 'ry'), num(row, csv, 'rz')] };
+      for (const n of legs) e[`foot${n}`] = ['x', 'y', 'z'].map((a) => num(row, csv, `foot${n}_${a}`));
+      return e;
+    },
+    // The body's corners (the knees are contact points, coloured by state).
+    dark: [1, 2, 3, 4, 5, 6].map((k) => `corner${k}`),
+    screenshot: shots && join(shots, 'viewer_hexapod_walk.png'),
+    shotFrame: (v) => Math.floor(v.n / 3),
+  });
+  const { page, context, errors } = await open(dir);
+  try {
+    await t.test('every foot: its state and its ground force as trajectory.csv has them', async () => {
+      const n = await page.evaluate(() => window.fbdViewer.frameCount);
+      assert.ok(await page.evaluate(() => window.fbdViewer.dynamic));
+      let touching = 0;
+      for (const i of [...new Set([0, Math.floor(n / 4), Math.floor(n / 2), Math.floor(3 * n / 4), n - 1])]) {
+        const s = await page.evaluate((i) => {
+          window.fbdViewer.seek(i);
+          return { row: window.fbdViewer.row[i], state: window.fbdViewer.state(), fc: window.fbdViewer.contactForces(), shown: window.fbdViewer.arrowsShown() };
+        }, i);
+        const row = csv.rows[s.row];
+        assert.equal(s.state.slice(0, legs.length), legs.map((n) => row[csv.col(`state${n}`)].slice(2)).join(''), `frame ${i}`);
+        let loaded = 0;
+        legs.forEach((n, k) => {
+          const want = ['fx', 'fy', 'fz'].map((a) => num(row, csv, `foot${n}_${a}`));
+          want.forEach((w, a) => assert.ok(Math.abs(s.fc[3 * k + a] - w) < 2e-6, `frame ${i} foot ${n} force ${a}: drawn ${s.fc[3 * k + a]}, trajectory.csv ${w}`));
+          if (Math.hypot(...want) > 1) loaded++;
+        });
+        // Every loaded foot has its arrow (contact forces are shown by default).
+        assert.ok(s.shown >= loaded, `frame ${i}: ${s.shown} arrows for ${loaded} loaded feet`);
+        touching += loaded;
+      }
+      assert.ok(touching > 0, 'no foot carried a force in the frames checked');
+    });
+    await t.test('every change of a foot\'s state is marked', async () => {
+      const marks = await page.evaluate(() => window.fbdViewer.events.map((e) => `${e.t} ${e.label}`));
+      // The contacts in the viewer's order: the feet, then each leg's knee
+      // and hip points when the model has them.
+      const contacts = legs.map((n) => [`state${n}`, `leg ${n} foot`]);
+      for (const n of legs) {
+        for (const [p, name] of [['kneepoint', 'knee'], ['hippoint', 'hip']]) {
+          if (csv.header.includes(`${p}${n}_state`)) contacts.push([`${p}${n}_state`, `leg ${n} ${name}`]);
+        }
+      }
+      const want = [];
+      for (let r = 1; r < csv.rows.length; r++) {
+        for (const [column, label] of contacts) {
+          const a = csv.rows[r - 1][csv.col(column)], b = csv.rows[r][csv.col(column)];
+          if (a !== b) want.push(`${Number(csv.rows[r][0])} ${label} ${a}→${b}`);
+        }
+      }
+      assert.ok(want.length > 0, 'no state change in the run');
+      assert.deepEqual(marks, want);
+    });
+    await t.test('no console error', () => assert.deepEqual(errors, []));
+  } finally {
+    await context.close();
+  }
 });

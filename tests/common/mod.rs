@@ -3,4 +3,5 @@
 
 pub mod gait;
 pub mod physics;
+pub mod spatial;
 pub mod strategies;

@@ -3,7 +3,8 @@
 //! The command-line front end of the simulator (docs/reference.md): the TOML
 //! configuration ([`config`]), the `fbd run` command writing
 //! `trajectory.csv`, `events.csv`, `summary.json`, `config.toml` and the
-//! plots ([`run`], [`output`], [`plot`]), and `fbd kinematics`
+//! plots ([`run`], [`output`], [`plot`]; a kinematic hexapod run in
+//! [`hexapod`], a dynamic one in [`spatial`]), and `fbd kinematics`
 //! ([`kinematics`]). The binary `fbd` only calls [`main_with_args`].
 //!
 //! Exit status ([`CliError::exit_code`]): 0 success, 2 usage or

@@ -467,6 +467,12 @@ fn fbd_run_of_a_dynamic_config_writes_its_files_and_view_repeats_the_page() {
             "{f} differs when rerun from config.toml"
         );
     }
+    // A planar run into the same folder removes the dynamic run's plots.
+    let o = fbd(&["run", "--out", arg(&out)]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for f in ["feet.svg", "body.svg"] {
+        assert!(!out.join(f).exists(), "{f} of the earlier run kept");
+    }
 }
 
 #[test]
@@ -520,4 +526,77 @@ fn sigint_stops_a_dynamic_run_and_keeps_its_rows() {
     for f in FILES {
         assert!(out.join(f).is_file(), "{f} missing");
     }
+}
+
+/// The hip and knee moments of `trajectory.csv` carry the actuator
+/// torques about the joint axes (the constraint moments are perpendicular
+/// to them): `hip·z0 = τ1`, `hip·z1 = τ2`, `knee·z2 = τ3`, with the D-H
+/// axes from the row's coordinates — checked on the walking example, whose
+/// joints stay inside their limits.
+#[test]
+fn the_joint_moments_carry_the_torques_about_the_joint_axes() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/hexapod_walk.toml");
+    let source = file.display().to_string();
+    let fbd_cli::Config::Hexapod(h) = fbd_cli::config::load(&file).unwrap() else {
+        panic!("not a hexapod configuration");
+    };
+    let p = h.spatial_params(&source).unwrap();
+    let r = run_into(&p, dir.path());
+    assert!(r.run.error.is_none(), "{:?}", r.run.error);
+    assert!(r.run.limit_events.is_empty(), "a joint reached its limit");
+    let csv = Csv::read(&dir.path().join("trajectory.csv"));
+    let model = HexapodModel::new(
+        p.side,
+        LegGeometry {
+            a: p.upper_length,
+            c: p.lower_length,
+        },
+        p.upper_com,
+        p.lower_com,
+    );
+    let mut d = HexapodData::new();
+    let mut largest = 0.0f64;
+    for k in 0..csv.rows.len() {
+        let mut q = [0.0; NQ];
+        for (i, name) in ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
+            .iter()
+            .enumerate()
+        {
+            q[i] = csv.f(k, name);
+        }
+        for &n in &p.legs {
+            for j in 0..3 {
+                q[6 + 3 * (n - 1) + j] = csv.f(k, &format!("theta{}_{n}", j + 1));
+            }
+        }
+        forward(&model, &HexapodConfig::from_q(&q), &mut d);
+        for &n in &p.legs {
+            let l = &d.legs[n - 1];
+            let hip = csv.v3(k, &format!("hip{n}_"), ["mx", "my", "mz"]);
+            let knee = csv.v3(k, &format!("knee{n}_"), ["mx", "my", "mz"]);
+            let dot = |m: [f64; 3], a: fbd_kinematics::nalgebra::Vector3<f64>| {
+                m[0] * a.x + m[1] * a.y + m[2] * a.z
+            };
+            for (j, got) in [
+                dot(hip, l.hip_axis),
+                dot(hip, l.upper_versor),
+                dot(knee, l.lower_versor),
+            ]
+            .into_iter()
+            .enumerate()
+            {
+                let tau = csv.f(k, &format!("tau{}_{n}", j + 1));
+                largest = largest.max(tau.abs());
+                assert!(
+                    (got - tau).abs() <= 1e-6 * (1.0 + tau.abs()),
+                    "row {k} (t = {}), leg {n}: moment about the θ{} axis {got} N·m, τ{} = {tau}",
+                    csv.rows[k][0],
+                    j + 1,
+                    j + 1
+                );
+            }
+        }
+    }
+    assert!(largest > 1.0, "the walk applied no torque ({largest} N·m)");
 }

@@ -155,7 +155,8 @@ pub enum History<'a> {
 pub struct FbdData {
     /// Kinematics at `q[k−1]`.
     pub kin_prev: PlanarData,
-    /// Kinematics at `q[k]` (positions and Jacobians).
+    /// Kinematics at `q[k]`: positions; Jacobians at `k = 0` only (see
+    /// [`advance`]).
     pub kin: PlanarData,
     /// Kinematics at the current Newton iterate of `q[k+1]`.
     pub kin_next: PlanarData,
@@ -173,9 +174,16 @@ pub struct FbdData {
     pub position_gain: f64,
     /// Scale of joint-limit rows, `Kθ = (M/Δt²)·ℓ²` (N·m/rad).
     pub limit_gain: f64,
+    /// The mechanism's total mass `M` (kg), [`Mechanism::total_mass`].
+    pub total_mass: f64,
+    /// The mechanism's length scale `ℓ` (m), [`Mechanism::length_scale`].
+    pub length_scale: f64,
     /// `kin_next` holds the positions of a candidate set by
     /// [`evaluate_next`] (and no Newton iterate since).
     next_is_candidate: bool,
+    /// The `q[k+1]` at which `kin_next`'s positions were last evaluated
+    /// (NaN before the first evaluation).
+    next_q: Vec<f64>,
     acc: Vec<[f64; 3]>,
 }
 
@@ -194,7 +202,10 @@ impl FbdData {
             dt: 0.0,
             position_gain: 0.0,
             limit_gain: 0.0,
+            total_mass: mech.total_mass(),
+            length_scale: mech.length_scale(),
             next_is_candidate: false,
+            next_q: vec![f64::NAN; mech.layout().nq],
             acc: vec![[0.0; 3]; mech.bodies.len()],
         }
     }
@@ -218,8 +229,8 @@ pub fn set_configuration(mech: &Mechanism, data: &mut FbdData, q: &[f64]) {
 /// differences, given `q[k]` already set.
 pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, dt: f64) {
     data.dt = dt;
-    data.position_gain = mech.total_mass() / (dt * dt);
-    let l = mech.length_scale();
+    data.position_gain = data.total_mass / (dt * dt);
+    let l = data.length_scale;
     data.limit_gain = data.position_gain * l * l;
     for b in 0..mech.bodies.len() {
         let x_k = FbdData::body_coords(mech, &data.kin, b);
@@ -239,26 +250,36 @@ pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, 
 
 /// Evaluates the point positions at a candidate `q[k+1]` into
 /// `data.kin_next` (after the solve, for the contact check), so that
-/// [`advance`] can accept it without evaluating them again.
+/// [`advance`] can accept it without evaluating them again. Nothing is
+/// evaluated when `kin_next` already holds the positions at exactly
+/// `q_next` (the solver's last evaluation is usually at its solution).
 pub fn evaluate_next(mech: &Mechanism, data: &mut FbdData, q_next: &[f64]) {
-    mech.chains.eval_positions(q_next, &mut data.kin_next);
+    if data.next_q != q_next {
+        mech.chains.eval_positions(q_next, &mut data.kin_next);
+        data.next_q.copy_from_slice(q_next);
+    }
     data.next_is_candidate = true;
 }
 
 /// Accepts the candidate of [`evaluate_next`]: `q[k]` becomes the previous
-/// configuration and `q[k+1]` the current one (its positions are reused,
-/// its Jacobians evaluated).
+/// configuration and `q[k+1]` the current one (its positions are reused).
+/// The Jacobians of `data.kin` are not evaluated: the step needs them at
+/// `k = 0` only ([`set_configuration`]); call
+/// [`PlanarChains::eval_jacobians`](fbd_kinematics::planar::PlanarChains::eval_jacobians)
+/// for them.
 ///
 /// # Panics
 /// If [`evaluate_next`] was not called since the last [`eval`].
-pub fn advance(mech: &Mechanism, data: &mut FbdData) {
+pub fn advance(_mech: &Mechanism, data: &mut FbdData) {
     assert!(
         data.next_is_candidate,
         "advance needs evaluate_next at the accepted configuration"
     );
     std::mem::swap(&mut data.kin_prev, &mut data.kin);
     std::mem::swap(&mut data.kin, &mut data.kin_next);
-    mech.chains.eval_jacobians(&mut data.kin);
+    // `kin_next` now holds what `kin_prev` held, which no longer matches
+    // `next_q`.
+    data.next_q.fill(f64::NAN);
     data.next_is_candidate = false;
 }
 
@@ -297,6 +318,7 @@ pub fn eval<S: JacobianSink>(
     assert_eq!(r.len(), lay.dim(), "residual vector has the wrong length");
     let nq = lay.nq;
     mech.chains.eval_positions(&z[..nq], &mut data.kin_next);
+    data.next_q.copy_from_slice(&z[..nq]);
     data.next_is_candidate = false;
     if S::ACTIVE {
         mech.chains.eval_jacobians(&mut data.kin_next);

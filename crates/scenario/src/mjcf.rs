@@ -575,6 +575,133 @@ mod tests {
         assert!((om - fd).norm() < 1e-8, "{om} vs {fd}");
     }
 
+    /// MuJoCo's forward kinematics of the document, by its documented
+    /// rule: a body's frame is its parent's composed with `pos`/`quat`; a
+    /// free joint sets the frame to `(qpos[0..3], qpos[3..7])`; each
+    /// hinge then turns the frame about its local axis by its `qpos`
+    /// (`R ← R·Rot(axis, q)`, in the order written). Returns every site's
+    /// position.
+    fn sites(doc: &roxmltree::Document, qpos: &[f64]) -> Vec<(String, Vector3<f64>)> {
+        fn attr(n: roxmltree::Node, key: &str) -> Option<Vec<f64>> {
+            n.attribute(key).map(numbers)
+        }
+        fn quat(v: &[f64]) -> UnitQuaternion<f64> {
+            UnitQuaternion::from_quaternion(fbd_kinematics::nalgebra::Quaternion::new(
+                v[0], v[1], v[2], v[3],
+            ))
+        }
+        fn walk(
+            n: roxmltree::Node,
+            p: Vector3<f64>,
+            r: UnitQuaternion<f64>,
+            qpos: &[f64],
+            next: &mut usize,
+            out: &mut Vec<(String, Vector3<f64>)>,
+        ) {
+            let pos = attr(n, "pos").map_or(Vector3::zeros(), |v| Vector3::new(v[0], v[1], v[2]));
+            let (mut p, mut r) = (
+                p + r * pos,
+                r * attr(n, "quat").map_or(UnitQuaternion::identity(), |v| quat(&v)),
+            );
+            for c in n.children().filter(|c| c.is_element()) {
+                match c.tag_name().name() {
+                    "freejoint" => {
+                        p = Vector3::new(qpos[0], qpos[1], qpos[2]);
+                        r = quat(&qpos[3..7]);
+                        *next = 7;
+                    }
+                    "joint" => {
+                        let a = attr(c, "axis").unwrap();
+                        let axis = fbd_kinematics::nalgebra::Unit::new_normalize(Vector3::new(
+                            a[0], a[1], a[2],
+                        ));
+                        r *= UnitQuaternion::from_axis_angle(&axis, qpos[*next]);
+                        *next += 1;
+                    }
+                    _ => {}
+                }
+            }
+            for c in n.children().filter(|c| c.is_element()) {
+                match c.tag_name().name() {
+                    "site" => {
+                        let v = attr(c, "pos").unwrap();
+                        out.push((
+                            c.attribute("name").unwrap().to_owned(),
+                            p + r * Vector3::new(v[0], v[1], v[2]),
+                        ));
+                    }
+                    "body" => walk(c, p, r, qpos, next, out),
+                    _ => {}
+                }
+            }
+        }
+        let world = doc
+            .descendants()
+            .find(|n| n.has_tag_name("worldbody"))
+            .unwrap();
+        let mut out = vec![];
+        let mut next = 0;
+        for b in world.children().filter(|c| c.has_tag_name("body")) {
+            walk(
+                b,
+                Vector3::zeros(),
+                UnitQuaternion::identity(),
+                qpos,
+                &mut next,
+                &mut out,
+            );
+        }
+        out
+    }
+
+    /// The exported frames put every hip, knee and tip where fbd's
+    /// kinematics does (eqs. 1–5), for the keyframe's qpos: the same check
+    /// `bench/peer/test_mjcf.py` makes in MuJoCo itself.
+    #[test]
+    fn frames_reproduce_fbd_kinematics() {
+        use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, forward};
+        use fbd_kinematics::leg::LegGeometry;
+        let mut q0 = vec![0.3, 0.5, -0.2, 0.4, -2.1, 0.3];
+        let joints = [
+            [0.1, 0.2, 4.0],
+            [-0.3, -0.1, 4.4],
+            [0.5, 0.6, 3.9],
+            [0.0, 0.0, 4.3],
+            [-0.7, 0.3, 2.0],
+            [1.1, -0.5, 4.7],
+        ];
+        q0.extend(joints.iter().flatten());
+        let p = SpatialParams {
+            q0: q0.clone(),
+            side: 0.27,
+            upper_length: 0.21,
+            lower_length: 0.4,
+            ..SpatialParams::default()
+        };
+        let xml = mjcf(&p, "robot.toml").unwrap();
+        let doc = parse(&xml);
+        let key = doc.descendants().find(|n| n.has_tag_name("key")).unwrap();
+        let got = sites(&doc, &numbers(key.attribute("qpos").unwrap()));
+        assert_eq!(got.len(), 18);
+        let model = HexapodModel::new(0.27, LegGeometry { a: 0.21, c: 0.4 }, 0.5, 0.75);
+        let mut d = HexapodData::new();
+        forward(
+            &model,
+            &HexapodConfig::from_q(&q0.clone().try_into().unwrap()),
+            &mut d,
+        );
+        for (name, at) in got {
+            let (kind, n) = name.split_at(name.len() - 1);
+            let leg = &d.legs[n.parse::<usize>().unwrap() - 1];
+            let want = match kind {
+                "hip" => leg.hip,
+                "knee" => leg.knee,
+                _ => leg.tip,
+            };
+            assert!((at - want).norm() < 1e-14, "{name}: {at} vs fbd {want}");
+        }
+    }
+
     #[test]
     fn other_terrains_are_an_error_naming_the_key() {
         let p = SpatialParams {

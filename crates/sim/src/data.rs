@@ -1,6 +1,7 @@
 //! The mutable workspace of a run ([`Data`]), built from a [`Model`].
 
 use crate::Model;
+use crate::predictor::Predictor;
 use crate::record::{Event, LimitEvent, RetryEvent};
 use fbd_contact::ContactState;
 use fbd_dynamics::{FbdData, LimitState};
@@ -16,8 +17,6 @@ pub struct Data {
     pub q_prev: Vec<f64>,
     /// `q[k−2]` (meaningful for `k ≥ 2`; the predictor's third point).
     pub q_prev2: Vec<f64>,
-    /// `q[k−3]` (meaningful for `k ≥ 3`; the predictor's fourth point).
-    pub q_prev3: Vec<f64>,
     /// `q[k]`.
     pub q: Vec<f64>,
     /// Unknowns of the step: `[q[k+1] | joint forces | contact forces]`; the
@@ -52,13 +51,8 @@ pub struct Data {
     pub external_torque: Option<[f64; crate::record::MAX_JOINTS]>,
     /// Per-row convergence scales of the current contact states.
     pub(crate) scales: Vec<f64>,
-    /// The unknowns of the last three accepted steps, newest first (the
-    /// predictor's history of the forces).
-    pub(crate) z_hist: [Vec<f64>; 3],
-    /// How many accepted steps before the last one were solved in the last
-    /// one's contact and joint-limit states, without a retry in substeps
-    /// (at most 3): how far back the predictor may extrapolate.
-    pub(crate) smooth: usize,
+    /// The predictor's histories of the accepted steps.
+    pub(crate) predictor: Predictor,
     /// Trial states of the state search.
     pub(crate) trial: Vec<ContactState>,
     /// State combinations visited in the current step's search.
@@ -110,12 +104,11 @@ impl Data {
         fbd_dynamics::set_configuration(mech, &mut fbd, &model.params.q0);
         let mut z = vec![0.0; lay.dim()];
         z[..lay.nq].copy_from_slice(&model.params.q0);
-        let z_hist = std::array::from_fn(|_| z.clone());
+        let predictor = Predictor::new(&model.params.q0, &z);
         Self {
             k: 0,
             q_prev: model.params.q0.to_vec(),
             q_prev2: model.params.q0.to_vec(),
-            q_prev3: model.params.q0.to_vec(),
             q: model.params.q0.to_vec(),
             z,
             states: model.initial_states.clone(),
@@ -127,8 +120,7 @@ impl Data {
             max_step_iterations: 0,
             external_torque: None,
             scales: vec![1.0; lay.dim()],
-            z_hist,
-            smooth: 0,
+            predictor,
             trial: model.initial_states.clone(),
             visited: Vec::with_capacity(64),
             seen: vec![0; lay.contacts],

@@ -79,7 +79,8 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
         Ok((iterations, trials)) => {
             data.max_step_iterations = data.max_step_iterations.max(iterations);
             let record = make_record(model, data, iterations, trials, model.dt());
-            accept(model, data, t);
+            let same = accept(model, data, t);
+            data.predictor.record(&data.z, same);
             data.k += 1;
             return Ok(record);
         }
@@ -196,7 +197,8 @@ fn solve(model: &Model, data: &mut Data) -> Result<(usize, usize), Failure> {
 
 /// Stage 6: events (at time `t`, attributed to step `data.k`), the trial
 /// states become the accepted ones and `q[k+1]` the current configuration.
-fn accept(model: &Model, data: &mut Data, t: f64) {
+/// `true` when the states did not change.
+fn accept(model: &Model, data: &mut Data, t: f64) -> bool {
     let mech = &model.mech;
     let k = data.k;
     for c in 0..mech.contacts.len() {
@@ -231,18 +233,14 @@ fn accept(model: &Model, data: &mut Data, t: f64) {
         }
     }
     let same = data.states == data.trial && data.limit_states == data.limit_trial;
-    data.smooth = if same { (data.smooth + 1).min(3) } else { 0 };
     data.states.copy_from_slice(&data.trial);
     data.limit_states.copy_from_slice(&data.limit_trial);
-    // Histories: q[k−3..k] and the unknowns of the last three steps.
-    data.z_hist.rotate_right(1);
-    data.z_hist[0].copy_from_slice(&data.z);
-    data.q_prev3.copy_from_slice(&data.q_prev2);
     std::mem::swap(&mut data.q_prev2, &mut data.q_prev);
     data.q_prev.copy_from_slice(&data.q);
     let nq = mech.layout().nq;
     data.q.copy_from_slice(&data.z[..nq]);
     advance(mech, &mut data.fbd);
+    same
 }
 
 /// Keeps what a failed attempt may change, to start the retry from it.
@@ -313,14 +311,14 @@ fn substeps(model: &Model, data: &mut Data, n: usize) -> Result<StepRecord, Fail
                 r.state_trials += trials;
             }
         }
-        accept(model, data, t + i as f64 * h);
+        let _ = accept(model, data, t + i as f64 * h);
     }
     // Back on the grid: the next full step continues from q[k] and q[k+1];
-    // the unknowns of the substeps are no history of the grid's forces.
+    // the predictor records the step (not its substeps) as a break of its
+    // history.
     data.q_prev.copy_from_slice(&data.grid_q);
     data.q_prev2.copy_from_slice(&data.grid_q_prev);
-    data.q_prev3.copy_from_slice(&data.grid_q_prev2);
-    data.smooth = 0;
+    data.predictor.record(&data.z, false);
     mech.chains
         .eval_positions(&data.grid_q, &mut data.fbd.kin_prev);
     Ok(record.expect("at least two substeps"))
@@ -480,63 +478,16 @@ pub fn prepare(model: &Model, data: &mut Data) {
     // 2. Joint torques at k (explicit, from q[k] and q[k−1]).
     crate::control::joint_torques(model, data);
 
-    // 3. Predictor (see `predict`).
-    predict(model, data);
+    // 3. Predictor ([`crate::predictor`]); the initial velocity at k = 0.
+    if k == 0 {
+        let nq = mech.layout().nq;
+        for i in 0..nq {
+            data.z[i] = data.q[i] + dt * model.params.qdot0[i];
+        }
+    } else {
+        data.predictor.predict(&mut data.z);
+    }
     start_search(data);
-}
-
-/// Stage 3, the predictor of step `data.k`: polynomial extrapolation of
-/// the unknowns through the last steps, so that Newton starts close to the
-/// solution (most steps then take one or two chord steps).
-///
-/// * `q[k+1]`: cubic through `q[k−3..k]` (exact, like the quadratic, for
-///   the discrete free fall), quadratic through `q[k−2..k]`, linear, or
-///   `q[0] + Δt·q̇(0)` at k = 0. The order is lowered after a change of the
-///   contact or joint-limit states: an impact changes the velocity, and the
-///   steps before it are no history of the motion after it.
-/// * the forces: quadratic through the last three steps' solutions when
-///   all three were solved in the current states, linear through two,
-///   else the last solution.
-fn predict(model: &Model, data: &mut Data) {
-    let k = data.k;
-    let nq = model.mech.layout().nq;
-    let dt = model.dt();
-    let smooth = data.smooth;
-    let qmax: usize = std::env::var("NQ_ORDER").ok().and_then(|v| v.parse().ok()).unwrap_or(3);
-    let fmax: usize = std::env::var("NF_ORDER").ok().and_then(|v| v.parse().ok()).unwrap_or(2);
-    let q_order = k.min(smooth + 1).min(qmax);
-    for i in 0..nq {
-        let q0 = data.q[i];
-        // Backward differences: exact for close coordinates, so that the
-        // extrapolation rounds once, at the end.
-        let d1 = q0 - data.q_prev[i];
-        let d2 = data.q_prev[i] - data.q_prev2[i];
-        let d3 = data.q_prev2[i] - data.q_prev3[i];
-        data.z[i] = if k == 0 {
-            q0 + dt * model.params.qdot0[i]
-        } else {
-            match q_order {
-                1 => q0 + d1,
-                2 => q0 + (2.0 * d1 - d2),
-                _ => q0 + (3.0 * (d1 - d2) + d3),
-            }
-        };
-    }
-    let [h1, h2, h3] = &data.z_hist;
-    let forces = nq..data.z.len();
-    match smooth.min(fmax) {
-        0 => data.z[forces.clone()].copy_from_slice(&h1[forces]),
-        1 => {
-            for i in forces {
-                data.z[i] = 2.0 * h1[i] - h2[i];
-            }
-        }
-        _ => {
-            for i in forces {
-                data.z[i] = 3.0 * (h1[i] - h2[i]) + h3[i];
-            }
-        }
-    }
 }
 
 /// The state search starts from the accepted states.
@@ -699,7 +650,7 @@ fn check_states(model: &Model, data: &mut Data) -> bool {
         }
     }
     // Joint limits: arrivals at once, a release competes with lift-offs.
-    let length = model.mech.length_scale();
+    let length = data.fbd.length_scale;
     let mut release: Option<(usize, f64)> = None;
     for (l, &j) in model.mech.limits.iter().enumerate() {
         let angle = data.z[model.mech.joints[j].q_index];
@@ -809,7 +760,7 @@ fn violation(model: &Model, data: &Data) -> f64 {
     let mech = &model.mech;
     let lay = mech.layout();
     let k = data.fbd.position_gain;
-    let length = mech.length_scale();
+    let length = data.fbd.length_scale;
     let mu = model.params.friction.mu_static;
     let mut worst: f64 = 0.0;
     for (c, spec) in mech.contacts.iter().enumerate() {

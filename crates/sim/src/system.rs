@@ -53,8 +53,8 @@ impl NewtonSystem for StepSystem<'_> {
 pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, extent: f64, scales: &mut [f64]) {
     let lay = mech.layout();
     let k = fbd.position_gain;
-    let force = mech.total_mass() * mech.gravity.abs().max(1.0) + 1e-6 * k * (1.0 + extent);
-    let moment = force * mech.length_scale();
+    let force = fbd.total_mass * mech.gravity.abs().max(1.0) + 1e-6 * k * (1.0 + extent);
+    let moment = force * fbd.length_scale;
     for b in 0..lay.bodies {
         let row = lay.body_row(b);
         scales[row] = force;

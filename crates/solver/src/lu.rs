@@ -15,7 +15,7 @@
 //!   [`simplicial::factorize_simplicial_numeric_lu`], called on a
 //!   [`SimplicialLu`] owned here, so that its `L` and `U` factors are at
 //!   hand. The Newton step `J Δx = −r` is solved with them by the plain
-//!   loops of [`Pattern::solve`] (row permutation, unit-lower and upper
+//!   loops of [`Factors::solve`] (row permutation, unit-lower and upper
 //!   column sweeps with the reciprocal pivots computed once per
 //!   factorisation, column permutation): the same arithmetic as faer's
 //!   `solve_in_place_with_conj`, without its generic multi-column
@@ -26,11 +26,16 @@
 //!   demand (never shrinking). Their fill depends on the numerical row
 //!   pivoting, so a later refactorisation of the same pattern could need
 //!   more room than the first one and would then allocate. To rule that
-//!   out, [`Pattern::warm_up`] factors a fully dense `n × n` matrix once
-//!   into the pattern's own storage: any `n × n` factorisation needs at
-//!   most the storage of the dense one, so every later one fits. Each
-//!   pattern keeps its own storage: a simplicial LU cannot be reused for a
-//!   smaller dimension.
+//!   out, [`Factors::new`] factors a fully dense `n × n` matrix once into
+//!   new storage: any `n × n` factorisation needs at most the storage of
+//!   the dense one, so every later one fits. The storage is shared by the
+//!   patterns of one dimension (the contact states of a run change the
+//!   pattern, seldom the dimension), so that this warm-up — a dense LU
+//!   through the sparse code, about 0.1 ms at 31 unknowns — is done once
+//!   per dimension rather than once per pattern; it holds the last
+//!   factorisation of one of them ([`Factors::holds`]). Storage is never
+//!   shared across dimensions: a simplicial LU cannot be reused for a
+//!   smaller one.
 
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::PermRef;
@@ -44,9 +49,12 @@ use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 
 use crate::SolverError;
 
-/// Cached per-pattern data: CSC structure, dense slot map, column ordering
-/// and the numeric LU of the last factorisation.
+/// Cached per-pattern data: CSC structure, dense slot map, column ordering,
+/// and the bookkeeping of its kept factorisation.
 pub(crate) struct Pattern {
+    /// Index of this pattern in the solver's cache (the owner id of
+    /// [`Factors`]).
+    id: usize,
     pub(crate) n: usize,
     pub(crate) col_ptr: Vec<usize>,
     pub(crate) row_idx: Vec<usize>,
@@ -55,23 +63,26 @@ pub(crate) struct Pattern {
     pub(crate) slot: Vec<u32>,
     /// faer's symbolic LU: the fill-reducing column permutation.
     symbolic: SymbolicLu<usize>,
-    /// Numeric `L`, `U` of the last factorisation (see the module docs).
-    lu: SimplicialLu<usize, f64>,
-    row_perm: Vec<usize>,
-    row_perm_inv: Vec<usize>,
-    /// `1 / U[j, j]` of the last factorisation.
-    pivot_inv: Vec<f64>,
-    /// Scratch of [`Self::solve`].
-    work: Vec<f64>,
-    /// `lu` holds the factorisation of a Jacobian of this pattern (not just
-    /// the dense warm-up): usable for chord steps.
-    pub(crate) factored: bool,
+    /// Index of the numeric storage of this pattern's dimension.
+    pub(crate) factors: usize,
+    /// Solves ended since the last factorisation.
+    solves_since: usize,
+    /// Chord steps taken with the last factorisation.
+    pub(crate) chords_since: usize,
+    /// Chord steps of the last solve after its last factorisation.
+    last_chords: usize,
 }
 
 impl Pattern {
     /// The CSC structure of `entries` (any order, duplicates allowed) and
-    /// its symbolic analysis. Allocates.
-    pub(crate) fn build(n: usize, entries: &mut Vec<(usize, usize)>) -> Self {
+    /// its symbolic analysis, as pattern `id` using numeric storage
+    /// `factors`. Allocates.
+    pub(crate) fn build(
+        id: usize,
+        n: usize,
+        entries: &mut Vec<(usize, usize)>,
+        factors: usize,
+    ) -> Self {
         for &(row, col) in entries.iter() {
             assert!(
                 row < n && col < n,
@@ -107,33 +118,77 @@ impl Pattern {
         let symbolic = factorize_symbolic_lu(a, params)
             .unwrap_or_else(|e| panic!("faer symbolic LU failed: {e:?}"));
         Self {
+            id,
             n,
             col_ptr,
             row_idx,
             slot,
             symbolic,
-            lu: SimplicialLu::new(),
-            row_perm: vec![0; n],
-            row_perm_inv: vec![0; n],
-            pivot_inv: vec![0.0; n],
-            work: vec![0.0; n],
-            factored: false,
+            factors,
+            solves_since: 0,
+            chords_since: 0,
+            last_chords: 0,
         }
-    }
-
-    /// Scratch that [`Self::factor`] and [`Self::warm_up`] need.
-    pub(crate) fn scratch(&self) -> StackReq {
-        factorize_simplicial_numeric_lu_scratch::<usize, f64>(self.n, self.n)
     }
 
     fn col_perm(&self) -> PermRef<'_, usize> {
         self.symbolic.col_perm()
     }
 
-    /// Grows the numeric storage to that of a dense `n × n` LU (see the
-    /// module docs). Allocates; `mem` must hold [`Self::scratch`].
-    pub(crate) fn warm_up(&mut self, mem: &mut MemBuffer) {
-        let n = self.n;
+    /// Bookkeeping at the end of a solve that took `chords` chord steps
+    /// after its last factorisation (see [`Self::renew`]).
+    pub(crate) fn solved(&mut self, chords: usize) {
+        self.solves_since += 1;
+        self.last_chords = chords;
+    }
+
+    /// The renewal rule of `NewtonParams::refactor_cost` (`cost`, in chord
+    /// steps; `0` never renews): whether the next solve should start with
+    /// a refactorisation rather than chord steps with the kept one.
+    pub(crate) fn renew(&self, cost: f64) -> bool {
+        cost > 0.0
+            && self.solves_since > 0
+            && self.last_chords as f64 * self.solves_since as f64
+                > cost + self.chords_since as f64
+    }
+}
+
+/// Numeric LU storage for the patterns of one dimension: faer's simplicial
+/// `L`, `U` and row pivoting of the last factorisation, and the scratch of
+/// the solves.
+pub(crate) struct Factors {
+    n: usize,
+    lu: SimplicialLu<usize, f64>,
+    row_perm: Vec<usize>,
+    row_perm_inv: Vec<usize>,
+    /// `1 / U[j, j]` of the last factorisation.
+    pivot_inv: Vec<f64>,
+    /// Scratch of [`Self::solve`].
+    work: Vec<f64>,
+    /// The pattern whose factorisation this holds (none after the dense
+    /// warm-up or a failed factorisation).
+    owner: Option<usize>,
+}
+
+impl Factors {
+    /// Scratch that [`Self::new`] and [`Self::factor`] need for dimension
+    /// `n`.
+    pub(crate) fn scratch(n: usize) -> StackReq {
+        factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n)
+    }
+
+    /// Storage for dimension `n`, grown to that of a dense `n × n` LU (see
+    /// the module docs). Allocates; `mem` must hold [`Self::scratch`].
+    pub(crate) fn new(n: usize, mem: &mut MemBuffer) -> Self {
+        let mut f = Self {
+            n,
+            lu: SimplicialLu::new(),
+            row_perm: vec![0; n],
+            row_perm_inv: vec![0; n],
+            pivot_inv: vec![0.0; n],
+            work: vec![0.0; n],
+            owner: None,
+        };
         // Diagonally dominant, hence nonsingular.
         let col_ptr: Vec<usize> = (0..=n).map(|j| j * n).collect();
         let row_idx: Vec<usize> = (0..n * n).map(|k| k % n).collect();
@@ -144,46 +199,61 @@ impl Pattern {
             SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx),
             &values,
         );
-        let col_perm = self.symbolic.col_perm();
+        let identity: Vec<usize> = (0..n).collect();
         factorize_simplicial_numeric_lu(
-            &mut self.row_perm,
-            &mut self.row_perm_inv,
-            &mut self.lu,
+            &mut f.row_perm,
+            &mut f.row_perm_inv,
+            &mut f.lu,
             dense,
-            col_perm,
+            PermRef::new_checked(&identity, &identity, n),
             MemStack::new(mem),
         )
         .unwrap_or_else(|e| panic!("faer dense warm-up LU failed: {e:?}"));
-        self.factored = false;
+        f
     }
 
-    /// Numeric LU of `values` (CSC order of this pattern) into the
-    /// pattern's storage, reusing its column ordering. `mem` must hold
-    /// [`Self::scratch`]. Allocation-free after [`Self::warm_up`].
+    /// The dimension.
+    pub(crate) fn dim(&self) -> usize {
+        self.n
+    }
+
+    /// Whether this holds a factorisation of `pattern` (usable for chord
+    /// steps).
+    pub(crate) fn holds(&self, pattern: &Pattern) -> bool {
+        self.owner == Some(pattern.id)
+    }
+
+    /// Numeric LU of `values` (CSC order of `pattern`), reusing its column
+    /// ordering. `mem` must hold [`Self::scratch`]. Allocation-free.
     ///
     /// # Errors
     /// [`SolverError::Singular`] when faer finds no structurally non-zero
     /// pivot for a column. (A numerically zero pivot shows up as a
     /// non-finite solution of [`Self::solve`].)
-    pub(crate) fn factor(&mut self, values: &[f64], mem: &mut MemBuffer) -> Result<(), SolverError> {
+    pub(crate) fn factor(
+        &mut self,
+        pattern: &mut Pattern,
+        values: &[f64],
+        mem: &mut MemBuffer,
+    ) -> Result<(), SolverError> {
         let n = self.n;
-        self.factored = false;
+        assert_eq!(pattern.n, n, "pattern and storage dimensions differ");
+        self.owner = None;
         let matrix = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &self.col_ptr, None, &self.row_idx),
+            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx),
             values,
         );
-        let col_perm = self.symbolic.col_perm();
         match factorize_simplicial_numeric_lu(
             &mut self.row_perm,
             &mut self.row_perm_inv,
             &mut self.lu,
             matrix,
-            col_perm,
+            pattern.col_perm(),
             MemStack::new(mem),
         ) {
             Ok(()) => {}
             Err(LuError::SymbolicSingular { index }) => {
-                let equation = self.col_perm().arrays().0[index];
+                let equation = pattern.col_perm().arrays().0[index];
                 return Err(SolverError::Singular { equation });
             }
             Err(LuError::Generic(e)) => panic!("faer numeric LU failed: {e:?}"),
@@ -195,15 +265,22 @@ impl Pattern {
         for (j, p) in self.pivot_inv.iter_mut().enumerate() {
             *p = u_val[u_ptr[j + 1] - 1].recip();
         }
-        self.factored = true;
+        self.owner = Some(pattern.id);
+        pattern.solves_since = 0;
+        pattern.chords_since = 0;
         Ok(())
     }
 
     /// Solves `J x = rhs` in place with the last factorisation
-    /// `P·J·Q = L·U` (`P`: row pivoting, `Q`: column ordering). A zero pivot
-    /// gives non-finite entries. No allocation.
-    pub(crate) fn solve(&mut self, rhs: &mut [f64]) {
+    /// `P·J·Q = L·U` (`P`: row pivoting, `Q`: `pattern`'s column ordering)
+    /// of `pattern`'s Jacobian. A zero pivot gives non-finite entries. No
+    /// allocation.
+    ///
+    /// # Panics
+    /// If this does not hold a factorisation of `pattern`.
+    pub(crate) fn solve(&mut self, pattern: &Pattern, rhs: &mut [f64]) {
         let n = self.n;
+        assert!(self.holds(pattern), "no factorisation of this pattern");
         assert_eq!(rhs.len(), n, "right-hand side has the wrong length");
         let w = &mut self.work[..n];
         for (wi, &p) in w.iter_mut().zip(&self.row_perm) {
@@ -214,10 +291,9 @@ impl Pattern {
         let (l_ptr, l_row, l_val) = (l.symbolic().col_ptr(), l.symbolic().row_idx(), l.val());
         for j in 0..n {
             let xj = w[j];
-            if xj != 0.0 {
-                for p in l_ptr[j] + 1..l_ptr[j + 1] {
-                    w[l_row[p]] -= l_val[p] * xj;
-                }
+            let (a, b) = (l_ptr[j] + 1, l_ptr[j + 1]);
+            for (&i, &v) in l_row[a..b].iter().zip(&l_val[a..b]) {
+                w[i] -= v * xj;
             }
         }
         // U: upper triangular, the diagonal last in each column.
@@ -226,13 +302,12 @@ impl Pattern {
         for j in (0..n).rev() {
             let xj = w[j] * self.pivot_inv[j];
             w[j] = xj;
-            if xj != 0.0 {
-                for p in u_ptr[j]..u_ptr[j + 1] - 1 {
-                    w[u_row[p]] -= u_val[p] * xj;
-                }
+            let (a, b) = (u_ptr[j], u_ptr[j + 1] - 1);
+            for (&i, &v) in u_row[a..b].iter().zip(&u_val[a..b]) {
+                w[i] -= v * xj;
             }
         }
-        let (col_fwd, _) = self.symbolic.col_perm().arrays();
+        let (col_fwd, _) = pattern.col_perm().arrays();
         for (&c, &wj) in col_fwd.iter().zip(w.iter()) {
             rhs[c] = wj;
         }
@@ -270,23 +345,25 @@ mod tests {
         for (n, seed) in [(5, 1), (19, 2), (31, 3), (64, 4)] {
             let triplets = matrix(n, seed);
             let mut entries: Vec<(usize, usize)> = triplets.iter().map(|t| (t.0, t.1)).collect();
-            let mut pattern = Pattern::build(n, &mut entries);
+            let mut pattern = Pattern::build(0, n, &mut entries, 0);
             let mut values = vec![0.0; pattern.row_idx.len()];
             for &(i, j, v) in &triplets {
                 values[pattern.slot[i * n + j] as usize] += v;
             }
-            let mut mem = MemBuffer::new(pattern.scratch().or(
+            let mut mem = MemBuffer::new(Factors::scratch(n).or(
                 pattern.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq).or(
                     pattern
                         .symbolic
                         .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
                 ),
             ));
-            pattern.warm_up(&mut mem);
-            pattern.factor(&values, &mut mem).expect("nonsingular");
+            let mut factors = Factors::new(n, &mut mem);
+            factors
+                .factor(&mut pattern, &values, &mut mem)
+                .expect("nonsingular");
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
             let mut ours = b.clone();
-            pattern.solve(&mut ours);
+            factors.solve(&pattern, &mut ours);
 
             let mut numeric = NumericLu::new();
             let a = SparseColMatRef::new(

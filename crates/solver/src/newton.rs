@@ -14,7 +14,7 @@
 
 use faer::dyn_stack::{MemBuffer, StackReq};
 
-use crate::lu::Pattern;
+use crate::lu::{Factors, Pattern};
 use crate::{JacobianSink, NewtonSystem, SolverError};
 
 /// Tuning parameters of [`NewtonSolver`].
@@ -77,6 +77,18 @@ pub struct NewtonParams {
     /// chord_contraction · ‖r(x)‖`, for the next step to be a chord step
     /// too. Default: `0.1`.
     pub chord_contraction: f64,
+    /// **Renewal of the kept factorisation across solves**: the cost of a
+    /// refactorisation in chord steps (its numeric LU and Jacobian, beyond
+    /// the residual and the solve a chord step costs too). A kept
+    /// factorisation grows staler from solve to solve, and the solves need
+    /// more chord steps; a solve starts with a refactorisation (at the
+    /// initial guess) when the previous solve needed more chord steps than
+    /// the average cost per solve since the last factorisation,
+    /// `(refactor_cost + chord steps since) / solves since` — the
+    /// renewal rule that minimises the average cost per solve when the
+    /// running cost grows. `0` disables it (the factorisation is renewed
+    /// only when a chord step contracts too little). Default: `0`.
+    pub refactor_cost: f64,
 }
 
 impl Default for NewtonParams {
@@ -89,6 +101,7 @@ impl Default for NewtonParams {
             max_backtracks: 8,
             chord_steps: 0,
             chord_contraction: 0.1,
+            refactor_cost: 0.0,
         }
     }
 }
@@ -137,6 +150,8 @@ pub struct NewtonSolver {
     params: NewtonParams,
     /// `(pattern key, pattern)`, in registration order.
     patterns: Vec<(u64, Pattern)>,
+    /// Numeric LU storage, one per dimension met.
+    factors: Vec<Factors>,
     /// Pattern loaded by [`Self::load_jacobian`].
     loaded: Option<usize>,
     /// Reused buffer for [`NewtonSystem::pattern`].
@@ -168,6 +183,7 @@ impl NewtonSolver {
         Self {
             params,
             patterns: Vec::new(),
+            factors: Vec::new(),
             loaded: None,
             entries: Vec::new(),
             ws: Workspace {
@@ -284,7 +300,8 @@ impl NewtonSolver {
         }
         let index = self.register(sys);
         let pattern = &mut self.patterns[index].1;
-        self.ws.run(&self.params, pattern, sys, x)
+        let factors = &mut self.factors[pattern.factors];
+        self.ws.run(&self.params, pattern, factors, sys, x)
     }
 
     /// Index in `self.patterns` of `sys`'s pattern, registered (symbolic LU,
@@ -298,11 +315,19 @@ impl NewtonSolver {
             None => {
                 self.entries.clear();
                 sys.pattern(&mut self.entries);
-                let mut pattern = Pattern::build(n, &mut self.entries);
+                self.ws.prepare(n, self.entries.len());
+                let factors = match self.factors.iter().position(|f| f.dim() == n) {
+                    Some(f) => f,
+                    None => {
+                        self.factors.push(Factors::new(n, &mut self.ws.mem));
+                        self.factors.len() - 1
+                    }
+                };
+                let id = self.patterns.len();
+                let pattern = Pattern::build(id, n, &mut self.entries, factors);
                 self.symbolic_factorizations += 1;
-                self.ws.prepare(&mut pattern);
                 self.patterns.push((key, pattern));
-                self.patterns.len() - 1
+                id
             }
         };
         let pattern = &self.patterns[index].1;
@@ -354,11 +379,12 @@ impl NewtonSolver {
             .loaded
             .expect("factorize_loaded: call load_jacobian first");
         let pattern = &mut self.patterns[index].1;
-        pattern.factor(&self.ws.values, &mut self.ws.mem)?;
+        let factors = &mut self.factors[pattern.factors];
+        factors.factor(pattern, &self.ws.values, &mut self.ws.mem)?;
         if let Some(dx) = dx {
             assert_eq!(dx.len(), pattern.n, "dx has the wrong length");
             negate(dx, &self.ws.r);
-            pattern.solve(dx);
+            factors.solve(pattern, dx);
         }
         Ok(())
     }
@@ -373,11 +399,15 @@ impl NewtonSolver {
     /// not have the system's dimension.
     pub fn solve_loaded(&mut self, dx: &mut [f64]) {
         let index = self.loaded.expect("solve_loaded: call load_jacobian first");
-        let pattern = &mut self.patterns[index].1;
-        assert!(pattern.factored, "solve_loaded: the pattern was never factored");
+        let pattern = &self.patterns[index].1;
+        let factors = &mut self.factors[pattern.factors];
+        assert!(
+            factors.holds(pattern),
+            "solve_loaded: no factorisation of the loaded pattern"
+        );
         assert_eq!(dx.len(), pattern.n, "dx has the wrong length");
         negate(dx, &self.ws.r);
-        pattern.solve(dx);
+        factors.solve(pattern, dx);
     }
 }
 
@@ -413,10 +443,9 @@ fn trial(x_trial: &mut [f64], x: &[f64], dx: &[f64], alpha: f64) {
 }
 
 impl Workspace {
-    /// Grows the reusable storage for a newly registered pattern.
-    fn prepare(&mut self, pattern: &mut Pattern) {
-        let n = pattern.n;
-        let nnz = pattern.row_idx.len();
+    /// Grows the reusable storage for a new pattern of dimension `n` with
+    /// at most `nnz` entries.
+    fn prepare(&mut self, n: usize, nnz: usize) {
         // Reserve, so that later switches between cached patterns never grow.
         self.values.reserve(nnz.saturating_sub(self.values.len()));
         for v in [
@@ -427,12 +456,11 @@ impl Workspace {
         ] {
             v.reserve(n.saturating_sub(v.len()));
         }
-        let grown = self.mem_req.or(pattern.scratch());
+        let grown = self.mem_req.or(Factors::scratch(n));
         if grown != self.mem_req {
             self.mem_req = grown;
             self.mem = MemBuffer::new(grown);
         }
-        pattern.warm_up(&mut self.mem);
     }
 
     /// Evaluates residual and Jacobian at `x` into `r` / `values`.
@@ -463,8 +491,26 @@ impl Workspace {
         &mut self,
         params: &NewtonParams,
         pattern: &mut Pattern,
+        factors: &mut Factors,
         sys: &mut S,
         x: &mut [f64],
+    ) -> Result<NewtonReport, SolverError> {
+        let mut run = 0;
+        let result = self.iterate(params, pattern, factors, sys, x, &mut run);
+        pattern.solved(run);
+        result
+    }
+
+    /// The iteration of [`Self::run`]; `run` ends as the number of chord
+    /// steps since the last factorisation.
+    fn iterate<S: NewtonSystem>(
+        &mut self,
+        params: &NewtonParams,
+        pattern: &mut Pattern,
+        factors: &mut Factors,
+        sys: &mut S,
+        x: &mut [f64],
+        run: &mut usize,
     ) -> Result<NewtonReport, SolverError> {
         let n = pattern.n;
         let nnz = pattern.row_idx.len();
@@ -478,9 +524,10 @@ impl Workspace {
         // Full Newton steps and chord steps applied to `x`, factorisations.
         let (mut full, mut chord, mut factorizations) = (0usize, 0usize, 0usize);
         // Chord steps since the last factorisation (or the start).
-        let mut run = 0usize;
+        *run = 0;
         // Whether the pattern's factorisation may serve the next step.
-        let mut usable = chords && pattern.factored;
+        let mut usable =
+            chords && factors.holds(pattern) && !pattern.renew(params.refactor_cost);
         // Whether `values` holds the Jacobian at `x` (`r` always holds the
         // residual at `x`).
         let mut have_jacobian = !usable;
@@ -492,11 +539,6 @@ impl Workspace {
         let Some(mut rnorm) = scaled_norm(sys, &self.r) else {
             return Err(SolverError::NonFinite { iter: 0 });
         };
-        if std::env::var_os("NDEBUG_CHORD").is_some() {
-            let (mut bi, mut bv) = (0, 0.0);
-            for i in 0..n { let v = self.r[i].abs() / sys.residual_scale(i); if v > bv { bv = v; bi = i; } }
-            eprintln!("S {rnorm:.3e} row {bi} {usable}");
-        }
 
         loop {
             if rnorm <= params.residual_tol {
@@ -508,10 +550,10 @@ impl Workspace {
                 });
             }
 
-            if usable && run < params.chord_steps {
+            if usable && *run < params.chord_steps {
                 // Chord step with the kept factorisation.
                 negate(&mut self.dx, &self.r);
-                pattern.solve(&mut self.dx);
+                factors.solve(pattern, &mut self.dx);
                 usable = false;
                 if self.dx.iter().all(|d| d.is_finite()) {
                     trial(&mut self.x_trial, x, &self.dx, 1.0);
@@ -523,7 +565,8 @@ impl Workspace {
                         std::mem::swap(&mut self.r, &mut self.r_trial);
                         have_jacobian = false;
                         chord += 1;
-                        run += 1;
+                        *run += 1;
+                        pattern.chords_since += 1;
                         let rate = t / rnorm;
                         rnorm = t;
                         // Keep chord steps while they contract well and, at
@@ -534,9 +577,8 @@ impl Workspace {
                         #[allow(clippy::neg_cmp_op_on_partial_ord)]
                         let on_track = rate <= params.chord_contraction
                             && (rnorm <= params.residual_tol
-                                || needed <= (params.chord_steps - run) as f64);
+                                || needed <= (params.chord_steps - *run) as f64);
                         usable = on_track;
-                        if std::env::var_os("NDEBUG_CHORD").is_some() { eprintln!("C {run} {rate:.3e} {rnorm:.3e} {on_track}"); }
                     }
                 }
                 continue;
@@ -561,10 +603,10 @@ impl Workspace {
                 return Err(SolverError::NonFinite { iter: full });
             }
             negate(&mut self.dx, &self.r);
-            pattern.factor(&self.values, &mut self.mem)?;
+            factors.factor(pattern, &self.values, &mut self.mem)?;
             factorizations += 1;
             self.numeric_factorizations += 1;
-            pattern.solve(&mut self.dx);
+            factors.solve(pattern, &mut self.dx);
             if let Some(equation) = self.dx.iter().position(|d| !d.is_finite()) {
                 // A zero pivot: 1/0 propagated through the triangular solves.
                 return Err(SolverError::Singular { equation });
@@ -644,7 +686,7 @@ impl Workspace {
             rnorm = trial_norm;
             full += 1;
             usable = chords;
-            run = 0;
+            *run = 0;
         }
     }
 }

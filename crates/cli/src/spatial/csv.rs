@@ -197,7 +197,10 @@ impl TrajectoryWriter {
         for &x in &r.q {
             self.f(x)?;
         }
-        self.feet.update(&r.q);
+        // Without a foot contact point, the foot is placed by the kinematics.
+        if slots.tips.iter().any(Option::is_none) {
+            self.feet.update(&r.q);
+        }
         for i in 0..self.layout.legs.len() {
             let tip = slots.tips[i].map(|c| &r.contacts[c]);
             let p = tip.map_or_else(|| self.feet.tip(i), |c| c.point);

@@ -175,6 +175,16 @@ fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &SpatialRecord
             d.foot_force[n - 1] = r.contacts[c].force;
             d.normal[n - 1] = r.contacts[c].normal;
         }
+        for (k, kind) in [PointKind::Knee, PointKind::Hip].into_iter().enumerate() {
+            let c = layout
+                .extra_points
+                .iter()
+                .position(|p| *p == (n, kind))
+                .and_then(|e| slots.extras[e]);
+            if let Some(c) = c {
+                d.points[n - 1][k] = (r.contacts[c].state, r.contacts[c].force);
+            }
+        }
         if let Some(l) = slots.legs[i] {
             let l = &r.legs[l];
             d.hip_force[n - 1] = l.hip_force;
@@ -246,6 +256,7 @@ impl Outputs {
                     kinematic_model(params),
                     params.terrain.clone(),
                     &layout.legs,
+                    &layout.extra_points,
                     steps.div_ceil(stride),
                     &crate::viewer::title_of(dir),
                 )
@@ -455,7 +466,15 @@ mod tests {
         let layout = Layout::of(p);
         let mut contacts = Vec::new();
         for &n in &layout.legs {
-            for kind in [PointKind::Tip, PointKind::Knee, PointKind::Hip] {
+            let cp = p.contact_points;
+            for (on, kind) in [
+                (cp.tips, PointKind::Tip),
+                (cp.knees, PointKind::Knee),
+                (cp.hips, PointKind::Hip),
+            ] {
+                if !on {
+                    continue;
+                }
                 let down = n == 4 && kind == PointKind::Tip && k >= 5;
                 contacts.push(ContactRow {
                     leg: n,
@@ -579,5 +598,39 @@ mod tests {
         }
         let feet = std::fs::read_to_string(dir.path().join("feet.svg")).unwrap();
         assert!(feet.contains("leg 4") && feet.contains("4 tip ST2"));
+    }
+
+    #[test]
+    fn feet_that_are_not_contact_points_are_placed_by_the_kinematics() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut p = SpatialParams {
+            duration: 0.002,
+            ..SpatialParams::default()
+        };
+        p.contact_points.tips = false;
+        let mut out = Outputs::new(&p, 3, Some(dir.path())).unwrap();
+        for k in 0..3 {
+            out.push(&record(&p, k), &mut |_| {});
+        }
+        let r = out.finish(&p, RunSummary::default(), "");
+        assert!(r.io_error.is_none());
+        let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        let header: Vec<&str> = lines[0].split(',').collect();
+        let row: Vec<&str> = lines[2].split(',').collect();
+        let at = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+        let mut feet = Feet::new(&p);
+        feet.update(&record(&p, 1).q);
+        for (i, n) in (1..=6).enumerate() {
+            let tip = feet.tip(i);
+            for (a, v) in ["x", "y", "z"].iter().zip(tip) {
+                assert_eq!(at(&format!("foot{n}_{a}")), ryu::Buffer::new().format(v));
+            }
+            assert_eq!(at(&format!("state{n}")), "ST1");
+            assert_eq!(at(&format!("foot{n}_fy")), "0.0");
+        }
+        // The default legs put the feet c·sin 250° = −0.395 m below the hips.
+        let ry = record(&p, 1).q[1];
+        assert!((feet.tip(0)[1] - (ry + 0.42 * 250f64.to_radians().sin())).abs() < 1e-12);
     }
 }

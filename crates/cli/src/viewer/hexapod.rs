@@ -6,16 +6,17 @@
 //!
 //! A kinematic gait run colours the feet stance (ST2) or swing (ST1). A
 //! dynamic (3D FBD) run ([`HexapodScene::dynamic`], frames carrying
-//! [`HexDynamics`]) draws only the model's legs, colours each foot
-//! ST1/ST2/ST3, draws the ground force on every foot and the hip and knee
-//! forces as arrows, and adds panels of the feet's normal forces and the
-//! knee torques.
+//! [`HexDynamics`]) draws only the model's legs, colours each foot (and
+//! each knee and hip contact point) ST1/ST2/ST3, draws the ground force on
+//! each and the hip and knee forces as arrows, and adds panels of the
+//! feet's normal forces and the knee torques.
 //!
 //! A run fills one [`HexFrame`] per row of its `trajectory.csv` and calls
 //! [`HexapodScene::push`], then [`HexapodScene::finish`] and
 //! [`super::write`]; `fbd view DIR` does the same from the CSV.
 
 use fbd_contact::{StateCode, Surface};
+use fbd_dynamics::PointKind;
 use fbd_kinematics::body::{GAMMA_DEG, LEG_COUNT};
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
 
@@ -57,6 +58,9 @@ pub struct HexDynamics {
     pub knee_force: [[f64; 3]; LEG_COUNT],
     /// Actuator torques `(τ1, τ2, τ3)` of each leg (N·m).
     pub torque: [[f64; 3]; LEG_COUNT],
+    /// State and ground force (N, inertial) of each leg's knee (`[0]`) and
+    /// hip (`[1]`) contact point, when the model has them.
+    pub points: [[(StateCode, [f64; 3]); 2]; LEG_COUNT],
 }
 
 impl Default for HexDynamics {
@@ -68,6 +72,7 @@ impl Default for HexDynamics {
             hip_force: [[0.0; 3]; LEG_COUNT],
             knee_force: [[0.0; 3]; LEG_COUNT],
             torque: [[0.0; 3]; LEG_COUNT],
+            points: [[(StateCode::St1, [0.0; 3]); 2]; LEG_COUNT],
         }
     }
 }
@@ -112,13 +117,18 @@ pub struct HexapodScene {
     model: HexapodModel,
     /// The drawn legs (leg number − 1), increasing.
     legs: Vec<usize>,
+    /// The knee and hip contact points drawn after the feet: (leg number
+    /// − 1, 0 knee / 1 hip).
+    extras: Vec<(usize, usize)>,
+    /// The event label of each contact, e.g. `leg 4 foot`.
+    labels: Vec<String>,
     dynamic: bool,
     surface: Surface,
     data: HexapodData,
     decimator: Decimator,
     rows_planned: usize,
     rows: usize,
-    last_state: Option<[StateCode; LEG_COUNT]>,
+    last_state: Option<String>,
     /// The last row pushed, when it is not a frame (kept by `finish`).
     pending: Option<(usize, HexFrame)>,
     scene: Scene,
@@ -136,25 +146,29 @@ impl HexapodScene {
     /// rows (the last pushed row is always kept).
     pub fn new(model: HexapodModel, surface: Surface, rows_planned: usize, title: &str) -> Self {
         let legs: Vec<usize> = (1..=LEG_COUNT).collect();
-        Self::with_legs(model, surface, &legs, false, rows_planned, title)
+        Self::with_legs(model, surface, &legs, &[], false, rows_planned, title)
     }
 
     /// The scene of a dynamic (3D FBD) run of the legs `legs` (numbers
-    /// 1–6): feet coloured ST1/ST2/ST3, ground and joint forces as arrows.
+    /// 1–6) with the knee and hip contact points `points` (`(leg, kind)`):
+    /// feet and points coloured ST1/ST2/ST3, ground and joint forces as
+    /// arrows.
     pub fn dynamic(
         model: HexapodModel,
         surface: Surface,
         legs: &[usize],
+        points: &[(usize, PointKind)],
         rows_planned: usize,
         title: &str,
     ) -> Self {
-        Self::with_legs(model, surface, legs, true, rows_planned, title)
+        Self::with_legs(model, surface, legs, points, true, rows_planned, title)
     }
 
     fn with_legs(
         model: HexapodModel,
         surface: Surface,
         leg_numbers: &[usize],
+        contact_points: &[(usize, PointKind)],
         dynamic: bool,
         rows_planned: usize,
         title: &str,
@@ -189,7 +203,7 @@ impl HexapodScene {
                 group: n,
             });
         }
-        let contacts: Vec<Marker> = legs
+        let mut contacts: Vec<Marker> = legs
             .iter()
             .enumerate()
             .map(|(slot, leg)| Marker {
@@ -197,6 +211,28 @@ impl HexapodScene {
                 point: leg_point(slot, 2),
             })
             .collect();
+        let mut labels: Vec<String> = legs
+            .iter()
+            .map(|leg| format!("leg {} foot", leg + 1))
+            .collect();
+        // Knee and hip contact points of a dynamic run, after the feet.
+        let mut extras = Vec::new();
+        for &(n, kind) in contact_points {
+            let (k, name) = match kind {
+                PointKind::Knee => (0, "knee"),
+                PointKind::Hip => (1, "hip"),
+                PointKind::Tip => continue,
+            };
+            let Some(slot) = legs.iter().position(|&l| l + 1 == n) else {
+                continue;
+            };
+            extras.push((n - 1, k));
+            contacts.push(Marker {
+                name: format!("{name}point{n}"),
+                point: leg_point(slot, [1, 0][k]),
+            });
+            labels.push(format!("leg {n} {name}"));
+        }
         // Joint-force arrows of a dynamic run: every hip and knee.
         let joints: Vec<Marker> = if dynamic {
             legs.iter()
@@ -219,7 +255,7 @@ impl HexapodScene {
             title: title.to_owned(),
             points,
             lines,
-            trails: contacts.iter().map(|c| c.point).collect(),
+            trails: contacts.iter().take(legs.len()).map(|c| c.point).collect(),
             contacts,
             joints,
             ring,
@@ -229,6 +265,8 @@ impl HexapodScene {
         Self {
             model,
             legs,
+            extras,
+            labels,
             dynamic,
             surface,
             data: HexapodData::new(),
@@ -248,23 +286,35 @@ impl HexapodScene {
         }
     }
 
-    /// The state of each foot in frame `f`: ST1/ST2/ST3 from a dynamic
-    /// run, swing (ST1) or stance (ST2) from a kinematic one.
-    fn states(f: &HexFrame) -> [StateCode; LEG_COUNT] {
-        match &f.dynamics {
-            Some(d) => d.state,
-            None => f
-                .stance
-                .map(|on| if on { StateCode::St2 } else { StateCode::St1 }),
-        }
+    /// The state of each contact in frame `f`, one digit each (feet,
+    /// then the knee and hip points): ST1/ST2/ST3 from a dynamic run, swing
+    /// (1) or stance (2) from a kinematic one.
+    fn states(&self, f: &HexFrame) -> String {
+        let digit = |s: StateCode| match s {
+            StateCode::St1 => '1',
+            StateCode::St2 => '2',
+            StateCode::St3 => '3',
+        };
+        let d = f.dynamics.unwrap_or_default();
+        let feet = self.legs.iter().map(|&leg| match &f.dynamics {
+            Some(d) => digit(d.state[leg]),
+            None if f.stance[leg] => '2',
+            None => '1',
+        });
+        feet.chain(
+            self.extras
+                .iter()
+                .map(|&(leg, k)| digit(d.points[leg][k].0)),
+        )
+        .collect()
     }
 
     /// Adds the next row.
     pub fn push(&mut self, f: &HexFrame) {
         let row = self.rows;
         self.rows += 1;
-        let state = Self::states(f);
-        let changed = self.last_state.is_some_and(|s| s != state);
+        let state = self.states(f);
+        let changed = self.last_state.as_ref().is_some_and(|s| *s != state);
         self.last_state = Some(state);
         let last = row + 1 >= self.rows_planned;
         if self.decimator.keep(row, changed, last) {
@@ -297,26 +347,23 @@ impl HexapodScene {
                 p.extend(v.iter().map(|x| round(*x)));
             }
         }
+        let state = self.states(f);
         let s = &mut self.scene;
         s.row.push(row);
         s.t.push(round_time(f.t));
         s.p.push(p);
-        let state = Self::states(f);
-        s.state.push(
-            self.legs
-                .iter()
-                .map(|&leg| match state[leg] {
-                    StateCode::St1 => '1',
-                    StateCode::St2 => '2',
-                    StateCode::St3 => '3',
-                })
-                .collect(),
-        );
+        s.state.push(state);
         let dynamics = f.dynamics.unwrap_or_default();
         s.fc.push(
             self.legs
                 .iter()
-                .flat_map(|&leg| dynamics.foot_force[leg].map(round))
+                .map(|&leg| dynamics.foot_force[leg])
+                .chain(
+                    self.extras
+                        .iter()
+                        .map(|&(leg, k)| dynamics.points[leg][k].1),
+                )
+                .flat_map(|v| v.map(round))
                 .collect(),
         );
         s.fj.push(if self.dynamic {
@@ -355,16 +402,16 @@ impl HexapodScene {
         s.terrain = surface_view(&self.surface, &s.p);
         for k in 1..s.state.len() {
             let (a, b) = (s.state[k - 1].as_bytes(), s.state[k].as_bytes());
-            for slot in 0..self.legs.len().min(a.len()).min(b.len()) {
+            for slot in 0..self.labels.len().min(a.len()).min(b.len()) {
                 if a[slot] != b[slot] {
-                    let n = self.legs[slot] + 1;
+                    let what = &self.labels[slot];
                     let label = if self.dynamic {
                         let st = |c: u8| format!("ST{}", c as char);
-                        format!("leg {n} foot {}→{}", st(a[slot]), st(b[slot]))
+                        format!("{what} {}→{}", st(a[slot]), st(b[slot]))
                     } else if b[slot] == b'2' {
-                        format!("leg {n} touchdown")
+                        format!("leg {} touchdown", self.legs[slot] + 1)
                     } else {
-                        format!("leg {n} lift-off")
+                        format!("leg {} lift-off", self.legs[slot] + 1)
                     };
                     s.events.push(EventMark {
                         t: s.t[k],

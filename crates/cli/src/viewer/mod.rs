@@ -12,8 +12,9 @@
 //! * [`planar`] fills a scene from the planar model's step records, during
 //!   `fbd run` or from `trajectory.csv` in `fbd view DIR`;
 //! * [`hexapod`] fills one from hexapod frames ([`hexapod::HexFrame`]: the
-//!   24 coordinates, which feet are in stance, the centre of mass), from a
-//!   gait run or from its `trajectory.csv`;
+//!   24 coordinates, which feet are in stance, the centre of mass; for a
+//!   dynamic run the feet's states and forces and the joint forces), from
+//!   a gait run, a dynamic (3D FBD) run, or their `trajectory.csv`;
 //! * [`view`] is `fbd view DIR`.
 //!
 //! Long runs are decimated to at most [`MAX_FRAMES`] frames: every k-th

@@ -315,6 +315,24 @@ pub fn spatial_frames(
             ])
         })
         .collect::<Result<_, CliError>>()?;
+    // The knee and hip contact points: (leg, 0 knee / 1 hip, state
+    // column, force columns).
+    let points: Vec<(usize, usize, usize, [usize; 3])> = layout
+        .extra_points
+        .iter()
+        .map(|&(n, kind)| {
+            let (k, prefix) = match kind {
+                fbd_dynamics::PointKind::Hip => (1, "hippoint"),
+                _ => (0, "kneepoint"),
+            };
+            Ok((
+                n,
+                k,
+                table.column(&format!("{prefix}{n}_state"))?,
+                triple(&format!("{prefix}{n}"), f)?,
+            ))
+        })
+        .collect::<Result<_, CliError>>()?;
     let mut feet = crate::spatial::Feet::new(params);
     let mut q = vec![0.0; q_cols.len()];
     let mut out = Vec::with_capacity(table.rows.len());
@@ -345,6 +363,17 @@ pub fn spatial_frames(
             d.hip_force[n - 1] = v3(cols[2])?;
             d.knee_force[n - 1] = v3(cols[3])?;
             d.torque[n - 1] = v3(cols[4])?;
+        }
+        for &(n, k, state_col, force) in &points {
+            let s = cell(row, state_col);
+            let code = state(s).ok_or_else(|| {
+                CliError::Io(format!(
+                    "{}: line {}: `{s}` is not a contact state (ST1, ST2 or ST3)",
+                    table.file.display(),
+                    r + 2
+                ))
+            })?;
+            d.points[n - 1][k] = (code, v3(force)?);
         }
         out.push(HexFrame {
             t: table.number(row, r, t_col)?,
@@ -391,6 +420,7 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
                 crate::spatial::kinematic_model(&params),
                 params.terrain.clone(),
                 &params.legs,
+                &crate::spatial::Layout::of(&params).extra_points,
                 frames.len(),
                 &title,
             );

@@ -128,8 +128,45 @@ pub struct SpatialFbdData {
     pub force: Vec<Vector3<f64>>,
     /// Per body, the sum of applied moments about its CoM at k (N·m).
     pub moment: Vec<Vector3<f64>>,
+    /// `ε = STOP_SPEED·Δt` (m) of [`slip_direction`].
+    pub slip_bias: f64,
+    /// Per contact, the slip direction `ŝ` at the last evaluated iterate
+    /// (sliding points; `(t1, t2)` components).
+    pub slip_hat: Vec<[f64; 2]>,
+    /// Per contact: the slide's friction keeps its reference direction `u`
+    /// (the planar rule, used when the implicit direction has no solution:
+    /// a slide about to stop), instead of following the step's slip.
+    pub fixed_direction: Vec<bool>,
+    /// Per contact, `max(|w|, ε)` of [`slip_direction`] at the last
+    /// evaluated iterate (m).
+    pub slip_len: Vec<f64>,
+    slip_n: Vec<f64>,
     rot_d: Vec<Matrix3<f64>>,
     next_is_candidate: bool,
+}
+
+/// Slip speed (m/s) below which a slide has stopped (1 µm/s): the friction
+/// direction is regularised below it (see [`slip_direction`]) and the
+/// state machine switches such a slide to ST2.
+pub use fbd_contact::spatial::STOP_SPEED;
+
+/// The direction of a sliding point's friction over the step (`(t1, t2)`
+/// components): `ŝ = w/max(|w|, ε)`, `w = s + ½ε·u`, with `s` the slip
+/// from `p[k]` to `p[k+1]` in the tangent plane, `u` the slide's reference
+/// direction (the last step's slip, or at the start of a slide the
+/// opposite of the force sticking needed) and `ε = STOP_SPEED·Δt`.
+/// Friction `−μD·N·ŝ` opposes the slip of the step itself (implicit, like
+/// everything at k+1) — exactly Coulomb's `s/|s|` for every slip faster
+/// than 1 µm/s; slower, it is regularised (linear in `w`), so that the
+/// equations always have a solution, and the slide counts as stopped. The
+/// bias `½ε·u` only picks the direction of a slip that has not started yet
+/// and turns a real slip's direction by at most `ε/(2|s|)` (5e-5 rad at
+/// 1 cm/s). Returns `(ŝ, max(|w|, ε))`.
+#[inline]
+pub fn slip_direction(s: [f64; 2], u: [f64; 2], eps: f64) -> ([f64; 2], f64) {
+    let w = [s[0] + 0.5 * eps * u[0], s[1] + 0.5 * eps * u[1]];
+    let len = w[0].hypot(w[1]).max(eps);
+    ([w[0] / len, w[1] / len], len)
 }
 
 impl SpatialFbdData {
@@ -152,6 +189,11 @@ impl SpatialFbdData {
             hip_dir: vec![Vector3::zeros(); nl],
             knee_dir: vec![[Vector3::zeros(); 2]; nl],
             l_next: vec![Vector3::zeros(); nb],
+            slip_bias: 0.0,
+            slip_hat: vec![[0.0; 2]; mech.contacts.len()],
+            slip_len: vec![1.0; mech.contacts.len()],
+            fixed_direction: vec![false; mech.contacts.len()],
+            slip_n: vec![0.0; mech.contacts.len()],
             force: vec![Vector3::zeros(); nb],
             moment: vec![Vector3::zeros(); nb],
             rot_d: vec![Matrix3::zeros(); nb],
@@ -190,6 +232,7 @@ pub fn prepare_step(
     dt: f64,
 ) {
     data.dt = dt;
+    data.slip_bias = STOP_SPEED * dt;
     data.position_gain = mech.total_mass() / (dt * dt);
     let l = mech.length_scale();
     data.limit_gain = data.position_gain * l * l;
@@ -393,9 +436,23 @@ pub fn eval<S: JacobianSink>(
                 }
             }
             SpatialState::Slide { dir } => {
-                r[row] = fl[0] + dir[0] * eq.mu_dynamic * fl[1];
+                let d = p - data.kin.point(mech, slot_of(spec.point), spec.kind);
+                let [t1, _, t2] = eq.frame;
+                let s = [
+                    d.x * t1[0] + d.y * t1[1] + d.z * t1[2],
+                    d.x * t2[0] + d.y * t2[1] + d.z * t2[2],
+                ];
+                let (u, len) = if data.fixed_direction[c] {
+                    (dir, f64::INFINITY)
+                } else {
+                    slip_direction(s, dir, data.slip_bias)
+                };
+                data.slip_hat[c] = u;
+                data.slip_len[c] = len;
+                data.slip_n[c] = fl[1];
+                r[row] = fl[0] + u[0] * eq.mu_dynamic * fl[1];
                 r[row + 1] = k * clearance(surface, [p.x, p.y, p.z]) + eq.regularization * fl[1];
-                r[row + 2] = fl[2] + dir[1] * eq.mu_dynamic * fl[1];
+                r[row + 2] = fl[2] + u[1] * eq.mu_dynamic * fl[1];
             }
         }
     }
@@ -492,13 +549,14 @@ fn force_entries<S: JacobianSink>(mech: &SpatialMechanism, data: &SpatialFbdData
                         jac.add(crow + i, col, eq.regularization * e[i]);
                     }
                 }
-                SpatialState::Slide { dir } => match m {
+                SpatialState::Slide { .. } => match m {
                     0 => jac.add(crow, col, 1.0),
                     2 => jac.add(crow + 2, col, 1.0),
                     _ => {
-                        jac.add(crow, col, dir[0] * eq.mu_dynamic);
+                        let u = data.slip_hat[c];
+                        jac.add(crow, col, u[0] * eq.mu_dynamic);
                         jac.add(crow + 1, col, eq.regularization);
-                        jac.add(crow + 2, col, dir[1] * eq.mu_dynamic);
+                        jac.add(crow + 2, col, u[1] * eq.mu_dynamic);
                     }
                 },
             }
@@ -567,8 +625,29 @@ fn position_entries<S: JacobianSink>(
                 let p = kin.point(mech, slot_of(spec.point), spec.kind);
                 let [gx, gz] = surface.gradient(p.x, p.z);
                 let jp = kin.contact_jacobian(mech, slot_of(spec.point), spec.kind);
+                // Friction rows: μ·N·∂ŝ/∂s·∂s/∂q, ∂ŝ/∂s = (I − ŝŝᵀ)/|w|
+                // (Coulomb) or I/ε (regularised, |w| < ε).
+                let eq = &data.contact[c];
+                let [t1, _, t2] = eq.frame;
+                let u = data.slip_hat[c];
+                let len = data.slip_len[c];
+                let g = eq.mu_dynamic * data.slip_n[c] / len;
+                let p2 = if len > data.slip_bias {
+                    [
+                        [1.0 - u[0] * u[0], -u[0] * u[1]],
+                        [-u[1] * u[0], 1.0 - u[1] * u[1]],
+                    ]
+                } else {
+                    [[1.0, 0.0], [0.0, 1.0]]
+                };
                 for (i, v) in jp.iter() {
                     jac.add(row + 1, *i, k * (v[1] - gx * v[0] - gz * v[2]));
+                    let ds = [
+                        v[0] * t1[0] + v[1] * t1[1] + v[2] * t1[2],
+                        v[0] * t2[0] + v[1] * t2[1] + v[2] * t2[2],
+                    ];
+                    jac.add(row, *i, g * (p2[0][0] * ds[0] + p2[0][1] * ds[1]));
+                    jac.add(row + 2, *i, g * (p2[1][0] * ds[0] + p2[1][1] * ds[1]));
                 }
             }
         }

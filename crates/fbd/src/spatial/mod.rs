@@ -53,9 +53,10 @@
 //!
 //! ## Contact rows
 //! As in the planar model ([`fbd_contact::spatial`]): ST1 `F = 0`; ST2
-//! `K·(p − a) + β·F = 0` (3 rows, inertial); ST3 `Ft1 + μD·u1·N = 0`,
-//! `K·(p_y − ϱ(p_x, p_z)) + β·N = 0`, `Ft2 + μD·u2·N = 0` with the unit
-//! slip direction `(u1, u2)`. Joint limits as in the planar model, the stop
+//! `K·(p − a) + β·F = 0` (3 rows, inertial); ST3 `Ft1 + μD·ŝ1·N = 0`,
+//! `K·(p_y − ϱ(p_x, p_z)) + β·N = 0`, `Ft2 + μD·ŝ2·N = 0` with `ŝ` the
+//! unit direction of the point's slip over the step, an implicit function
+//! of `q[k+1]` ([`assemble::slip_direction`]). Joint limits as in the planar model, the stop
 //! moment along the joint's axis.
 
 pub mod assemble;

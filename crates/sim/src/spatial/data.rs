@@ -66,6 +66,8 @@ pub struct SpatialData {
     pub(crate) failed_trial: Vec<SpatialState>,
     pub(crate) best_violation: f64,
     pub(crate) best_z: Vec<f64>,
+    /// The unknowns the (sub)step's search started from (the predictor).
+    pub(crate) start_z: Vec<f64>,
     pub(crate) best_trial: Vec<SpatialState>,
     pub(crate) best_limits: Vec<LimitState>,
     pub(crate) last_resort: bool,
@@ -151,6 +153,7 @@ impl SpatialData {
             failed_trial: model.initial_states.clone(),
             best_violation: f64::INFINITY,
             best_z: vec![0.0; lay.dim()],
+            start_z: vec![0.0; lay.dim()],
             best_trial: model.initial_states.clone(),
             best_limits: free,
             last_resort: false,

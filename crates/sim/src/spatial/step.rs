@@ -10,12 +10,13 @@
 //!    limit states;
 //! 5. **state check** — every touchdown and limit arrival at once, the most
 //!    violated other switch (lift-off/release, then slip, then the end of a
-//!    slide) one at a time, and a sliding point whose slip turned takes the
-//!    new direction ([`fbd_contact::spatial`]); back to 4 until no point
-//!    switches. A repeated combination is a cycle: a point that
+//!    slide) one at a time ([`fbd_contact::spatial`]); back to 4 until no
+//!    point switches. A repeated combination is a cycle: a point that
 //!    flip-flopped between ST1 and ST2 is tried in ST3, then the least
 //!    inconsistent combination is taken if its violation is negligible;
-//! 6. **accept** — record, events, `q[k+1]` becomes the current state.
+//! 6. **accept** — record, events, `q[k+1]` becomes the current state; a
+//!    sliding point's reference direction becomes the step's slip
+//!    direction.
 //!
 //! A step that cannot be solved is retried as 2, 4, … substeps down to
 //! `Δt/max_substeps`, exactly as in the planar model.
@@ -37,9 +38,6 @@ use fbd_solver::{NewtonSolver, NewtonSystem, SolverError};
 
 /// Most solves of one (sub)step's state search.
 const MAX_STATE_TRIALS: usize = 64;
-/// Rounds of slip-direction updates per (sub)step; later turns are
-/// accepted as they are (the direction then lags by less than a step).
-const MAX_DIRECTION_ROUNDS: usize = 16;
 /// A joint past an end by more than this (rad) reaches the limit.
 const LIMIT_ANGLE_TOL: f64 = 1e-10;
 /// The step length at which the contact rows carry the regularisation
@@ -192,6 +190,8 @@ pub fn prepare(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimEr
 }
 
 fn start_search(data: &mut SpatialData) {
+    data.start_z.copy_from_slice(&data.z);
+    data.fbd.fixed_direction.fill(false);
     data.best_violation = f64::INFINITY;
     data.trial.copy_from_slice(&data.states);
     data.limit_trial.copy_from_slice(&data.limit_states);
@@ -246,6 +246,17 @@ fn system<'a>(
     (sys, &mut data.solver, &mut data.z)
 }
 
+/// Stage 4's system for the accepted states of `data` (for benchmarks,
+/// which time the assembly and the factorisation apart).
+pub fn system_for_bench<'a>(
+    model: &'a SpatialModel,
+    data: &'a mut SpatialData,
+) -> SpatialSystem<'a> {
+    data.trial.copy_from_slice(&data.states);
+    data.limit_trial.copy_from_slice(&data.limit_states);
+    system(model, data).0
+}
+
 /// Convergence scales: forces to `1e-9 ×` the weight with a round-off
 /// floor, moments times the length scale, positions to `1e-12 m`-ish (as
 /// the planar model's).
@@ -276,25 +287,33 @@ fn row_scales(model: &SpatialModel, data: &mut SpatialData) {
     }
 }
 
-/// What the state check found.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Check {
-    Consistent,
-    Turned,
-    Switched,
-}
-
 /// Stages 4–5 for the current (sub)step.
 fn solve(model: &SpatialModel, data: &mut SpatialData) -> Result<(usize, usize), Failure> {
     let nq = model.nq();
     let mut fallback_used = false;
     let mut newton_iterations = 0;
     let mut trials = 0;
-    let mut direction_rounds = 0;
     loop {
         trials += 1;
         let (mut sys, solver, z) = system(model, data);
-        let report = solver.solve(&mut sys, z).map_err(Failure::Newton)?;
+        let report = match solver.solve(&mut sys, z) {
+            Ok(report) => report,
+            Err(e) => {
+                // A slide about to stop can leave the implicit friction
+                // direction without a solution (the direction of a
+                // vanishing slip is undefined): the slides keep their
+                // reference direction (the planar rule); if that fails too
+                // the slowest sliding point sticks (under p[k]) and the
+                // search goes on; without one, the step fails.
+                if trials < MAX_STATE_TRIALS
+                    && (fix_slides(data) || stop_slowest_slide(model, data))
+                {
+                    data.z.copy_from_slice(&data.start_z);
+                    continue;
+                }
+                return Err(Failure::Newton(e));
+            }
+        };
         newton_iterations += report.iterations;
         if data.z.iter().any(|v| !v.is_finite()) {
             return Err(Failure::NonFinite {
@@ -309,16 +328,8 @@ fn solve(model: &SpatialModel, data: &mut SpatialData) -> Result<(usize, usize),
             data.best_trial.copy_from_slice(&data.trial);
             data.best_limits.copy_from_slice(&data.limit_trial);
         }
-        let allow_turn = direction_rounds < MAX_DIRECTION_ROUNDS;
-        match check_states(model, data, allow_turn) {
-            Check::Consistent => break,
-            Check::Turned => {
-                direction_rounds += 1;
-                if trials < MAX_STATE_TRIALS {
-                    continue;
-                }
-            }
-            Check::Switched => {}
+        if !check_states(model, data) {
+            break;
         }
         let mut key = states_key(data);
         if data.visited.contains(&key) && !fallback_used {
@@ -348,6 +359,36 @@ fn solve(model: &SpatialModel, data: &mut SpatialData) -> Result<(usize, usize),
     Ok((newton_iterations, trials))
 }
 
+/// Fixes the friction direction of every sliding point of the trial at
+/// its reference direction; `false` if there was none to fix.
+fn fix_slides(data: &mut SpatialData) -> bool {
+    let mut any = false;
+    for (c, state) in data.trial.iter().enumerate() {
+        if matches!(state, SpatialState::Slide { .. }) && !data.fbd.fixed_direction[c] {
+            data.fbd.fixed_direction[c] = true;
+            any = true;
+        }
+    }
+    any
+}
+
+/// Sticks the sliding point of the trial whose slip at the last evaluated
+/// iterate is the smallest; `false` without sliding points.
+fn stop_slowest_slide(model: &SpatialModel, data: &mut SpatialData) -> bool {
+    let slowest = (0..data.trial.len())
+        .filter(|&c| matches!(data.trial[c], SpatialState::Slide { .. }))
+        .min_by(|&a, &b| data.fbd.slip_len[a].total_cmp(&data.fbd.slip_len[b]));
+    let Some(c) = slowest else {
+        return false;
+    };
+    let spec = &model.mech.contacts[c];
+    let p = data.fbd.kin.point(&model.mech, spec.point / 3, spec.kind);
+    data.trial[c] = SpatialState::Stick {
+        anchor: project(&model.params.terrain, [p.x, p.y, p.z]),
+    };
+    true
+}
+
 /// The trial of contact `c` from the last solution.
 fn trial_of(model: &SpatialModel, data: &SpatialData, c: usize) -> SpatialTrial {
     let mech = &model.mech;
@@ -370,13 +411,12 @@ fn trial_of(model: &SpatialModel, data: &SpatialData, c: usize) -> SpatialTrial 
 }
 
 /// Applies the switching rules to the trial solution (see the module
-/// docs).
-fn check_states(model: &SpatialModel, data: &mut SpatialData, allow_turn: bool) -> Check {
+/// docs); `true` if any point or limit switched.
+fn check_states(model: &SpatialModel, data: &mut SpatialData) -> bool {
     let mech = &model.mech;
     let lay = mech.layout();
     let mu_s = model.params.friction.mu_static;
     let mut touchdown = false;
-    let mut turned = false;
     let mut best: Option<(usize, SpatialState, f64)> = None;
     for c in 0..mech.contacts.len() {
         let trial = trial_of(model, data, c);
@@ -399,12 +439,6 @@ fn check_states(model: &SpatialModel, data: &mut SpatialData, allow_turn: bool) 
             (SpatialState::Free, _) => {
                 data.trial[c] = next;
                 touchdown = true;
-            }
-            (SpatialState::Slide { .. }, SpatialState::Slide { .. }) => {
-                if allow_turn {
-                    data.trial[c] = next;
-                    turned = true;
-                }
             }
             (SpatialState::Slide { .. }, SpatialState::Stick { .. }) if stick_failed => {}
             (_, SpatialState::Free) => {
@@ -461,14 +495,10 @@ fn check_states(model: &SpatialModel, data: &mut SpatialData, allow_turn: bool) 
             && best.is_none_or(|b| priority > b.2)
         {
             data.limit_trial[l] = LimitState::Free;
-            return Check::Switched;
+            return true;
         }
         let Some((c, next, _)) = best else {
-            return if turned {
-                Check::Turned
-            } else {
-                Check::Consistent
-            };
+            return false;
         };
         if data.seen[c] & 0b100 != 0
             && matches!(data.trial[c], SpatialState::Stick { .. })
@@ -479,7 +509,7 @@ fn check_states(model: &SpatialModel, data: &mut SpatialData, allow_turn: bool) 
         data.trial[c] = next;
     }
     rigid_anchors(model, data);
-    Check::Switched
+    true
 }
 
 /// Anchors of points that share a rigid body (as in the planar model): on
@@ -563,8 +593,11 @@ fn violation(model: &SpatialModel, data: &SpatialData) -> f64 {
                 (-t.n).max(0.0) + (t.ft[0].hypot(t.ft[1]) - mu * t.n).max(0.0)
             }
             SpatialState::Slide { dir } => {
+                // A slide slower than the stop speed carries less than μD·N
+                // (regularised direction): that deficit is a violation too.
                 let s = t.slip();
-                (-t.n).max(0.0) + k * (-(s[0] * dir[0] + s[1] * dir[1])).max(0.0)
+                let deficit = model.params.friction.mu_dynamic * t.n - t.ft[0].hypot(t.ft[1]);
+                (-t.n).max(0.0) + k * (-(s[0] * dir[0] + s[1] * dir[1])).max(0.0) + deficit.max(0.0)
             }
         };
         worst = worst.max(v);
@@ -645,6 +678,12 @@ fn accept(model: &SpatialModel, data: &mut SpatialData, t: f64) {
         }
     }
     data.states.copy_from_slice(&data.trial);
+    // A slide's reference direction follows its slip.
+    for (c, state) in data.states.iter_mut().enumerate() {
+        if let SpatialState::Slide { dir } = state {
+            *dir = data.fbd.slip_hat[c];
+        }
+    }
     data.limit_states.copy_from_slice(&data.limit_trial);
     std::mem::swap(&mut data.q_prev2, &mut data.q_prev);
     data.q_prev.copy_from_slice(&data.q);

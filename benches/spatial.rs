@@ -1,0 +1,130 @@
+//! The 3D (spatial) engine, stage by stage, on the six-legged robot at
+//! Δt = 1 ms: the assembly of the residual and analytic Jacobian
+//! (standing on six feet: 96 unknowns), its sparse LU (faer, symbolic
+//! factorisation cached per contact pattern) and one whole step standing
+//! (PD stance on six sticking feet) and walking (the tripod gait tracked by
+//! PD, `examples/hexapod_walk.toml`, steps 0.5–2.5 s).
+//!
+//! `cargo bench -p fbd-suite --bench spatial`
+
+use std::hint::black_box;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use fbd_dynamics::spatial::{eval, pattern};
+use fbd_dynamics::{JacobianSink, NoJacobian};
+use fbd_scenario::Config;
+use fbd_sim::spatial::{SpatialData, SpatialModel, step};
+use fbd_solver::NewtonSolver;
+
+fn example(name: &str) -> SpatialModel {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name);
+    let file = path.display().to_string();
+    let Config::Hexapod(h) = fbd_scenario::load(&path).expect("example loads") else {
+        panic!("{file} is a hexapod file")
+    };
+    SpatialModel::new(&h.spatial_params(&file).expect("parameters")).expect("model")
+}
+
+/// A model and a workspace after `warm` steps.
+fn warmed(model: &SpatialModel, warm: usize) -> SpatialData {
+    let mut data = SpatialData::new(model);
+    for _ in 0..warm {
+        step(model, &mut data).expect("warm-up step");
+    }
+    data
+}
+
+struct Dense<'a>(&'a mut [f64], usize);
+impl JacobianSink for Dense<'_> {
+    const ACTIVE: bool = true;
+    fn add(&mut self, r: usize, c: usize, v: f64) {
+        self.0[r * self.1 + c] += v;
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let stand = example("hexapod_stand.toml");
+    let walk = example("hexapod_walk.toml");
+
+    // Assembly at a standing state (all feet sticking).
+    let mut data = warmed(&stand, 500);
+    let n = stand.mech.layout().dim();
+    let z = data.z.clone();
+    let mut r = vec![0.0; n];
+    c.bench_function("spatial/assembly_residual", |b| {
+        b.iter(|| {
+            eval(
+                &stand.mech,
+                &stand.params.terrain,
+                &mut data.fbd,
+                black_box(&z),
+                &mut r,
+                &mut NoJacobian,
+            )
+        })
+    });
+    let mut dense = vec![0.0; n * n];
+    c.bench_function("spatial/assembly_residual_and_jacobian_dense", |b| {
+        b.iter(|| {
+            dense.fill(0.0);
+            eval(
+                &stand.mech,
+                &stand.params.terrain,
+                &mut data.fbd,
+                black_box(&z),
+                &mut r,
+                &mut Dense(&mut dense, n),
+            )
+        })
+    });
+    let mut entries = Vec::new();
+    pattern(&stand.mech, &data.fbd, &mut entries);
+    println!(
+        "standing: {n} unknowns, {} structural entries",
+        entries.len()
+    );
+
+    // Factorisation: load the Jacobian into the solver's cached pattern
+    // and factor it (numeric LU), as one full Newton iteration does.
+    let mut solver = NewtonSolver::new(stand.newton);
+    {
+        let mut sys = fbd_sim::spatial::step::system_for_bench(&stand, &mut data);
+        solver.load_jacobian(&mut sys, &z);
+    }
+    c.bench_function("spatial/numeric_lu", |b| {
+        b.iter(|| solver.factorize_loaded(None).expect("factorisation"))
+    });
+
+    // One whole step, standing and walking.
+    for (name, model, from) in [("stand", &stand, 500usize), ("walk", &walk, 500usize)] {
+        c.bench_function(&format!("spatial/step_{name}"), |b| {
+            b.iter_custom(|iters| {
+                let mut total = Duration::ZERO;
+                let mut data = warmed(model, from);
+                let mut k = from;
+                for _ in 0..iters {
+                    if k >= (from + 2000).min(model.steps - 1) {
+                        data = warmed(model, from);
+                        k = from;
+                    }
+                    let t = Instant::now();
+                    step(model, &mut data).expect("step");
+                    total += t.elapsed();
+                    k += 1;
+                }
+                total
+            })
+        });
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().measurement_time(Duration::from_secs(2)).warm_up_time(Duration::from_secs(1));
+    targets = bench
+}
+criterion_main!(benches);

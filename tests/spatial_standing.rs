@@ -1,0 +1,64 @@
+//! The 3D robot standing on its six feet, held by PD joints: once at rest
+//! the normal forces carry the weight, and every joint torque equals its
+//! static value `−a·[(tip − o) × F + Σ (c − o) × m·g]` from the foot force
+//! `F` and the weights of the links beyond the joint (axis `a` through the
+//! joint point `o`) — the reported forces and torques agree with statics.
+
+use fbd_dynamics::spatial::{SpatialKin, lower_body, upper_body};
+use fbd_kinematics::nalgebra::Vector3;
+use fbd_sim::spatial::{SpatialModel, run_collect};
+
+mod common;
+use common::spatial::stance;
+
+#[test]
+fn at_rest_the_forces_and_torques_are_the_static_ones() {
+    let p = stance();
+    let model = SpatialModel::new(&p).unwrap();
+    let (rows, summary) = run_collect(&model);
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    let last = rows.last().unwrap();
+    let mech = &model.mech;
+    let weight = mech.total_mass() * p.gravity;
+    let normal: f64 = last.contacts.iter().map(|c| c.force[1]).sum();
+    println!("Σ N = {normal:.9} N, weight {weight:.9} N, events {}", summary.events.len());
+    assert!((normal - weight).abs() < 1e-6 * weight, "Σ N = {normal}, weight {weight}");
+    for c in &last.contacts {
+        assert_eq!(c.state.as_str(), if c.kind.as_str() == "tip" { "ST2" } else { "ST1" });
+    }
+    let mut kin = SpatialKin::new(&model.mech);
+    kin.eval(mech, &last.q);
+    let g = Vector3::new(0.0, -p.gravity, 0.0);
+    let mut worst: f64 = 0.0;
+    for (s, leg) in last.legs.iter().enumerate() {
+        let foot = last
+            .contacts
+            .iter()
+            .find(|c| c.leg == leg.leg && c.kind.as_str() == "tip")
+            .unwrap();
+        let f = Vector3::from(foot.force);
+        let l = &kin.fk.legs[leg.leg - 1];
+        let (u, lo) = (upper_body(s), lower_body(s));
+        let w = |b: usize, o: &Vector3<f64>| (kin.com[b] - o).cross(&(mech.bodies[b].mass * g));
+        let outboard_hip = (l.tip - l.hip).cross(&f) + w(u, &l.hip) + w(lo, &l.hip);
+        let outboard_knee = (l.tip - l.knee).cross(&f) + w(lo, &l.knee);
+        let want = [
+            -l.hip_axis.dot(&outboard_hip),
+            -l.upper_versor.dot(&outboard_hip),
+            -l.lower_versor.dot(&outboard_knee),
+        ];
+        for j in 0..3 {
+            let d = (leg.torque[j] - want[j]).abs();
+            worst = worst.max(d);
+            assert!(
+                d < 1e-5 * (1.0 + want[j].abs()),
+                "leg {} θ{}: torque {} vs static {}",
+                leg.leg,
+                j + 1,
+                leg.torque[j],
+                want[j]
+            );
+        }
+    }
+    println!("max |τ − τ_static| = {worst:.2e} N·m");
+}

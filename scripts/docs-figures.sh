@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates the plots the README shows, in docs/: forces.svg, joints.svg
 # and energy.svg of the default experiment, the gait diagram and footprints
-# of examples/hexapod_tripod.toml, and the sweep plot of
+# of examples/hexapod_tripod.toml, the feet's normal forces and the joint
+# torques of examples/hexapod_walk.toml, and the sweep plot of
 # examples/sweep_friction_height.toml. (The viewer screenshots docs/viewer.png
 # and docs/viewer_hexapod.png are taken by scripts/test-browser.sh.)
 set -euo pipefail
@@ -20,7 +21,11 @@ done
 for f in gait footprints; do
   cp "$runs/tripod/$f.svg" "docs/hexapod_tripod_$f.svg"
 done
+"$fbd" run examples/hexapod_walk.toml --out "$runs/walk" >/dev/null
+for f in feet torques; do
+  cp "$runs/walk/$f.svg" "docs/hexapod_walk_$f.svg"
+done
 "$fbd" sweep examples/sweep_friction_height.toml --out "$runs/sweep" --plot slip4 \
   >/dev/null 2>&1
 cp "$runs/sweep/sweep.svg" docs/sweep_friction_height.svg
-echo "docs/: forces.svg joints.svg energy.svg hexapod_tripod_gait.svg hexapod_tripod_footprints.svg sweep_friction_height.svg"
+echo "docs/: forces.svg joints.svg energy.svg hexapod_tripod_gait.svg hexapod_tripod_footprints.svg hexapod_walk_feet.svg hexapod_walk_torques.svg sweep_friction_height.svg"

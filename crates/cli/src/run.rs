@@ -216,8 +216,9 @@ pub struct Simulated {
 /// writes the files of `fbd run` there, streaming `trajectory.csv`. A
 /// simulation error does not make this fail: it is in `run.error`, with
 /// every file written. The run stops before its next step once `stop` is
-/// set (`run.interrupted`). Fails for a hexapod configuration, an invalid
-/// model or an output directory that cannot be created.
+/// set (`run.interrupted`). Fails for a hexapod configuration (see
+/// [`crate::spatial::simulate`] and [`crate::hexapod::simulate`]), an
+/// invalid model or an output directory that cannot be created.
 pub fn simulate(
     config: &Config,
     source: &str,
@@ -229,7 +230,7 @@ pub fn simulate(
         Config::Planar(c) => c,
         Config::Hexapod(_) => {
             return Err(CliError::Usage(format!(
-                "{source}: model = \"hexapod\": the 3D dynamics are not implemented yet; `fbd kinematics {source}` works for hexapod configurations"
+                "{source}: model = \"hexapod\": a hexapod runs in `fbd_cli::spatial::simulate` (the 3D dynamics) or `fbd_cli::hexapod::simulate` (the kinematic gait), not in the planar `simulate`"
             )));
         }
     };

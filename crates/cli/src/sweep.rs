@@ -71,6 +71,28 @@ pub const HEXAPOD_COLUMNS: [&str; 12] = [
     "error",
 ];
 
+/// The fixed columns of `index.csv` of a sweep of the hexapod's 3D FBD
+/// dynamics, after `run, status` and the varied keys: the horizontal
+/// distance the body moved and its final height (m), the largest joint
+/// torque (N·m) and foot normal force (N), the first touchdown of any foot
+/// (s), the number of slip events of the feet (a foot entering ST3), of
+/// all events (`events.csv`), the Newton iterations and steps per second
+/// of the run, then as for the planar model.
+pub const DYNAMIC_COLUMNS: [&str; 12] = [
+    "distance",
+    "final_height",
+    "peak_torque",
+    "peak_foot_n",
+    "first_touchdown",
+    "foot_slips",
+    "events",
+    "newton_iterations",
+    "steps_per_second",
+    "steps",
+    "wall_seconds",
+    "error",
+];
+
 /// Which model a sweep runs, and so which columns `index.csv` has.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum IndexKind {
@@ -79,6 +101,8 @@ pub enum IndexKind {
     Planar,
     /// The hexapod's kinematic gait: [`HEXAPOD_COLUMNS`].
     Hexapod,
+    /// The hexapod's 3D FBD dynamics: [`DYNAMIC_COLUMNS`].
+    Dynamic,
 }
 
 impl IndexKind {
@@ -87,12 +111,14 @@ impl IndexKind {
         match self {
             IndexKind::Planar => &COLUMNS,
             IndexKind::Hexapod => &HEXAPOD_COLUMNS,
+            IndexKind::Dynamic => &DYNAMIC_COLUMNS,
         }
     }
 
     fn of(config: &Config) -> Self {
         match config {
             Config::Planar(_) => IndexKind::Planar,
+            Config::Hexapod(h) if h.is_dynamic() => IndexKind::Dynamic,
             Config::Hexapod(_) => IndexKind::Hexapod,
         }
     }
@@ -100,16 +126,20 @@ impl IndexKind {
 
 /// Columns `--plot` accepts: `touchdown`, the first touchdown of either
 /// tip (the default; `distance` for a hexapod sweep), and the numeric
-/// columns of `index.csv` (all of [`COLUMNS`] and [`HEXAPOD_COLUMNS`] but
-/// `error`).
+/// columns of `index.csv` (all of [`COLUMNS`], [`HEXAPOD_COLUMNS`] and
+/// [`DYNAMIC_COLUMNS`] but `error`), each once.
 pub fn plot_columns() -> impl Iterator<Item = &'static str> {
-    std::iter::once("touchdown").chain(
-        COLUMNS
-            .iter()
-            .chain(&HEXAPOD_COLUMNS[..9])
-            .copied()
-            .filter(|c| *c != "error"),
-    )
+    let mut seen: Vec<&'static str> = vec!["touchdown"];
+    for c in COLUMNS
+        .iter()
+        .chain(&HEXAPOD_COLUMNS)
+        .chain(&DYNAMIC_COLUMNS)
+    {
+        if *c != "error" && !seen.contains(c) {
+            seen.push(c);
+        }
+    }
+    seen.into_iter()
 }
 
 /// Marker written in a run directory after all its files.
@@ -566,6 +596,7 @@ pub fn read_index(path: &Path, nkeys: usize) -> Result<(IndexKind, Vec<Row>), Cl
     let mut r = csv::Reader::from_path(path)
         .map_err(|e| CliError::Io(format!("{}: {e}", path.display())))?;
     let kind = match r.headers() {
+        Ok(h) if h.get(3 + nkeys) == Some(DYNAMIC_COLUMNS[1]) => IndexKind::Dynamic,
         Ok(h) if h.get(2 + nkeys) == Some(HEXAPOD_COLUMNS[0]) => IndexKind::Hexapod,
         _ => IndexKind::Planar,
     };
@@ -602,6 +633,9 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
     let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
     let s: serde_json::Value = serde_json::from_str(&text).ok()?;
     let num = |v: &serde_json::Value| v.as_f64();
+    if s["model"] == "hexapod" && s["run"] == "dynamic" {
+        return Some(dynamic_row(&s, run, values));
+    }
     if s["model"] == "hexapod" {
         let liftoffs = s["events"]
             .as_array()
@@ -648,6 +682,51 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
         kind: IndexKind::Planar,
         error: s["error"].as_str().unwrap_or("").replace('\n', " "),
     })
+}
+
+/// The row of a finished dynamic hexapod run, from its `summary.json`
+/// ([`DYNAMIC_COLUMNS`]).
+fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
+    let num = |v: &serde_json::Value| v.as_f64();
+    let events = s["events"].as_array();
+    let foot_slips = events.map(|e| {
+        e.iter()
+            .filter(|e| e["point"] == "tip" && e["to"] == "ST3" && e["from"] != "ST3")
+            .count() as f64
+    });
+    // The earliest touchdown of any foot; the largest normal force of any
+    // foot (the knees and hips are contact points too, but not feet).
+    let first_touchdown = s["first_touchdown"].as_object().and_then(|m| {
+        m.values()
+            .filter_map(serde_json::Value::as_f64)
+            .reduce(f64::min)
+    });
+    let peak_foot_n = s["peak_contact_force"].as_object().and_then(|m| {
+        m.iter()
+            .filter(|(k, _)| k.starts_with("tip"))
+            .filter_map(|(_, v)| v["n"].as_f64())
+            .reduce(f64::max)
+    });
+    Row {
+        run,
+        status: s["status"].as_str().unwrap_or("error").to_owned(),
+        values,
+        numbers: [
+            num(&s["distance"]),
+            num(&s["final_height"]),
+            num(&s["peak_torque_max"]),
+            peak_foot_n,
+            first_touchdown,
+            foot_slips,
+            events.map(|e| e.len() as f64),
+            num(&s["newton_iterations"]),
+            num(&s["steps_per_second"]),
+            num(&s["steps"]),
+            num(&s["wall_seconds"]),
+        ],
+        kind: IndexKind::Dynamic,
+        error: s["error"].as_str().unwrap_or("").replace('\n', " "),
+    }
 }
 
 /// A finished run with status ok whose config.toml is the one planned
@@ -751,6 +830,10 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         match &c {
             Config::Planar(p) => {
                 p.model(&base_name).map_err(|e| fail(e.to_string()))?;
+            }
+            Config::Hexapod(h) if h.is_dynamic() => {
+                h.spatial_model(&base_name)
+                    .map_err(|e| fail(e.to_string()))?;
             }
             Config::Hexapod(h) => {
                 h.gait_model(&base_name).map_err(|e| fail(e.to_string()))?;
@@ -911,9 +994,9 @@ fn write_plot(
 }
 
 /// The plotted column: `distance` for the default `touchdown` of a
-/// hexapod sweep (no contact dynamics, no touchdowns of the planar tips).
+/// hexapod sweep (no touchdowns of the planar tips).
 fn default_plot(kind: IndexKind, column: &str) -> &str {
-    if kind == IndexKind::Hexapod && column == "touchdown" {
+    if kind != IndexKind::Planar && column == "touchdown" {
         "distance"
     } else {
         column

@@ -14,14 +14,16 @@
 //! * The numeric LU is faer's
 //!   [`simplicial::factorize_simplicial_numeric_lu`], called on a
 //!   [`SimplicialLu`] owned here, so that its `L` and `U` factors are at
-//!   hand. The Newton step `J Δx = −r` is solved with them by the plain
-//!   loops of [`Factors::solve`] (row permutation, unit-lower and upper
-//!   column sweeps with the reciprocal pivots computed once per
-//!   factorisation, column permutation): the same arithmetic as faer's
-//!   `solve_in_place_with_conj`, without its generic multi-column
-//!   machinery, which cost about six times as much on these sizes — it
-//!   matters because a chord step (a step with a kept factorisation) is
-//!   one residual and one solve.
+//!   hand. After each factorisation they are copied into two flat lists of
+//!   updates `w[i] −= v·w[j]` in elimination order ([`Factors::factor`]):
+//!   `L`'s, and `U`'s with each column divided by its pivot, so that the
+//!   Newton step `J Δx = −r` is the row permutation, one pass over each
+//!   list, and the column permutation with the reciprocal pivots
+//!   ([`Factors::solve`]) — the arithmetic of faer's
+//!   `solve_in_place_with_conj`, without its per-column and generic
+//!   multi-column machinery, which cost about twice as much on these sizes.
+//!   It matters because a chord step (a step with a kept factorisation) is
+//!   one residual and one solve, and most steps are chord steps.
 //! * faer's simplicial numeric LU stores `L`/`U` in `Vec`s that it grows on
 //!   demand (never shrinking). Their fill depends on the numerical row
 //!   pivoting, so a later refactorisation of the same pattern could need
@@ -153,9 +155,17 @@ impl Pattern {
     }
 }
 
+/// One update `w[i] −= v·w[j]` of a triangular sweep.
+#[derive(Clone, Copy, Debug)]
+struct Update {
+    i: u32,
+    j: u32,
+    v: f64,
+}
+
 /// Numeric LU storage for the patterns of one dimension: faer's simplicial
-/// `L`, `U` and row pivoting of the last factorisation, and the scratch of
-/// the solves.
+/// `L`, `U` and row pivoting of the last factorisation, its sweeps, and the
+/// scratch of the solves.
 pub(crate) struct Factors {
     n: usize,
     lu: SimplicialLu<usize, f64>,
@@ -163,6 +173,11 @@ pub(crate) struct Factors {
     row_perm_inv: Vec<usize>,
     /// `1 / U[j, j]` of the last factorisation.
     pivot_inv: Vec<f64>,
+    /// The forward sweep: `L`'s strictly lower entries, column by column.
+    lower: Vec<Update>,
+    /// The backward sweep: `U`'s strictly upper entries divided by their
+    /// column's pivot, last column first.
+    upper: Vec<Update>,
     /// Scratch of [`Self::solve`].
     work: Vec<f64>,
     /// The pattern whose factorisation this holds (none after the dense
@@ -186,6 +201,8 @@ impl Factors {
             row_perm: vec![0; n],
             row_perm_inv: vec![0; n],
             pivot_inv: vec![0.0; n],
+            lower: Vec::with_capacity(n * n.saturating_sub(1) / 2),
+            upper: Vec::with_capacity(n * n.saturating_sub(1) / 2),
             work: vec![0.0; n],
             owner: None,
         };
@@ -258,12 +275,34 @@ impl Factors {
             }
             Err(LuError::Generic(e)) => panic!("faer numeric LU failed: {e:?}"),
         }
-        // faer stores each column's diagonal of U last (the contract of its
-        // own upper-triangular solve).
+        // faer stores each column's unit diagonal of L first and its
+        // diagonal of U last (the contracts of its own triangular solves).
+        let index = |i: usize| u32::try_from(i).expect("dimension fits in u32");
+        let l = self.lu.l_factor_unsorted();
+        let (l_ptr, l_row, l_val) = (l.symbolic().col_ptr(), l.symbolic().row_idx(), l.val());
+        self.lower.clear();
+        for j in 0..n {
+            for p in l_ptr[j] + 1..l_ptr[j + 1] {
+                self.lower.push(Update {
+                    i: index(l_row[p]),
+                    j: index(j),
+                    v: l_val[p],
+                });
+            }
+        }
         let u = self.lu.u_factor_unsorted();
-        let (u_ptr, u_val) = (u.symbolic().col_ptr(), u.val());
-        for (j, p) in self.pivot_inv.iter_mut().enumerate() {
-            *p = u_val[u_ptr[j + 1] - 1].recip();
+        let (u_ptr, u_row, u_val) = (u.symbolic().col_ptr(), u.symbolic().row_idx(), u.val());
+        self.upper.clear();
+        for j in (0..n).rev() {
+            let pivot_inv = u_val[u_ptr[j + 1] - 1].recip();
+            self.pivot_inv[j] = pivot_inv;
+            for p in u_ptr[j]..u_ptr[j + 1] - 1 {
+                self.upper.push(Update {
+                    i: index(u_row[p]),
+                    j: index(j),
+                    v: u_val[p] * pivot_inv,
+                });
+            }
         }
         self.owner = Some(pattern.id);
         pattern.solves_since = 0;
@@ -286,30 +325,19 @@ impl Factors {
         for (wi, &p) in w.iter_mut().zip(&self.row_perm) {
             *wi = rhs[p];
         }
-        // L: unit lower triangular, the unit diagonal first in each column.
-        let l = self.lu.l_factor_unsorted();
-        let (l_ptr, l_row, l_val) = (l.symbolic().col_ptr(), l.symbolic().row_idx(), l.val());
-        for j in 0..n {
-            let xj = w[j];
-            let (a, b) = (l_ptr[j] + 1, l_ptr[j + 1]);
-            for (&i, &v) in l_row[a..b].iter().zip(&l_val[a..b]) {
-                w[i] -= v * xj;
-            }
+        // L: w[j] is final when column j's updates start (they come from
+        // the columns before it).
+        for u in &self.lower {
+            w[u.i as usize] -= u.v * w[u.j as usize];
         }
-        // U: upper triangular, the diagonal last in each column.
-        let u = self.lu.u_factor_unsorted();
-        let (u_ptr, u_row, u_val) = (u.symbolic().col_ptr(), u.symbolic().row_idx(), u.val());
-        for j in (0..n).rev() {
-            let xj = w[j] * self.pivot_inv[j];
-            w[j] = xj;
-            let (a, b) = (u_ptr[j], u_ptr[j + 1] - 1);
-            for (&i, &v) in u_row[a..b].iter().zip(&u_val[a..b]) {
-                w[i] -= v * xj;
-            }
+        // U D⁻¹, last column first: w[j] is final (unscaled) when column
+        // j's updates start.
+        for u in &self.upper {
+            w[u.i as usize] -= u.v * w[u.j as usize];
         }
         let (col_fwd, _) = pattern.col_perm().arrays();
-        for (&c, &wj) in col_fwd.iter().zip(w.iter()) {
-            rhs[c] = wj;
+        for ((&c, &wj), &p) in col_fwd.iter().zip(w.iter()).zip(&self.pivot_inv) {
+            rhs[c] = wj * p;
         }
     }
 }

@@ -5,6 +5,7 @@
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
 use fbd_sim::spatial::{SpatialParams, SpatialRecord};
 use tempfile::NamedTempFile;
@@ -117,6 +118,125 @@ impl Slots {
     }
 }
 
+/// Receives the values of one row of `trajectory.csv`, column by column
+/// in the order of [`columns`]: the file's writer and the in-memory
+/// columns of the Python package share [`row_values`], one source of the
+/// values.
+pub trait RowSink {
+    /// `t`: the time of step `step` (`t = step·Δt`; the file writes the
+    /// exact decimal of `step·Δt`, [`StepTimes`]).
+    fn time(&mut self, step: usize, t: f64);
+    /// A number (m, rad, N, N·m, J).
+    fn num(&mut self, x: f64);
+    /// A contact state (`ST1`, `ST2`, `ST3`).
+    fn state(&mut self, s: StateCode);
+    /// A count (`newton_iterations`).
+    fn count(&mut self, n: usize);
+}
+
+/// Hands the values of the row of `r` to `sink`, in the order of
+/// [`columns`]`(layout)`; `slots` are those of `layout` ([`Slots::of`]),
+/// `feet` places the feet that are not contact points. No allocation.
+pub fn row_values(
+    layout: &Layout,
+    slots: &Slots,
+    feet: &mut super::Feet,
+    r: &SpatialRecord,
+    sink: &mut dyn RowSink,
+) {
+    sink.time(r.step, r.t);
+    for &x in &r.q {
+        sink.num(x);
+    }
+    // Without a foot contact point, the foot is placed by the kinematics.
+    if slots.tips.iter().any(Option::is_none) {
+        feet.update(&r.q);
+    }
+    let zero = [0.0; 3];
+    for i in 0..layout.legs.len() {
+        let tip = slots.tips[i].map(|c| &r.contacts[c]);
+        let p = tip.map_or_else(|| feet.tip(i), |c| c.point);
+        for x in p {
+            sink.num(x);
+        }
+        sink.state(tip.map_or(StateCode::St1, |c| c.state));
+        let (f, n) = tip.map_or((zero, 0.0), |c| (c.force, c.normal));
+        for x in f {
+            sink.num(x);
+        }
+        sink.num(n);
+        let leg = slots.legs[i].map(|l| &r.legs[l]);
+        for v in [
+            leg.map_or(zero, |l| l.hip_force),
+            leg.map_or(zero, |l| l.hip_moment),
+            leg.map_or(zero, |l| l.knee_force),
+            leg.map_or(zero, |l| l.knee_moment),
+            leg.map_or(zero, |l| l.torque),
+        ] {
+            for x in v {
+                sink.num(x);
+            }
+        }
+    }
+    for slot in &slots.extras {
+        let c = slot.map(|c| &r.contacts[c]);
+        sink.state(c.map_or(StateCode::St1, |c| c.state));
+        let (f, n) = c.map_or((zero, 0.0), |c| (c.force, c.normal));
+        for x in f {
+            sink.num(x);
+        }
+        sink.num(n);
+    }
+    sink.num(r.kinetic);
+    sink.num(r.potential);
+    sink.count(r.newton_iterations);
+}
+
+/// One row of the file: comma-separated, the first I/O error kept.
+struct CsvRow<'a> {
+    out: &'a mut BufWriter<NamedTempFile>,
+    num: &'a mut ryu::Buffer,
+    times: &'a StepTimes,
+    error: Option<io::Error>,
+    first: bool,
+}
+
+impl CsvRow<'_> {
+    fn put(
+        &mut self,
+        f: impl FnOnce(&mut BufWriter<NamedTempFile>, &mut ryu::Buffer) -> io::Result<()>,
+    ) {
+        if self.error.is_some() {
+            return;
+        }
+        let r = if self.first {
+            self.first = false;
+            Ok(())
+        } else {
+            self.out.write_all(b",")
+        };
+        if let Err(e) = r.and_then(|()| f(&mut *self.out, &mut *self.num)) {
+            self.error = Some(e);
+        }
+    }
+}
+
+impl RowSink for CsvRow<'_> {
+    fn time(&mut self, step: usize, t: f64) {
+        let times = self.times;
+        self.put(|out, _| times.write(out, step, t));
+    }
+    fn num(&mut self, x: f64) {
+        self.put(|out, num| out.write_all(num.format(x).as_bytes()));
+    }
+    fn state(&mut self, s: StateCode) {
+        self.put(|out, _| out.write_all(s.as_str().as_bytes()));
+    }
+    fn count(&mut self, n: usize) {
+        self.put(|out, _| write!(out, "{n}"));
+    }
+}
+
 /// Streams `trajectory.csv` through a buffer into a temporary file; no
 /// allocation per row.
 pub struct TrajectoryWriter {
@@ -175,71 +295,22 @@ impl TrajectoryWriter {
         }
     }
 
-    fn f(&mut self, x: f64) -> io::Result<()> {
-        self.out.write_all(b",")?;
-        self.out.write_all(self.num.format(x).as_bytes())
-    }
-
-    fn s(&mut self, s: &str) -> io::Result<()> {
-        self.out.write_all(b",")?;
-        self.out.write_all(s.as_bytes())
-    }
-
     fn write_row(&mut self, r: &SpatialRecord) -> io::Result<()> {
         let slots = self.slots.take().unwrap_or_default();
-        let result = self.write_values(r, &slots);
+        let mut sink = CsvRow {
+            out: &mut self.out,
+            num: &mut self.num,
+            times: &self.times,
+            error: None,
+            first: true,
+        };
+        row_values(&self.layout, &slots, &mut self.feet, r, &mut sink);
+        let result = match sink.error.take() {
+            Some(e) => Err(e),
+            None => self.out.write_all(b"\n"),
+        };
         self.slots = Some(slots);
         result
-    }
-
-    fn write_values(&mut self, r: &SpatialRecord, slots: &Slots) -> io::Result<()> {
-        self.times.write(&mut self.out, r.step, r.t)?;
-        for &x in &r.q {
-            self.f(x)?;
-        }
-        // Without a foot contact point, the foot is placed by the kinematics.
-        if slots.tips.iter().any(Option::is_none) {
-            self.feet.update(&r.q);
-        }
-        for i in 0..self.layout.legs.len() {
-            let tip = slots.tips[i].map(|c| &r.contacts[c]);
-            let p = tip.map_or_else(|| self.feet.tip(i), |c| c.point);
-            for x in p {
-                self.f(x)?;
-            }
-            self.s(tip.map_or("ST1", |c| c.state.as_str()))?;
-            let (f, n) = tip.map_or(([0.0; 3], 0.0), |c| (c.force, c.normal));
-            for x in f {
-                self.f(x)?;
-            }
-            self.f(n)?;
-            let leg = slots.legs[i].map(|l| &r.legs[l]);
-            let zero = [0.0; 3];
-            for v in [
-                leg.map_or(zero, |l| l.hip_force),
-                leg.map_or(zero, |l| l.hip_moment),
-                leg.map_or(zero, |l| l.knee_force),
-                leg.map_or(zero, |l| l.knee_moment),
-                leg.map_or(zero, |l| l.torque),
-            ] {
-                for x in v {
-                    self.f(x)?;
-                }
-            }
-        }
-        for slot in &slots.extras {
-            let c = slot.map(|c| &r.contacts[c]);
-            self.s(c.map_or("ST1", |c| c.state.as_str()))?;
-            let (f, n) = c.map_or(([0.0; 3], 0.0), |c| (c.force, c.normal));
-            for x in f {
-                self.f(x)?;
-            }
-            self.f(n)?;
-        }
-        self.f(r.kinetic)?;
-        self.f(r.potential)?;
-        write!(self.out, ",{}", r.newton_iterations)?;
-        self.out.write_all(b"\n")
     }
 
     /// Flushes and renames the file into place.

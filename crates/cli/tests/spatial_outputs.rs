@@ -600,3 +600,111 @@ fn the_joint_moments_carry_the_torques_about_the_joint_axes() {
     }
     assert!(largest > 1.0, "the walk applied no torque ({largest} N·m)");
 }
+
+/// The rotational half of every body's six equations, from the written
+/// columns alone: `(L[k+½] − L[k−½])/Δt = ΣM[k]` about the body's centre of
+/// mass at k, with `L[k+½]` the discrete angular momentum of the scheme
+/// (`R[k]·exp(ψ/2)·I·ψ/Δt`, `ψ = log(R[k]ᵀR[k+1])`, rotations and points
+/// from the q columns), the moments of the written hip, knee and contact
+/// forces at their points plus the written hip and knee moments — on a
+/// PD-held robot landing and settling (torques, sticking and sliding feet,
+/// knee and hip contact points).
+#[test]
+fn every_body_obeys_eulers_equations_from_the_csv() {
+    use fbd_dynamics::spatial::{SpatialKin, half_momentum, lower_body, upper_body};
+    use fbd_kinematics::nalgebra::Vector3;
+    use fbd_sim::spatial::{SpatialControl, SpatialModel};
+    let dir = tempfile::tempdir().unwrap();
+    let mut p = drop(&[1, 2, 3, 4, 5, 6]);
+    p.duration = 0.3;
+    p.control = SpatialControl::Pd {
+        kp: 150.0,
+        kd: 4.0,
+        torque_limit: Some(40.0),
+        target: vec![[0.1, -0.2, 4.6]; 6],
+    };
+    let r = run_into(&p, dir.path());
+    assert!(r.run.error.is_none(), "{:?}", r.run.error);
+    let csv = Csv::read(&dir.path().join("trajectory.csv"));
+    let model = SpatialModel::new(&p).unwrap();
+    let mech = &model.mech;
+    let xyz = ["fx", "fy", "fz"];
+    let mxyz = ["mx", "my", "mz"];
+    let v = |a: [f64; 3]| Vector3::new(a[0], a[1], a[2]);
+    let kin_at = |row: usize| {
+        let mut q = vec![0.0; model.nq()];
+        for (k, name) in ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
+            .iter()
+            .enumerate()
+        {
+            q[k] = csv.f(row, name);
+        }
+        for (s, &n) in p.legs.iter().enumerate() {
+            for j in 0..3 {
+                q[6 + 3 * s + j] = csv.f(row, &format!("theta{}_{n}", j + 1));
+            }
+        }
+        let mut kin = SpatialKin::new(mech);
+        kin.eval(mech, &q);
+        kin
+    };
+    let kins: Vec<_> = (0..csv.rows.len()).map(kin_at).collect();
+    let (mut worst, mut sliding) = (0.0f64, 0);
+    for k in 1..csv.rows.len() - 1 {
+        let (kp, kk, kn) = (&kins[k - 1], &kins[k], &kins[k + 1]);
+        let mut moment = vec![Vector3::zeros(); mech.bodies.len()];
+        let mut scale = vec![0.0; mech.bodies.len()];
+        let mut add = |b: usize, point: Vector3<f64>, f: Vector3<f64>, m: Vector3<f64>| {
+            let arm = point - kk.com[b];
+            moment[b] += arm.cross(&f) + m;
+            scale[b] += arm.norm() * f.norm() + m.norm();
+        };
+        for (s, &n) in p.legs.iter().enumerate() {
+            let l = &kk.fk.legs[n - 1];
+            let (u, lo) = (upper_body(s), lower_body(s));
+            let hf = v(csv.v3(k, &format!("hip{n}_"), xyz));
+            let hm = v(csv.v3(k, &format!("hip{n}_"), mxyz));
+            let kf = v(csv.v3(k, &format!("knee{n}_"), xyz));
+            let km = v(csv.v3(k, &format!("knee{n}_"), mxyz));
+            add(u, l.hip, hf, hm);
+            add(0, l.hip, -hf, -hm);
+            add(lo, l.knee, kf, km);
+            add(u, l.knee, -kf, -km);
+            let foot = v(csv.v3(k, &format!("foot{n}_"), xyz));
+            add(lo, l.tip, foot, Vector3::zeros());
+            add(
+                lo,
+                l.knee,
+                v(csv.v3(k, &format!("kneepoint{n}_"), xyz)),
+                Vector3::zeros(),
+            );
+            add(
+                0,
+                l.hip,
+                v(csv.v3(k, &format!("hippoint{n}_"), xyz)),
+                Vector3::zeros(),
+            );
+            sliding += usize::from(csv.rows[k][csv.col[&format!("state{n}")]] == "ST3");
+        }
+        for (b, body) in mech.bodies.iter().enumerate() {
+            let l_prev = half_momentum(&kp.rot[b], &kk.rot[b], &body.inertia, p.dt).0;
+            let l_next = half_momentum(&kk.rot[b], &kn.rot[b], &body.inertia, p.dt).0;
+            let lhs = (l_next - l_prev) / p.dt;
+            let err = (lhs - moment[b]).norm();
+            let tol = 1e-6 * (scale[b] + 1.0);
+            worst = worst.max(err / (scale[b] + 1.0));
+            assert!(
+                err <= tol,
+                "{}, row {k} (t = {}): dL/dt = {lhs:?} but ΣM = {:?} (error {err:e} N·m)",
+                body.name,
+                csv.rows[k][0],
+                moment[b]
+            );
+        }
+    }
+    assert!(
+        sliding > 0,
+        "no foot slid: the check should see sliding rows"
+    );
+    eprintln!("largest relative moment imbalance: {worst:e}");
+}

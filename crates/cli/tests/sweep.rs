@@ -406,3 +406,122 @@ fn counts_agree_with_their_nouns() {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(e.contains("1 of 1 run failed (run 0)"), "{e}");
 }
+
+/// A sweep of the hexapod's 3D dynamics: the standing example, 0.2 s (the
+/// feet touch down at 0.1 s), friction × PD stiffness.
+#[test]
+fn a_dynamic_hexapod_sweep_runs_the_dynamics_with_its_columns() {
+    let t = tempfile::tempdir().unwrap();
+    let stand = std::fs::read_to_string(examples().join("hexapod_stand.toml")).unwrap();
+    assert!(stand.contains("\nduration = 1.0\n"));
+    let base = stand.replace("\nduration = 1.0\n", "\nduration = 0.2\n");
+    std::fs::write(t.path().join("stand.toml"), base).unwrap();
+    let f = t.path().join("s.toml");
+    // μS = 0.1 is below the stance's |Ft|/N = 0.13: the feet slip.
+    std::fs::write(
+        &f,
+        r#"base = "stand.toml"
+mode = "grid"
+[vary]
+"terrain.mu_static" = [0.1, 0.8]
+"control.kp" = [200.0, 300.0]
+[derive]
+"terrain.mu_dynamic" = { from = "terrain.mu_static", scale = 0.75 }
+"#,
+    )
+    .unwrap();
+    let out = t.path().join("out");
+    run_ok(&["sweep", s(&f), "--out", s(&out), "--jobs", "2"]);
+    let (h, rows) = index(&out);
+    assert_eq!(
+        h.join(","),
+        "run,status,terrain.mu_static,control.kp,terrain.mu_dynamic,distance,final_height,\
+         peak_torque,peak_foot_n,first_touchdown,foot_slips,events,newton_iterations,\
+         steps_per_second,steps,wall_seconds,error"
+    );
+    assert_eq!(rows.len(), 4);
+    let col = |r: &[String], name: &str| -> String {
+        r[h.iter().position(|c| c == name).unwrap()].clone()
+    };
+    let num = |r: &[String], name: &str| -> f64 { col(r, name).parse().unwrap() };
+    let weight = 18.4 * 9.81;
+    for (i, r) in rows.iter().enumerate() {
+        assert_eq!(r[1], "ok", "{r:?}");
+        let d = out.join("runs").join(i.to_string());
+        // The files of a dynamic run, not of the kinematic gait.
+        for f in ["trajectory.csv", "feet.svg", "torques.svg", "body.svg"] {
+            assert!(d.join(f).is_file(), "{}", d.join(f).display());
+        }
+        assert!(!d.join("gait.svg").exists());
+        let j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(j["run"], "dynamic");
+        assert_eq!(col(r, "steps"), "201");
+        assert_eq!(col(r, "steps"), j["steps"].to_string());
+        assert_eq!(
+            num(r, "newton_iterations"),
+            j["newton_iterations"].as_f64().unwrap()
+        );
+        assert_eq!(num(r, "distance"), j["distance"].as_f64().unwrap());
+        assert_eq!(num(r, "final_height"), j["final_height"].as_f64().unwrap());
+        assert_eq!(
+            num(r, "peak_torque"),
+            j["peak_torque_max"].as_f64().unwrap()
+        );
+        let events = j["events"].as_array().unwrap();
+        assert_eq!(num(r, "events"), events.len() as f64);
+        assert!(num(r, "steps_per_second") > 0.0);
+        // Touchdown of the six feet together after the 5 cm drop,
+        // √(2·0.05/g) = 0.101 s: the step from 0.1 s puts them down.
+        assert_eq!(num(r, "first_touchdown"), 0.1, "{r:?}");
+        // Standing, the feet carry the weight: the impact's peak is above
+        // a sixth of it; the body stays up (touchdown height 0.3516 m).
+        assert!(num(r, "peak_foot_n") > weight / 6.0, "{r:?}");
+        let y = num(r, "final_height");
+        assert!((0.33..0.36).contains(&y), "{r:?}");
+        // No sideways push: the body does not travel.
+        assert!(num(r, "distance") < 1e-6, "{r:?}");
+        // The feet slip on μS = 0.1 (each foot at least once), never on 0.8.
+        let slips = num(r, "foot_slips");
+        let counted = events
+            .iter()
+            .filter(|e| e["point"] == "tip" && e["to"] == "ST3" && e["from"] != "ST3")
+            .count() as f64;
+        assert_eq!(slips, counted);
+        if col(r, "terrain.mu_static") == "0.1" {
+            assert!(slips >= 6.0, "{r:?}");
+        } else {
+            assert_eq!(slips, 0.0, "{r:?}");
+        }
+    }
+    // Same run alone: the same files (the dynamics, not the gait).
+    let a = out.join("runs/1");
+    let alone = t.path().join("alone");
+    run_ok(&["run", s(&a.join("config.toml")), "--out", s(&alone)]);
+    for f in ["trajectory.csv", "events.csv", "config.toml"] {
+        assert_eq!(
+            std::fs::read(a.join(f)).unwrap(),
+            std::fs::read(alone.join(f)).unwrap(),
+            "{f}"
+        );
+    }
+    // merge reads the dynamic index back with its columns.
+    let merged = t.path().join("merged");
+    run_ok(&["sweep", "merge", s(&out), "--out", s(&merged)]);
+    assert_eq!(index(&merged).0, h);
+    assert_eq!(index(&merged).1.len(), 4);
+    // An invalid run of a dynamic base fails up front, naming run and key.
+    std::fs::write(
+        &f,
+        "base = \"stand.toml\"\n[vary]\n\"control.kp\" = [300.0, -1.0]\n",
+    )
+    .unwrap();
+    let o = fbd(&["sweep", s(&f), "--out", s(&t.path().join("bad"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        e.contains("run 1 (control.kp = -1.0)") && e.contains("kp"),
+        "{e}"
+    );
+}

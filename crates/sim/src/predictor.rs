@@ -25,7 +25,7 @@
 //! No allocation after [`Predictor::new`].
 
 /// Highest order of the extrapolation of `q` (it uses `q[k−5..k]`).
-pub const MAX_Q_ORDER: usize = 7;
+pub const MAX_Q_ORDER: usize = 5;
 
 /// Highest order of the extrapolation of the forces (the last four
 /// solutions).

@@ -40,6 +40,16 @@ impl Columns {
         let extras: Vec<usize> = (0..contacts.len())
             .filter(|&i| !tips.contains(&Some(i)))
             .collect();
+        let mut c = Self::named(names, dt, rows);
+        c.tips = tips;
+        c.extras = extras;
+        c
+    }
+
+    /// Empty columns named `names` (`newton_iterations` holds counts,
+    /// `state*` and `*_state` contact states, every other one numbers),
+    /// filled through [`Columns::sink`].
+    pub fn named(names: Vec<String>, dt: f64, rows: usize) -> Self {
         let values = names
             .iter()
             .map(|n| {
@@ -56,8 +66,20 @@ impl Columns {
             names,
             values,
             times: StepTimes::new(dt),
-            tips,
-            extras,
+            tips: [None; 2],
+            extras: Vec::new(),
+        }
+    }
+
+    /// The row being written, one value per call in column order (the 3D
+    /// run's [`fbd_cli::spatial::csv::row_values`]).
+    pub fn sink(&mut self) -> Sink<'_> {
+        Sink {
+            w: Writer {
+                values: &mut self.values,
+                i: 0,
+            },
+            times: &self.times,
         }
     }
 
@@ -148,5 +170,27 @@ impl Writer<'_> {
             v.push(x);
         }
         self.i += 1;
+    }
+}
+
+/// One row of [`Columns`] filled by the 3D run's row builder: the same
+/// values, in the same order, as its `trajectory.csv`.
+pub struct Sink<'a> {
+    w: Writer<'a>,
+    times: &'a StepTimes,
+}
+
+impl fbd_cli::spatial::csv::RowSink for Sink<'_> {
+    fn time(&mut self, step: usize, t: f64) {
+        self.w.f(self.times.value(step, t));
+    }
+    fn num(&mut self, x: f64) {
+        self.w.f(x);
+    }
+    fn state(&mut self, s: fbd_contact::StateCode) {
+        self.w.s(s.as_str());
+    }
+    fn count(&mut self, n: usize) {
+        self.w.i(n as i64);
     }
 }

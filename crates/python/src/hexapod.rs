@@ -1,5 +1,5 @@
-//! `run(config)` of a hexapod configuration: the kinematic gait (or a
-//! standing run without `[gait]`), every column of its `trajectory.csv` in
+//! `run(config)` of a kinematic hexapod configuration: the kinematic gait
+//! (or a kinematic standing run, `dynamics = "kinematic"`), every column of its `trajectory.csv` in
 //! memory ([`fbd_cli::hexapod::columns`]), the same values as the file.
 
 use std::path::Path;

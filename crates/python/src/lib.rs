@@ -2,7 +2,8 @@
 //!
 //! The native module `fbd._fbd` of the Python package `fbd`: loading a
 //! configuration from a path, a TOML string or a dict ([`config`]), whole
-//! runs with every trajectory column ([`run`]), the step-wise
+//! runs with every trajectory column ([`run`]; a dynamic hexapod in
+//! [`spatial`], its kinematic gait in [`hexapod`]), the step-wise
 //! [`simulator::Simulator`], sweeps ([`sweep`]) and kinematics
 //! ([`kinematics`]). The Python layer (`python/fbd/__init__.py`) wraps the
 //! raw results in classes and defines the exceptions this module raises.
@@ -17,6 +18,7 @@ mod hexapod;
 mod kinematics;
 mod run;
 mod simulator;
+mod spatial;
 mod sweep;
 
 use pyo3::prelude::*;

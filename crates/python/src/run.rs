@@ -79,6 +79,18 @@ pub fn run<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let loaded = crate::config::load(py, config)?;
+        if let fbd_scenario::Config::Hexapod(h) = &loaded.config
+            && h.is_dynamic()
+        {
+            return crate::spatial::run(
+                py,
+                h,
+                &loaded.config,
+                &loaded.source,
+                loaded.from_text,
+                out.as_deref(),
+            );
+        }
         if let fbd_scenario::Config::Hexapod(h) = &loaded.config {
             return crate::hexapod::run(
                 py,

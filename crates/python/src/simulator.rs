@@ -81,7 +81,7 @@ impl Simulator {
                     return Err(crate::errors::cli_error(
                         py,
                         &fbd_cli::CliError::Usage(format!(
-                            "{}: model = \"hexapod\": the 3D dynamics are not implemented yet",
+                            "{}: model = \"hexapod\": Simulator steps the planar model only; fbd.run(config) runs the hexapod (its 3D dynamics or its kinematic gait)",
                             loaded.source
                         )),
                         true,

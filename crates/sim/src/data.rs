@@ -51,6 +51,8 @@ pub struct Data {
     pub external_torque: Option<[f64; crate::record::MAX_JOINTS]>,
     /// Per-row convergence scales of the current contact states.
     pub(crate) scales: Vec<f64>,
+    /// Their reciprocals.
+    pub(crate) weights: Vec<f64>,
     /// The predictor's histories of the accepted steps.
     pub(crate) predictor: Predictor,
     /// Trial states of the state search.
@@ -120,6 +122,7 @@ impl Data {
             max_step_iterations: 0,
             external_torque: None,
             scales: vec![1.0; lay.dim()],
+            weights: vec![1.0; lay.dim()],
             predictor,
             trial: model.initial_states.clone(),
             visited: Vec::with_capacity(64),

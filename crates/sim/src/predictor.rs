@@ -36,12 +36,14 @@ pub const MAX_FORCE_ORDER: usize = 3;
 pub struct Predictor {
     /// Number of coordinates `q` at the front of the unknowns.
     nq: usize,
-    /// Per coordinate, `q_i[k], q_i[k−1], …, q_i[k−5]` (the older ones
-    /// meaningful only as far as `steps` and `smooth` allow).
-    q: Vec<[f64; MAX_Q_ORDER + 1]>,
-    /// Per force (the unknowns after `q`), its last four solutions, newest
-    /// first.
-    f: Vec<[f64; MAX_FORCE_ORDER + 1]>,
+    /// Per coordinate, its backward differences at the newest step,
+    /// `∇ʲq_i[k]` for `j = 0..=MAX_Q_ORDER + 1` (the higher ones
+    /// meaningful only as far as `steps` and `smooth` allow; the last one
+    /// measures the error of the highest order).
+    q: Vec<[f64; MAX_Q_ORDER + 2]>,
+    /// Per force (the unknowns after `q`), the backward differences of its
+    /// solutions at the newest step.
+    f: Vec<[f64; MAX_FORCE_ORDER + 2]>,
     /// Accepted steps recorded (`k`).
     steps: usize,
     /// How many recorded steps before the newest were solved in the
@@ -60,8 +62,8 @@ impl Predictor {
         let nq = q0.len();
         Self {
             nq,
-            q: q0.iter().map(|&v| [v; MAX_Q_ORDER + 1]).collect(),
-            f: z0[nq..].iter().map(|&v| [v; MAX_FORCE_ORDER + 1]).collect(),
+            q: q0.iter().map(|&v| differences_of(v)).collect(),
+            f: z0[nq..].iter().map(|&v| differences_of(v)).collect(),
             steps: 0,
             smooth: 0,
             orders: [1, 0],
@@ -88,11 +90,11 @@ impl Predictor {
         assert_eq!(z.len(), self.nq + self.f.len(), "unknowns of the wrong length");
         let [q_order, f_order] = self.orders();
         let (zq, zf) = z.split_at_mut(self.nq);
-        for (zi, h) in zq.iter_mut().zip(&self.q) {
-            *zi = extrapolations(h)[q_order];
+        for (zi, d) in zq.iter_mut().zip(&self.q) {
+            *zi = extrapolate(d, q_order);
         }
-        for (zi, h) in zf.iter_mut().zip(&self.f) {
-            *zi = extrapolations(h)[f_order];
+        for (zi, d) in zf.iter_mut().zip(&self.f) {
+            *zi = extrapolate(d, f_order);
         }
     }
 
@@ -106,8 +108,8 @@ impl Predictor {
         assert_eq!(z.len(), self.nq + self.f.len(), "unknowns of the wrong length");
         let (zq, zf) = z.split_at(self.nq);
         self.orders = [
-            argmin(&record_history(&mut self.q, zq)[1..]) + 1,
-            argmin(&record_history(&mut self.f, zf)),
+            argmin(&record_history(&mut self.q, zq)[1..=MAX_Q_ORDER]) + 1,
+            argmin(&record_history(&mut self.f, zf)[..=MAX_FORCE_ORDER]),
         ];
         self.smooth = if same_states {
             (self.smooth + 1).min(MAX_Q_ORDER - 1)
@@ -118,20 +120,58 @@ impl Predictor {
     }
 }
 
-/// Pushes `values` onto the per-value histories `hist` (newest first) and
-/// returns, for each extrapolation order, the largest error with which it
-/// would have predicted them from the histories before.
+/// The backward differences of a history that is `v` at every step.
+fn differences_of<const N: usize>(v: f64) -> [f64; N] {
+    let mut d = [0.0; N];
+    d[0] = v;
+    d
+}
+
+/// The extrapolation one step ahead of order `p` from the backward
+/// differences `d` at the newest step: Newton's form `d[0] + Σ_{1≤j≤p}
+/// d[j]`, in which the differences of close values are exact and their
+/// small sum is added to `d[0]` last, so that it rounds about once.
+fn extrapolate(d: &[f64], p: usize) -> f64 {
+    let sum: f64 = d[1..=p].iter().sum();
+    d[0] + sum
+}
+
+/// Records `values` as the newest step of the histories whose backward
+/// differences are `hist` (`∇ʲv[k]` → `∇ʲv[k+1] = ∇ʲ⁻¹v[k+1] −
+/// ∇ʲ⁻¹v[k]`), and returns, for each extrapolation order `p`, the largest
+/// error with which it would have predicted them, `|∇ᵖ⁺¹v[k+1]|` (the
+/// highest order's error is not known: infinity).
 fn record_history<const N: usize>(hist: &mut [[f64; N]], values: &[f64]) -> [f64; N] {
     let mut err = [0.0f64; N];
-    for (h, &v) in hist.iter_mut().zip(values) {
-        for (e, p) in err.iter_mut().zip(extrapolations(h)) {
-            *e = e.max((p - v).abs());
+    err[N - 1] = f64::INFINITY;
+    for (d, &v) in hist.iter_mut().zip(values) {
+        let mut new = v;
+        for j in 0..N {
+            let old = d[j];
+            d[j] = new;
+            new -= old;
+            if j + 1 < N {
+                err[j] = err[j].max(new.abs());
+            }
         }
-        h.copy_within(0..N - 1, 1);
-        h[0] = v;
     }
     err
 }
+
+/// Index of the smallest value, the first one on ties (NaN never wins).
+fn argmin(v: &[f64]) -> usize {
+    let mut best = 0;
+    for (i, &x) in v.iter().enumerate() {
+        if x < v[best] {
+            best = i;
+        }
+    }
+    best
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
 
 /// The extrapolations one step ahead of a history `v` (newest first) by
 /// the polynomials through its first `p + 1` values, `p = 0, 1, …`:
@@ -152,20 +192,6 @@ fn extrapolations<const N: usize>(v: &[f64; N]) -> [f64; N] {
     out
 }
 
-/// Index of the smallest value, the first one on ties (NaN never wins).
-fn argmin(v: &[f64]) -> usize {
-    let mut best = 0;
-    for (i, &x) in v.iter().enumerate() {
-        if x < v[best] {
-            best = i;
-        }
-    }
-    best
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
 
     #[test]
     fn extrapolations_are_exact_for_polynomials_of_their_order() {

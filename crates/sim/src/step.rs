@@ -521,12 +521,14 @@ pub fn system<'a>(
         &data.fbd,
         data.q[0].abs().max(data.q[1].abs()),
         &mut data.scales,
+        &mut data.weights,
     );
     let sys = StepSystem {
         mech: &model.mech,
         terrain: &model.params.terrain,
         fbd: &mut data.fbd,
         scales: &data.scales,
+        weights: &data.weights,
     };
     (sys, &mut data.solver, &mut data.z)
 }

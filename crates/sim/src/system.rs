@@ -22,6 +22,8 @@ pub struct StepSystem<'a> {
     pub(crate) terrain: &'a Terrain,
     pub(crate) fbd: &'a mut FbdData,
     pub(crate) scales: &'a [f64],
+    /// `1 / scales`.
+    pub(crate) weights: &'a [f64],
 }
 
 impl NewtonSystem for StepSystem<'_> {
@@ -43,14 +45,24 @@ impl NewtonSystem for StepSystem<'_> {
     fn residual_scale(&self, row: usize) -> f64 {
         self.scales[row]
     }
+    fn residual_weight(&self, row: usize) -> f64 {
+        self.weights[row]
+    }
 }
 
-/// Convergence scales of every row for the current contact states: forces
+/// Convergence scales of every row for the current contact states, and
+/// their reciprocals (the weights of the scaled norm): forces
 /// to `1e-9 ×` the weight, with a round-off floor `1e-6·(M/Δt²)·(1 m + |R|)`
 /// (a body row is `m·x/Δt²` minus forces, so its round-off grows with the
 /// coordinates' magnitude `|R|` and with `1/Δt²`); moments to that times the
 /// length scale; contact positions to `1e-12·(1 m + |R|)`.
-pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, extent: f64, scales: &mut [f64]) {
+pub(crate) fn row_scales(
+    mech: &Mechanism,
+    fbd: &FbdData,
+    extent: f64,
+    scales: &mut [f64],
+    weights: &mut [f64],
+) {
     let lay = mech.layout();
     let k = fbd.position_gain;
     let force = fbd.total_mass * mech.gravity.abs().max(1.0) + 1e-6 * k * (1.0 + extent);
@@ -75,5 +87,8 @@ pub(crate) fn row_scales(mech: &Mechanism, fbd: &FbdData, extent: f64, scales: &
     // A joint-limit row is a moment, free (λ) or at an end (Kθ·δθ).
     for l in 0..lay.limits {
         scales[lay.limit_row(l)] = moment;
+    }
+    for (w, &s) in weights.iter_mut().zip(scales.iter()) {
+        *w = 1.0 / s;
     }
 }

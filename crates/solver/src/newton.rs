@@ -411,15 +411,15 @@ impl NewtonSolver {
     }
 }
 
-/// Scaled residual max-norm `max_i |r_i| / scale_i`; `None` if any entry is
-/// not finite.
+/// Scaled residual max-norm `max_i |r_i| / scale_i` (as `|r_i| · weight_i`);
+/// `None` if any entry is not finite.
 fn scaled_norm<S: NewtonSystem>(sys: &S, r: &[f64]) -> Option<f64> {
     let mut norm = 0.0f64;
     for (i, &ri) in r.iter().enumerate() {
         if !ri.is_finite() {
             return None;
         }
-        norm = norm.max(ri.abs() / sys.residual_scale(i));
+        norm = norm.max(ri.abs() * sys.residual_weight(i));
     }
     Some(norm)
 }

@@ -26,6 +26,15 @@ pub trait NewtonSystem {
         let _ = row;
         1.0
     }
+
+    /// `1 / residual_scale(row)`, the weight of the row in the scaled
+    /// residual max-norm `max_i |r_i| · weight_i` (the solver evaluates it
+    /// at every iterate; a system that keeps the reciprocals saves the
+    /// divisions). Must equal `1.0 / self.residual_scale(row)`, which is
+    /// the default.
+    fn residual_weight(&self, row: usize) -> f64 {
+        1.0 / self.residual_scale(row)
+    }
 }
 
 /// Write access to the Jacobian values of the current pattern.

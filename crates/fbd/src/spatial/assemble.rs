@@ -81,15 +81,28 @@ pub fn half_momentum(
     dt: f64,
 ) -> (Vector3<f64>, Matrix3<f64>) {
     let psi = so3::log(&(r_k.transpose() * r_next));
-    let r_mid = r_k * so3::exp(&(0.5 * psi));
+    let half = so3::exp(&(0.5 * psi));
+    let r_mid = r_k * half;
     let ipsi = inertia * psi;
-    let l = r_mid * ipsi / dt;
+    // The same operations as `half_momentum_value`: bit-identical values.
+    let l = r_k * (half * ipsi) / dt;
     let d = r_mid
         * (inertia - 0.5 * so3::hat(&ipsi) * so3::right_jacobian(&(0.5 * psi)))
         * so3::right_jacobian_inv(&psi)
         * r_next.transpose()
         / dt;
     (l, d)
+}
+
+/// [`half_momentum`] without its derivative (residual-only evaluations).
+pub fn half_momentum_value(
+    r_k: &Matrix3<f64>,
+    r_next: &Matrix3<f64>,
+    inertia: &Matrix3<f64>,
+    dt: f64,
+) -> Vector3<f64> {
+    let psi = so3::log(&(r_k.transpose() * r_next));
+    r_k * (so3::exp(&(0.5 * psi)) * (inertia * psi)) / dt
 }
 
 /// Mutable workspace of the spatial assembly (allocated once).
@@ -242,13 +255,12 @@ pub fn prepare_step(
             History::Previous => BodyStep3 {
                 c_next: 1.0,
                 x_const: -2.0 * com_k + data.kin_prev.com[b],
-                l_const: half_momentum(
+                l_const: half_momentum_value(
                     &data.kin_prev.rot[b],
                     &data.kin.rot[b],
                     &mech.bodies[b].inertia,
                     dt,
-                )
-                .0,
+                ),
                 com_k,
             },
             History::Initial { qdot } => {
@@ -408,9 +420,14 @@ pub fn eval<S: JacobianSink>(
         let bs = &data.body[b];
         let row = lay.body_row(b);
         let acc = (bs.c_next * data.kin_next.com[b] + bs.x_const) / (dt * dt);
-        let (l_next, d) = half_momentum(&data.kin.rot[b], &data.kin_next.rot[b], &body.inertia, dt);
+        let l_next = if S::ACTIVE {
+            let (l, d) = half_momentum(&data.kin.rot[b], &data.kin_next.rot[b], &body.inertia, dt);
+            data.rot_d[b] = d * (bs.c_next / dt);
+            l
+        } else {
+            half_momentum_value(&data.kin.rot[b], &data.kin_next.rot[b], &body.inertia, dt)
+        };
         data.l_next[b] = l_next;
-        data.rot_d[b] = d * (bs.c_next / dt);
         let dl = (bs.c_next * l_next - bs.l_const) / dt;
         for i in 0..3 {
             r[row + i] = body.mass * acc[i] - data.force[b][i];

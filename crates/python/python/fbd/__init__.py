@@ -59,11 +59,23 @@ class Result(Mapping):
     arrays of ``"ST1"``, ``"ST2"``, ``"ST3"``; ``newton_iterations`` is
     int64). Values are those of the CLI's file, bit for bit.
 
+    A hexapod running the 3D FBD dynamics has the columns of its
+    ``trajectory.csv``: ``t``, the body pose ``rx`` … ``phi_z``,
+    ``theta{1,2,3}_{n}`` of each leg n of the model, per leg the foot
+    ``foot{n}_x/y/z``, its state ``state{n}`` (strings as above), the
+    ground's force on it ``foot{n}_fx/fy/fz`` and normal ``foot{n}_n``,
+    the hip and knee forces and moments ``hip{n}_fx`` … ``knee{n}_mz`` and
+    the torques ``tau{1,2,3}_{n}``; the knee and hip contact points
+    ``kneepoint{n}_state/fx/fy/fz/n`` (``hippoint…``); ``kinetic``,
+    ``potential``, ``newton_iterations`` (int64). The kinematic gait's
+    columns are all float64.
+
     Attributes:
         columns: the column names, in the file's order.
-        events: contact events, dicts with ``t``, ``step``, ``leg``,
-            ``point``, ``from``, ``to`` (as ``events.csv``); for a hexapod
-            (the kinematic gait) lift-offs, touchdowns and stability
+        events: contact, joint-limit and retried-step events, dicts with
+            ``t``, ``step``, ``leg``, ``point``, ``from``, ``to`` (as
+            ``events.csv``; also for the hexapod's 3D dynamics); for the
+            hexapod's kinematic gait lift-offs, touchdowns and stability
             warnings, dicts with ``t``, ``leg``, ``event``, ``margin``.
         summary: the content of ``summary.json`` as a dict.
         source: the configuration's name (a file, ``<string>``, ``<dict>``).
@@ -123,6 +135,8 @@ def run(config: ConfigLike = None, out: Union[None, str, "os.PathLike[str]"] = N
         config: None (the built-in default experiment: the paper's §6
             fall), a path to a TOML file, TOML text, or a dict with the
             same keys as the files, e.g. ``{"time": {"duration": 0.5}}``.
+            A hexapod (``model = "hexapod"``) runs as ``fbd run`` runs it:
+            the 3D FBD dynamics, or the kinematic gait.
         out: when given, the directory where the files of ``fbd run`` are
             written (``trajectory.csv``, ``events.csv``, ``summary.json``,
             ``config.toml`` and the plots); nothing is written otherwise.

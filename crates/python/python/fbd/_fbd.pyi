@@ -7,7 +7,10 @@ import numpy.typing as npt
 
 TRAJECTORY_SPEC_COLUMNS: List[str]
 
-def run(config: Any = None, out: Optional[str] = None) -> Dict[str, Any]: ...
+def run(config: Any = None, out: Optional[str] = None) -> Dict[str, Any]:
+    """Simulates ``config`` (planar, the hexapod's 3D dynamics or its
+    kinematic gait) with the GIL released: ``{"columns", "data", "events",
+    "summary" (JSON text), "error", "source"}``; ``fbd.run`` wraps it."""
 def sweep(
     sweep_config: str, out: str, jobs: Optional[int] = None, plot: str = "touchdown"
 ) -> Tuple[str, Optional[str]]: ...

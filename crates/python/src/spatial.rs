@@ -1,0 +1,109 @@
+//! `run(config)` of a dynamic hexapod configuration: the 3D FBD dynamics
+//! ([`fbd_cli::spatial::simulate`]), every column of its `trajectory.csv`
+//! in memory from the CLI's own row builder
+//! ([`fbd_cli::spatial::csv::row_values`]): the same names and values as
+//! the file.
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+
+use fbd_cli::spatial::csv::{Slots, row_values};
+use fbd_cli::spatial::{Feet, Layout, SpatialRun, columns, simulate};
+use fbd_scenario::{Config, HexapodConfig};
+use fbd_sim::spatial::SpatialRecord;
+use pyo3::exceptions::PyKeyboardInterrupt;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::columns::Columns;
+use crate::errors::{cli_error, config_error};
+use crate::run::{SignalWatch, events};
+
+/// The dynamic hexapod's `run` dict, as the planar run's: `columns`,
+/// `data` (float64 arrays; `state{n}` and `*point{n}_state` lists of
+/// `"ST1"`/`"ST2"`/`"ST3"`; `newton_iterations` int64), `events` (dicts
+/// `t`, `step`, `leg`, `point`, `from`, `to`, as `events.csv`), `summary`
+/// (JSON text), `error`, `source`. Runs with the GIL released; Ctrl-C
+/// stops it ([`SignalWatch`]).
+pub fn run<'py>(
+    py: Python<'py>,
+    h: &HexapodConfig,
+    config: &Config,
+    source: &str,
+    from_text: bool,
+    out: Option<&Path>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let params = h
+        .spatial_params(source)
+        .map_err(|e| config_error(py, &e, from_text))?;
+    let dt = params.dt;
+    let outcome = py.detach(|| {
+        let layout = Layout::of(&params);
+        let stride = params.stride.max(1);
+        // Room for the rows planned, at most 2^16 up front (some 230
+        // columns of a six-legged model): a long run grows as it goes.
+        let rows = ((params.duration / dt).round().max(0.0) as usize + 1)
+            .div_ceil(stride)
+            .min(1 << 16);
+        let mut cols = Columns::named(columns(&layout), dt, rows);
+        let mut feet = Feet::new(&params);
+        let mut slots: Option<Slots> = None;
+        let stop = AtomicBool::new(false);
+        let mut watch = SignalWatch::default();
+        simulate(
+            &params,
+            &config.to_toml(),
+            source,
+            out,
+            &stop,
+            &mut |r: &SpatialRecord| {
+                let s = slots.get_or_insert_with(|| Slots::of(&layout, r));
+                row_values(&layout, s, &mut feet, r, &mut cols.sink());
+                watch.row(&stop);
+            },
+        )
+        .map(|s| (s, cols, watch.signal))
+    });
+    let (sim, cols, signal) = outcome.map_err(|e| cli_error(py, &e, from_text))?;
+    let SpatialRun {
+        run,
+        summary,
+        io_error,
+        ..
+    } = sim;
+    if let Some(e) = io_error {
+        return Err(cli_error(py, &e, from_text));
+    }
+    if let Some(e) = signal {
+        if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+            return Err(PyKeyboardInterrupt::new_err(format!(
+                "{source}: interrupted after {} steps",
+                run.steps
+            )));
+        }
+        return Err(e);
+    }
+    let d = PyDict::new(py);
+    let (names, data) = cols.into_py(py)?;
+    d.set_item("columns", names)?;
+    d.set_item("data", data)?;
+    d.set_item(
+        "events",
+        events(py, &run.events, &run.limit_events, &run.retries, dt)?,
+    )?;
+    let json = serde_json::to_string(&summary).unwrap_or_else(|_| "{}".into());
+    d.set_item("summary", json)?;
+    d.set_item("source", source)?;
+    let error = match &run.error {
+        Some(e) => {
+            let err = PyDict::new(py);
+            err.set_item("message", format!("{e} ({source})"))?;
+            err.set_item("step", e.step())?;
+            err.set_item("t", e.step().map(|k| k as f64 * dt))?;
+            Some(err)
+        }
+        None => None,
+    };
+    d.set_item("error", error)?;
+    Ok(d)
+}

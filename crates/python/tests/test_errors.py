@@ -88,9 +88,10 @@ def test_unconvertible_dict_value_is_a_type_error():
 
 
 def test_hexapod_simulator_is_a_config_error_naming_model(examples):
-    # fbd.run simulates the hexapod's kinematic gait (test_hexapod.py); the
-    # step-wise Simulator is the planar dynamics only.
-    with pytest.raises(fbd.ConfigError) as info:
+    # fbd.run runs the hexapod (test_hexapod.py: the kinematic gait,
+    # test_spatial.py: the 3D dynamics); the step-wise Simulator is the
+    # planar dynamics only, and says so.
+    with pytest.raises(fbd.ConfigError, match="planar model only") as info:
         fbd.Simulator(examples / "hexapod_pose.toml")
     assert info.value.key == "model"
 

@@ -31,6 +31,7 @@ mod model;
 mod params;
 pub mod predictor;
 pub mod record;
+mod rules;
 mod run;
 pub mod spatial;
 pub mod step;

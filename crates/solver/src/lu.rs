@@ -67,7 +67,6 @@ pub(crate) struct Pattern {
     symbolic: SymbolicLu<usize>,
     /// Index of the numeric storage of this pattern's dimension.
     pub(crate) factors: usize,
-    ident: Vec<usize>,
     /// Solves ended since the last factorisation.
     solves_since: usize,
     /// Chord steps taken with the last factorisation.
@@ -128,7 +127,6 @@ impl Pattern {
             slot,
             symbolic,
             factors,
-            ident: (0..n).collect(),
             solves_since: 0,
             chords_since: 0,
             last_chords: 0,
@@ -136,9 +134,6 @@ impl Pattern {
     }
 
     fn col_perm(&self) -> PermRef<'_, usize> {
-        if std::env::var_os("NIDENT").is_some() {
-            return PermRef::new_checked(&self.ident, &self.ident, self.n);
-        }
         self.symbolic.col_perm()
     }
 

@@ -3,6 +3,7 @@
 use super::params::{SpatialControl, SpatialParams};
 use crate::SimError;
 use crate::record::LimitCode;
+use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
 use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism};
 use fbd_dynamics::{LimitState, PointKind};
@@ -33,35 +34,6 @@ pub struct SpatialModel {
     /// when its violation is at most this force (N). Default `1e-7 ×`
     /// weight.
     pub cycle_tolerance: f64,
-}
-
-fn check(
-    ok: bool,
-    key: &str,
-    what: &str,
-    got: impl std::fmt::Display,
-    expected: &str,
-) -> Result<(), SimError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(SimError::InvalidParameter {
-            key: key.into(),
-            what: what.into(),
-            got: got.to_string(),
-            expected: expected.into(),
-        })
-    }
-}
-
-fn positive(key: &str, v: f64) -> Result<(), SimError> {
-    check(
-        v.is_finite() && v > 0.0,
-        key,
-        "must be positive and finite",
-        v,
-        "a finite value > 0",
-    )
 }
 
 /// The body's inertia tensor from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`.

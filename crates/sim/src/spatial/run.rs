@@ -5,8 +5,8 @@ use super::model::SpatialModel;
 use super::record::SpatialRecord;
 use super::step::step;
 use crate::RunSummary;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use crate::rules::step_loop;
+use std::sync::atomic::AtomicBool;
 
 /// Runs `model` from its initial state to the end (or the first error, or
 /// until `stop` is set), handing every `stride`-th record to `on_row`.
@@ -16,31 +16,15 @@ pub fn run_until(
     mut on_row: impl FnMut(&SpatialRecord),
 ) -> RunSummary {
     let mut data = SpatialData::new(model);
-    let stride = model.params.stride.max(1);
-    let mut wall = 0.0;
-    let mut error = None;
-    let mut interrupted = false;
-    for k in 0..model.steps {
-        if stop.load(Ordering::Relaxed) {
-            interrupted = true;
-            break;
-        }
-        let start = Instant::now();
-        let result = step(model, &mut data);
-        wall += start.elapsed().as_secs_f64();
-        match result {
-            Ok(()) => {
-                if k % stride == 0 {
-                    on_row(&data.record);
-                }
-            }
-            Err(e) => {
-                error = Some(e);
-                break;
-            }
-        }
-    }
-    summary(data, wall, error, interrupted)
+    let end = step_loop(
+        &mut data,
+        model.steps,
+        model.params.stride,
+        stop,
+        |d| step(model, d),
+        |(), d| on_row(&d.record),
+    );
+    summary(data, end.wall, end.error, end.interrupted)
 }
 
 fn summary(

@@ -26,23 +26,16 @@ use super::data::SpatialData;
 use super::model::{SpatialModel, limit_code};
 use crate::SimError;
 use crate::record::{Event, LimitEvent, RetryEvent};
+use crate::rules::{MAX_STATE_TRIALS, Sink, limit_arrival, limit_release, regularization};
 use fbd_contact::spatial::{clearance, frame, point_at_distance, project};
 use fbd_contact::{SpatialState, SpatialTrial, transition_spatial};
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
     half_momentum, pattern, pattern_key, prepare_step, set_previous,
 };
-use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
+use fbd_dynamics::{History, LimitEquation, LimitState, NoJacobian};
 use fbd_kinematics::nalgebra::Vector3;
 use fbd_solver::{NewtonSolver, NewtonSystem, SolverError};
-
-/// Most solves of one (sub)step's state search.
-const MAX_STATE_TRIALS: usize = 64;
-/// A joint past an end by more than this (rad) reaches the limit.
-const LIMIT_ANGLE_TOL: f64 = 1e-10;
-/// The step length at which the contact rows carry the regularisation
-/// itself (as in the planar model).
-const REGULARIZATION_DT: f64 = 0.01;
 
 #[derive(Clone, Copy, Debug)]
 enum Failure {
@@ -58,17 +51,6 @@ impl Failure {
             Failure::Cycle { .. } => "cycle",
             Failure::NonFinite { .. } => "non-finite",
         }
-    }
-}
-
-/// Adapts the solver's sink to the assembly's sink trait.
-struct Sink<'s, 'a>(&'s mut fbd_solver::JacobianSink<'a>);
-
-impl JacobianSink for Sink<'_, '_> {
-    const ACTIVE: bool = true;
-    #[inline]
-    fn add(&mut self, row: usize, col: usize, v: f64) {
-        self.0.add(row, col, v);
     }
 }
 
@@ -203,8 +185,7 @@ fn start_search(data: &mut SpatialData) {
 
 /// The regularisation β for a (sub)step of length `h` (as the planar one).
 fn beta(model: &SpatialModel, h: f64) -> f64 {
-    let r = REGULARIZATION_DT / h;
-    model.params.contact.regularization * r * r
+    regularization(model.params.contact.regularization, h)
 }
 
 /// Stage 4's system for the current trial states.
@@ -464,30 +445,21 @@ fn check_states(model: &SpatialModel, data: &mut SpatialData) -> bool {
     let limits = &model.params.joint_limits;
     let mut release: Option<(usize, f64)> = None;
     for (l, lim) in mech.limits.iter().enumerate() {
-        let angle = data.z[lim.q_index];
-        match data.limit_trial[l] {
-            LimitState::Free => {
-                let side = limits
-                    .violated(lim.joint, angle - LIMIT_ANGLE_TOL)
-                    .and(limits.violated(lim.joint, angle + LIMIT_ANGLE_TOL));
-                if let Some(side) = side {
-                    data.limit_trial[l] = LimitState::At {
-                        side,
-                        angle: limits.end(lim.joint, side),
-                    };
-                    touchdown = true;
-                }
+        let state = data.limit_trial[l];
+        if !state.is_at() {
+            if let Some(at) = limit_arrival(limits, lim.joint, data.z[lim.q_index]) {
+                data.limit_trial[l] = at;
+                touchdown = true;
             }
-            LimitState::At { side, .. } => {
-                let push = side.sign() * data.z[lay.limit_moment(l)] / length;
-                if push < -model.params.contact.force_tol {
-                    let priority = 2e12 - push;
-                    if best.is_none_or(|b| priority > b.2) && release.is_none_or(|r| priority > r.1)
-                    {
-                        release = Some((l, priority));
-                    }
-                }
-            }
+        } else if let Some(priority) = limit_release(
+            &state,
+            data.z[lay.limit_moment(l)],
+            length,
+            model.params.contact.force_tol,
+        ) && best.is_none_or(|b| priority > b.2)
+            && release.is_none_or(|r| priority > r.1)
+        {
+            release = Some((l, priority));
         }
     }
     if !touchdown {

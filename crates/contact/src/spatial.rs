@@ -22,10 +22,12 @@
 //! friction keeps the force's direction, as in the plane), afterwards the
 //! last accepted step's slip direction. ST3 → ST2 when `s·û ≤
 //! v_stop·Δt`: the slide stopped (slower than `v_stop` = the larger of
-//! `speed_tol` and [`STOP_SPEED`], 1 µm/s, below which the friction
+//! `speed_tol` and [`STOP_SPEED`], 1e-9 m/s, below which the friction
 //! direction is regularised) or turned back (by more than 90° in one
 //! step) — the planar rule, the sliding velocity reversing or vanishing;
-//! the point is anchored under `p[k]`.
+//! the point is anchored under `p[k]`. (A slide about to stop whose
+//! implicit direction has no solution keeps `û` for that step, the planar
+//! rule exactly: `fbd_sim::spatial::step`.)
 //!
 //! With motion in the X–Y plane every vector has a zero `t2` component, û
 //! is `(±1, 0)` and each rule is the planar one: the planar engine and this
@@ -33,8 +35,9 @@
 
 use crate::mode::{ContactParams, Friction, StateCode};
 
-/// Slip speed (m/s) below which a 3D slide has stopped: 1 µm/s (the
-/// dynamics regularise the friction direction below it).
+/// Slip speed (m/s) below which a 3D slide has stopped: 1e-9 m/s, the
+/// planar `speed_tol` (the dynamics regularise the friction direction
+/// below it).
 pub const STOP_SPEED: f64 = 1e-9;
 use crate::surface::Surface;
 

@@ -1,5 +1,6 @@
 //! The immutable [`Model`] of a planar run, validated from [`PlanarParams`].
 
+use crate::rules::{check, positive};
 use crate::{PlanarParams, SimError};
 use fbd_contact::{ContactParams, ContactState};
 use fbd_dynamics::{Mechanism, PointKind, TwoLegInertia};
@@ -52,35 +53,6 @@ pub struct Model {
     /// Default `1e-7 × weight` (13 µN on the default robot: a penetration
     /// of 0.1 nm at Δt = 10 ms), the order of the solver's tolerances.
     pub cycle_tolerance: f64,
-}
-
-fn check(
-    ok: bool,
-    key: &str,
-    what: &str,
-    got: impl std::fmt::Display,
-    expected: &str,
-) -> Result<(), SimError> {
-    if ok {
-        Ok(())
-    } else {
-        Err(SimError::InvalidParameter {
-            key: key.into(),
-            what: what.into(),
-            got: got.to_string(),
-            expected: expected.into(),
-        })
-    }
-}
-
-fn positive(key: &str, v: f64) -> Result<(), SimError> {
-    check(
-        v.is_finite() && v > 0.0,
-        key,
-        "must be positive and finite",
-        v,
-        "a finite value > 0",
-    )
 }
 
 impl PlanarParams {

@@ -158,7 +158,7 @@ pub struct SpatialFbdData {
     next_is_candidate: bool,
 }
 
-/// Slip speed (m/s) below which a slide has stopped (1 µm/s): the friction
+/// Slip speed (m/s) below which a slide has stopped (1e-9 m/s): the friction
 /// direction is regularised below it (see [`slip_direction`]) and the
 /// state machine switches such a slide to ST2.
 pub use fbd_contact::spatial::STOP_SPEED;
@@ -170,11 +170,11 @@ pub use fbd_contact::spatial::STOP_SPEED;
 /// opposite of the force sticking needed) and `ε = STOP_SPEED·Δt`.
 /// Friction `−μD·N·ŝ` opposes the slip of the step itself (implicit, like
 /// everything at k+1) — exactly Coulomb's `s/|s|` for every slip faster
-/// than 1 µm/s; slower, it is regularised (linear in `w`), so that the
+/// than 1e-9 m/s; slower, it is regularised (linear in `w`), so that the
 /// equations always have a solution, and the slide counts as stopped. The
 /// bias `½ε·u` only picks the direction of a slip that has not started yet
 /// and turns a real slip's direction by at most `ε/(2|s|)` (5e-5 rad at
-/// 1 cm/s). Returns `(ŝ, max(|w|, ε))`.
+/// 1 cm/s at Δt = 1 ms). Returns `(ŝ, max(|w|, ε))`.
 #[inline]
 pub fn slip_direction(s: [f64; 2], u: [f64; 2], eps: f64) -> ([f64; 2], f64) {
     let w = [s[0] + 0.5 * eps * u[0], s[1] + 0.5 * eps * u[1]];

@@ -173,7 +173,7 @@ pub use fbd_contact::spatial::STOP_SPEED;
 /// than 1e-9 m/s; slower, it is regularised (linear in `w`), so that the
 /// equations always have a solution, and the slide counts as stopped. The
 /// bias `½ε·u` only picks the direction of a slip that has not started yet
-/// and turns a real slip's direction by at most `ε/(2|s|)` (5e-5 rad at
+/// and turns a real slip's direction by at most `ε/(2|s|)` (5e-8 rad at
 /// 1 cm/s at Δt = 1 ms). Returns `(ŝ, max(|w|, ε))`.
 #[inline]
 pub fn slip_direction(s: [f64; 2], u: [f64; 2], eps: f64) -> ([f64; 2], f64) {

@@ -1,8 +1,9 @@
 //! Stage "factorisation": faer's numeric sparse LU of one step's Jacobian
 //! (19 × 19), the symbolic analysis cached per pattern and the storage
 //! reused, exactly as each Newton iteration does (through the solver's
-//! `load_jacobian` / `factorize_loaded` hooks); and the LU plus the
-//! triangular solves of the Newton step.
+//! `load_jacobian` / `factorize_loaded` hooks); the LU plus the
+//! triangular solves of the Newton step; and the triangular solves alone
+//! (a chord step's solve, `solve_loaded`).
 //!
 //! `cargo bench -p fbd-suite --bench factorization`
 
@@ -28,6 +29,14 @@ fn bench(c: &mut Criterion) {
         c.bench_function(&format!("numeric_lu_and_solve/{}", case.name()), |b| {
             b.iter(|| {
                 solver.factorize_loaded(Some(&mut dx)).expect("nonsingular");
+                black_box(&dx);
+            })
+        });
+        // The solve of a chord step: the kept factorisation's triangular
+        // sweeps alone.
+        c.bench_function(&format!("chord_solve/{}", case.name()), |b| {
+            b.iter(|| {
+                solver.solve_loaded(&mut dx);
                 black_box(&dx);
             })
         });

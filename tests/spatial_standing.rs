@@ -47,16 +47,14 @@ fn at_rest_the_forces_and_torques_are_the_static_ones() {
             -l.upper_versor.dot(&outboard_hip),
             -l.lower_versor.dot(&outboard_knee),
         ];
-        for j in 0..3 {
-            let d = (leg.torque[j] - want[j]).abs();
+        for (j, (&tau, &want)) in leg.torque.iter().zip(&want).enumerate() {
+            let d = (tau - want).abs();
             worst = worst.max(d);
             assert!(
-                d < 1e-5 * (1.0 + want[j].abs()),
-                "leg {} θ{}: torque {} vs static {}",
+                d < 1e-5 * (1.0 + want.abs()),
+                "leg {} θ{}: torque {tau} vs static {want}",
                 leg.leg,
                 j + 1,
-                leg.torque[j],
-                want[j]
             );
         }
     }

@@ -455,7 +455,7 @@ fn runtime_failure_names_step_time_and_residual() {
     let last = rows.lines().last().unwrap();
     assert_eq!(rows.lines().count(), 1 + FAIL_STEP);
     // Times are the decimal of k·Δt.
-    assert!(last.starts_with("0.22,"), "{last}");
+    assert!(last.starts_with("0.25,"), "{last}");
     assert_no_temp_files(&out);
 }
 

@@ -400,7 +400,7 @@ fn a_failed_simulation_still_writes_everything() {
         .skip(1)
         .map(|l| l.split(',').next().unwrap().parse().unwrap())
         .collect();
-    assert_eq!(t.len(), FAIL_STEP, "rows for t = 0 … 0.22");
+    assert_eq!(t.len(), FAIL_STEP, "rows for t = 0 … 0.25");
     for (k, t) in t.iter().enumerate() {
         assert!((t - k as f64 * FAIL_DT).abs() < 1e-12, "row {k}: t = {t}");
     }

@@ -246,7 +246,7 @@ fn jobs_1_and_2_give_identical_runs_equal_to_fbd_run() {
 #[test]
 fn a_failing_run_is_isolated() {
     let t = tempfile::tempdir().unwrap();
-    // The reference failing experiment stops at step 23; stopped earlier,
+    // The reference failing experiment stops at step 26; stopped earlier,
     // it does not fail.
     std::fs::write(t.path().join("fail.toml"), common::FAILS).unwrap();
     let f = t.path().join("f.toml");

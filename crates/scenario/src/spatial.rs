@@ -307,9 +307,12 @@ impl HexapodConfig {
         }
         self.legs = Some(self.leg_numbers());
         let (m, side) = (self.body.mass, self.body.side);
-        self.body.inertia.get_or_insert_with(|| {
-            InertiaConfig::Components(hexagon_inertia(m, side)[..3].to_vec())
-        });
+        // Only from a valid mass and side: otherwise the check names them.
+        if m.is_finite() && m > 0.0 && side.is_finite() && side > 0.0 {
+            self.body.inertia.get_or_insert_with(|| {
+                InertiaConfig::Components(hexagon_inertia(m, side)[..3].to_vec())
+            });
+        }
         let d = SpatialParams::default();
         let l = &mut self.leg;
         let ru = *l.upper_radius.get_or_insert(d.upper_radius);

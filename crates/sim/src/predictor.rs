@@ -87,7 +87,11 @@ impl Predictor {
     /// the prediction), or `z` has the wrong length.
     pub fn predict(&self, z: &mut [f64]) {
         assert!(self.steps > 0, "the predictor needs an accepted step");
-        assert_eq!(z.len(), self.nq + self.f.len(), "unknowns of the wrong length");
+        assert_eq!(
+            z.len(),
+            self.nq + self.f.len(),
+            "unknowns of the wrong length"
+        );
         let [q_order, f_order] = self.orders();
         let (zq, zf) = z.split_at_mut(self.nq);
         for (zi, d) in zq.iter_mut().zip(&self.q) {
@@ -105,7 +109,11 @@ impl Predictor {
     /// # Panics
     /// If `z` has the wrong length.
     pub fn record(&mut self, z: &[f64], same_states: bool) {
-        assert_eq!(z.len(), self.nq + self.f.len(), "unknowns of the wrong length");
+        assert_eq!(
+            z.len(),
+            self.nq + self.f.len(),
+            "unknowns of the wrong length"
+        );
         let (zq, zf) = z.split_at(self.nq);
         self.orders = [
             argmin(&record_history(&mut self.q, zq)[1..=MAX_Q_ORDER]) + 1,
@@ -173,36 +181,37 @@ fn argmin(v: &[f64]) -> usize {
 mod tests {
     use super::*;
 
-/// The extrapolations one step ahead of a history `v` (newest first) by
-/// the polynomials through its first `p + 1` values, `p = 0, 1, …`:
-/// Newton's backward-difference form `v[0] + Σ_{j≤p} ∇ʲv[0]`, in which the
-/// differences of close values are exact and their small sum is added to
-/// `v[0]` last, so that an extrapolation rounds about once.
-fn extrapolations<const N: usize>(v: &[f64; N]) -> [f64; N] {
-    let mut d = *v;
-    let mut out = [v[0]; N];
-    let mut sum = 0.0;
-    for p in 1..N {
-        for i in 0..N - p {
-            d[i] -= d[i + 1];
+    /// The extrapolations of every order one step ahead of the history
+    /// `v` (newest first), through the predictor's own functions: the
+    /// values recorded oldest first, then extrapolated.
+    fn extrapolations<const N: usize>(v: &[f64; N]) -> [f64; N] {
+        let mut hist = [differences_of::<N>(v[N - 1])];
+        for &x in v[..N - 1].iter().rev() {
+            record_history(&mut hist, &[x]);
         }
-        sum += d[0];
-        out[p] = v[0] + sum;
+        std::array::from_fn(|p| extrapolate(&hist[0], p))
     }
-    out
-}
-
 
     #[test]
     fn extrapolations_are_exact_for_polynomials_of_their_order() {
         // v(t) = 1 + 2t − t² + 0.5t³ − 0.1t⁴ + 0.01t⁵ sampled at t = 0, −1, …
-        let f = |t: f64| 1.0 + 2.0 * t - t * t + 0.5 * t.powi(3) - 0.1 * t.powi(4) + 0.01 * t.powi(5);
+        let f =
+            |t: f64| 1.0 + 2.0 * t - t * t + 0.5 * t.powi(3) - 0.1 * t.powi(4) + 0.01 * t.powi(5);
         let v: [f64; 6] = std::array::from_fn(|j| f(-(j as f64)));
         let e = extrapolations(&v);
-        assert!((e[5] - f(1.0)).abs() < 1e-12, "quintic: {} vs {}", e[5], f(1.0));
+        assert!(
+            (e[5] - f(1.0)).abs() < 1e-12,
+            "quintic: {} vs {}",
+            e[5],
+            f(1.0)
+        );
         // Lower orders are exact for lower-degree polynomials.
         for p in 0..6 {
-            let g = |t: f64| (0..=p).map(|d| (d as f64 + 1.0) * t.powi(d as i32)).sum::<f64>();
+            let g = |t: f64| {
+                (0..=p)
+                    .map(|d| (d as f64 + 1.0) * t.powi(d as i32))
+                    .sum::<f64>()
+            };
             let v: [f64; 6] = std::array::from_fn(|j| g(-(j as f64)));
             let e = extrapolations(&v);
             for (order, ep) in e.iter().enumerate().skip(p) {

@@ -5,9 +5,10 @@ use fbd_contact::StateCode;
 use fbd_kinematics::Joint;
 
 /// The state of a joint limit as written to the output files.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum LimitCode {
     /// Inside the range.
+    #[default]
     Free,
     /// At the lower end (`min`).
     Min,

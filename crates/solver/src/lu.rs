@@ -150,8 +150,7 @@ impl Pattern {
     pub(crate) fn renew(&self, cost: f64) -> bool {
         cost > 0.0
             && self.solves_since > 0
-            && self.last_chords as f64 * self.solves_since as f64
-                > cost + self.chords_since as f64
+            && self.last_chords as f64 * self.solves_since as f64 > cost + self.chords_since as f64
     }
 }
 
@@ -353,7 +352,9 @@ mod tests {
     fn matrix(n: usize, seed: u64) -> Vec<(usize, usize, f64)> {
         let mut s = seed;
         let mut next = || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
         };
         let mut e = Vec::new();
@@ -378,13 +379,14 @@ mod tests {
             for &(i, j, v) in &triplets {
                 values[pattern.slot[i * n + j] as usize] += v;
             }
-            let mut mem = MemBuffer::new(Factors::scratch(n).or(
-                pattern.symbolic.solve_in_place_scratch::<f64>(1, Par::Seq).or(
-                    pattern
+            let mut mem = MemBuffer::new(
+                Factors::scratch(n).or(pattern
+                    .symbolic
+                    .solve_in_place_scratch::<f64>(1, Par::Seq)
+                    .or(pattern
                         .symbolic
-                        .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-                ),
-            ));
+                        .factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()))),
+            );
             let mut factors = Factors::new(n, &mut mem);
             factors
                 .factor(&mut pattern, &values, &mut mem)

@@ -62,20 +62,21 @@ pub struct NewtonParams {
     /// iterate of this solve or from an earlier solve — instead of
     /// factoring the Jacobian at the iterate. A chord step
     /// `Δx = −J_old⁻¹ r(x)` costs one residual evaluation and one pair of
-    /// triangular solves. It is kept when it decreases the scaled residual
-    /// max-norm; the next step refactors (a full Newton step at the
-    /// iterate, then chord steps again with that factorisation) when it did
-    /// not decrease it, when it contracted by less than
-    /// [`Self::chord_contraction`], or when, at the observed contraction,
-    /// the tolerance would not be reached within the remaining chord steps.
+    /// triangular solves. It is kept when it converged or contracted the
+    /// scaled residual max-norm by [`Self::chord_contraction`] at least
+    /// (else it is discarded); the next step refactors (a full Newton step
+    /// at the iterate, then chord steps again with that factorisation) when
+    /// it was discarded, when, at the observed contraction, the tolerance
+    /// would not be reached within the remaining chord steps, or after a
+    /// damped full step (far from the root).
     /// Convergence is still the residual test on the true residual
     /// (tolerances unchanged); `max_iterations` counts the full Newton
     /// steps. `0` disables chord steps: every step refactors (pure Newton).
     /// Default: `0`.
     pub chord_steps: usize,
-    /// Contraction a chord step must reach, `‖r(x + Δx)‖ ≤
-    /// chord_contraction · ‖r(x)‖`, for the next step to be a chord step
-    /// too. Default: `0.1`.
+    /// Contraction a chord step must reach to be kept (unless it
+    /// converged), `‖r(x + Δx)‖ ≤ chord_contraction · ‖r(x)‖`. Default:
+    /// `0.1`.
     pub chord_contraction: f64,
     /// **Renewal of the kept factorisation across solves**: the cost of a
     /// refactorisation in chord steps (its numeric LU and Jacobian, beyond
@@ -526,8 +527,7 @@ impl Workspace {
         // Chord steps since the last factorisation (or the start).
         *run = 0;
         // Whether the pattern's factorisation may serve the next step.
-        let mut usable =
-            chords && factors.holds(pattern) && !pattern.renew(params.refactor_cost);
+        let mut usable = chords && factors.holds(pattern) && !pattern.renew(params.refactor_cost);
         // Whether `values` holds the Jacobian at `x` (`r` always holds the
         // residual at `x`).
         let mut have_jacobian = !usable;
@@ -558,8 +558,10 @@ impl Workspace {
                 if self.dx.iter().all(|d| d.is_finite()) {
                     trial(&mut self.x_trial, x, &self.dx, 1.0);
                     Self::eval_residual(sys, &self.x_trial, &mut self.r_trial);
+                    // Kept when it converged or contracted enough; else
+                    // discarded, and the next step refactors at `x`.
                     if let Some(t) = scaled_norm(sys, &self.r_trial)
-                        && t < rnorm
+                        && (t <= params.residual_tol || t <= params.chord_contraction * rnorm)
                     {
                         x.copy_from_slice(&self.x_trial);
                         std::mem::swap(&mut self.r, &mut self.r_trial);
@@ -569,15 +571,14 @@ impl Workspace {
                         pattern.chords_since += 1;
                         let rate = t / rnorm;
                         rnorm = t;
-                        // Keep chord steps while they contract well and, at
-                        // the observed rate, reach the tolerance within the
-                        // steps left; otherwise refactor at the new iterate.
+                        // Keep chord steps while, at the observed rate, they
+                        // reach the tolerance within the steps left;
+                        // otherwise refactor at the new iterate.
                         let needed = (params.residual_tol / rnorm).ln() / rate.ln();
                         // Negated so that a NaN estimate also refactors.
                         #[allow(clippy::neg_cmp_op_on_partial_ord)]
-                        let on_track = rate <= params.chord_contraction
-                            && (rnorm <= params.residual_tol
-                                || needed <= (params.chord_steps - *run) as f64);
+                        let on_track = rnorm <= params.residual_tol
+                            || needed <= (params.chord_steps - *run) as f64;
                         usable = on_track;
                     }
                 }
@@ -685,7 +686,9 @@ impl Workspace {
             std::mem::swap(&mut self.r, &mut self.r_trial);
             rnorm = trial_norm;
             full += 1;
-            usable = chords;
+            // A damped step: far from the root, where the Jacobian changes
+            // fast; the next step refactors too.
+            usable = chords && alpha == 1.0;
             *run = 0;
         }
     }

@@ -356,3 +356,83 @@ fn error_messages_are_one_line() {
         .contains("iteration 20")
     );
 }
+
+/// Chord steps (`NewtonParams::chord_steps`): along a sequence of nearby
+/// problems most steps reuse the kept factorisation, every solve still
+/// meets the tolerance on the true residual, and the report counts chord
+/// and full steps and factorisations consistently.
+#[test]
+fn chord_steps_reuse_the_factorisation_and_converge() {
+    let root = root10();
+    let mut sys = TrigChain::with_root(&root, 1);
+    let mut solver = NewtonSolver::new(NewtonParams {
+        chord_steps: 6,
+        ..NewtonParams::default()
+    });
+    let mut x = vec![0.0; 10];
+    let first = solver.solve(&mut sys, &mut x).expect("converges");
+    assert_eq!(
+        first.chord_iterations,
+        first.iterations - first.factorizations.min(first.iterations)
+    );
+    let (mut chords, mut fulls, mut lus) = (0, 0, 0);
+    for k in 1..=100 {
+        let target: Vec<f64> = root.iter().map(|r| r + 0.002 * k as f64).collect();
+        sys.retarget(&target);
+        let rep = solver.solve(&mut sys, &mut x).expect("converges");
+        assert!(rep.residual <= 1e-9, "{rep:?}");
+        for (xi, ti) in x.iter().zip(&target) {
+            assert!((xi - ti).abs() < 1e-8, "step {k}: {x:?} vs {target:?}");
+        }
+        assert!(rep.chord_iterations <= rep.iterations);
+        // A full step factors once; the step test may add one.
+        let full = rep.iterations - rep.chord_iterations;
+        assert!(
+            rep.factorizations >= full && rep.factorizations <= full + 1,
+            "{rep:?}"
+        );
+        chords += rep.chord_iterations;
+        fulls += full;
+        lus += rep.factorizations;
+    }
+    assert!(chords > 3 * fulls, "chord {chords}, full {fulls}");
+    assert!(lus < 40, "{lus} factorisations in 100 solves");
+}
+
+/// The renewal rule (`NewtonParams::refactor_cost`): when the kept
+/// factorisation has grown stale the next solve starts with one; without
+/// the rule (cost 0) the same sequence refactors less often.
+#[test]
+fn the_renewal_rule_refactors_a_stale_factorisation() {
+    let root = root10();
+    let run = |cost: f64| {
+        let mut sys = TrigChain::with_root(&root, 1);
+        let mut solver = NewtonSolver::new(NewtonParams {
+            chord_steps: 20,
+            chord_contraction: 0.9,
+            refactor_cost: cost,
+            ..NewtonParams::default()
+        });
+        let mut x = vec![0.0; 10];
+        let (mut chords, mut lus) = (0, 0);
+        for k in 0..60 {
+            let target: Vec<f64> = root.iter().map(|r| r + 0.02 * k as f64).collect();
+            sys.retarget(&target);
+            let rep = solver.solve(&mut sys, &mut x).expect("converges");
+            assert!(rep.residual <= 1e-9);
+            chords += rep.chord_iterations;
+            lus += rep.factorizations;
+        }
+        (chords, lus)
+    };
+    let (chords_off, lus_off) = run(0.0);
+    let (chords_on, lus_on) = run(2.0);
+    assert!(
+        lus_on > lus_off,
+        "renewal: {lus_on} vs {lus_off} factorisations"
+    );
+    assert!(
+        chords_on < chords_off,
+        "renewal: {chords_on} vs {chords_off} chord steps"
+    );
+}

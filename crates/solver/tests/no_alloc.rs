@@ -16,7 +16,7 @@ mod common;
 use std::alloc::System;
 
 use common::{Cubic, Pivoting, TrigChain};
-use fbd_solver::{NewtonSolver, SolverError};
+use fbd_solver::{NewtonParams, NewtonSolver, SolverError};
 use stats_alloc::{INSTRUMENTED_SYSTEM, Region, Stats, StatsAlloc};
 
 #[global_allocator]
@@ -115,4 +115,41 @@ fn second_solve_of_a_pattern_does_not_allocate() {
         assert_no_heap("re-pivoted refactorisation", stats);
     }
     assert_eq!(solver.symbolic_factorizations(), 3);
+
+    // Chord steps with a kept factorisation, refactorisations when they
+    // contract too little, the renewal rule across solves, and patterns of
+    // one dimension sharing their numeric storage: a sequence of nearby
+    // solves as a simulation makes them.
+    let mut solver = NewtonSolver::new(NewtonParams {
+        chord_steps: 6,
+        refactor_cost: 4.0,
+        ..NewtonParams::default()
+    });
+    let mut other = TrigChain::with_root(&root_a, 3);
+    let mut x = vec![0.0; 10];
+    solver.solve(&mut chain, &mut x).expect("first solve");
+    solver.solve(&mut other, &mut x).expect("second pattern");
+    let targets: Vec<Vec<f64>> = (0..200)
+        .map(|k| {
+            root_a
+                .iter()
+                .map(|r| r + 0.3 * (0.05 * k as f64).sin())
+                .collect()
+        })
+        .collect();
+    let region = Region::new(GLOBAL);
+    let mut chords = 0;
+    let mut ok = true;
+    for (k, target) in targets.iter().enumerate() {
+        let sys = if k % 50 == 49 { &mut other } else { &mut chain };
+        sys.retarget(target);
+        match solver.solve(sys, &mut x) {
+            Ok(rep) => chords += rep.chord_iterations,
+            Err(_) => ok = false,
+        }
+    }
+    let stats = region.change();
+    assert!(ok);
+    assert!(chords > 100, "chord steps taken: {chords}");
+    assert_no_heap("chord steps and refactorisations", stats);
 }

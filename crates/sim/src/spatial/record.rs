@@ -47,12 +47,6 @@ pub struct LegRow {
     pub limit: [LimitCode; 3],
 }
 
-impl Default for LimitCode {
-    fn default() -> Self {
-        LimitCode::Free
-    }
-}
-
 /// Everything known about spatial step `k` once it is solved: row `k` of
 /// `trajectory.csv`.
 #[derive(Clone, Debug, PartialEq)]

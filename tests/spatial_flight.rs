@@ -113,7 +113,10 @@ fn weightless(n: usize) -> (f64, f64, f64, f64, f64) {
 #[test]
 fn angular_momentum_is_conserved_to_1e_9() {
     let (worst_h, ..) = weightless(2000);
-    assert!(worst_h < 1e-9, "angular momentum drifts by {worst_h:e} (relative)");
+    assert!(
+        worst_h < 1e-9,
+        "angular momentum drifts by {worst_h:e} (relative)"
+    );
 }
 
 #[test]
@@ -121,8 +124,14 @@ fn no_energy_drift_over_1e5_steps() {
     let (worst_h, e_first, e_last, e_min, e_max) = weightless(100_000);
     let drift = (e_last - e_first).abs() / e_first;
     assert!(drift < 1e-5, "energy drifts by {drift:e} (relative)");
-    assert!((e_max - e_min) / e_first < 1e-3, "energy oscillates by more than 0.1 %");
-    assert!(worst_h < 2e-6, "angular momentum drifts by {worst_h:e} over 1e5 steps");
+    assert!(
+        (e_max - e_min) / e_first < 1e-3,
+        "energy oscillates by more than 0.1 %"
+    );
+    assert!(
+        worst_h < 2e-6,
+        "angular momentum drifts by {worst_h:e} over 1e5 steps"
+    );
 }
 
 #[test]
@@ -152,5 +161,8 @@ fn the_scheme_is_second_order() {
     let (e1, e2, e3) = (err(2e-3), err(1e-3), err(0.5e-3));
     let (p1, p2) = ((e1 / e2).log2(), (e2 / e3).log2());
     println!("max |q − q_ref| over [0, {t}] s: {e1:.3e} {e2:.3e} {e3:.3e}; orders {p1:.3} {p2:.3}");
-    assert!((1.8..2.2).contains(&p1) && (1.8..2.2).contains(&p2), "orders {p1} {p2}");
+    assert!(
+        (1.8..2.2).contains(&p1) && (1.8..2.2).contains(&p2),
+        "orders {p1} {p2}"
+    );
 }

@@ -7,11 +7,11 @@
 
 mod common;
 
+use common::spatial::stance;
 use fbd_contact::spatial::{clearance, frame};
 use fbd_contact::{Friction, Surface, Terrain};
 use fbd_dynamics::spatial::SpatialKin;
 use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_collect};
-use common::spatial::stance;
 
 /// Checks the law on every contact row; returns (sticking, sliding) rows.
 fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize) {
@@ -40,10 +40,20 @@ fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize) {
                     let ftn = ft.iter().map(|v| v * v).sum::<f64>().sqrt();
                     if state == "ST2" {
                         sticking += 1;
-                        assert!(ftn <= mu_s * n + tol, "t = {}: |Ft| {ftn} > μS·N {}", r.t, mu_s * n);
+                        assert!(
+                            ftn <= mu_s * n + tol,
+                            "t = {}: |Ft| {ftn} > μS·N {}",
+                            r.t,
+                            mu_s * n
+                        );
                     } else {
                         sliding += 1;
-                        assert!((ftn - mu_d * n).abs() < tol, "t = {}: |Ft| {ftn} ≠ μD·N {}", r.t, mu_d * n);
+                        assert!(
+                            (ftn - mu_d * n).abs() < tol,
+                            "t = {}: |Ft| {ftn} ≠ μD·N {}",
+                            r.t,
+                            mu_d * n
+                        );
                         let slip: Vec<f64> = (0..3).map(|i| nc.point[i] - c.point[i]).collect();
                         let dot: f64 = ft.iter().zip(&slip).map(|(a, b)| a * b).sum();
                         let sn = slip.iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -70,7 +80,10 @@ fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize) {
         }
     }
     println!("{aligned} of {checked} sliding rows with friction within 0.08° of the slip");
-    assert!(aligned * 100 >= checked * 95, "{aligned} of {checked} aligned");
+    assert!(
+        aligned * 100 >= checked * 95,
+        "{aligned} of {checked} aligned"
+    );
     (sticking, sliding)
 }
 
@@ -92,8 +105,14 @@ fn a_spinning_landing_obeys_coulomb_on_every_row() {
     let (rows, summary) = run_collect(&model);
     assert!(summary.error.is_none(), "{:?}", summary.error);
     let (stick, slide) = check_law(&model, &rows);
-    println!("{stick} sticking and {slide} sliding rows, {} events", summary.events.len());
-    assert!(stick > 100 && slide > 20, "the run should both stick and slide");
+    println!(
+        "{stick} sticking and {slide} sliding rows, {} events",
+        summary.events.len()
+    );
+    assert!(
+        stick > 100 && slide > 20,
+        "the run should both stick and slide"
+    );
 }
 
 fn on_slope(mu: f64) -> (SpatialModel, Vec<SpatialRecord>) {

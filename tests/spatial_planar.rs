@@ -24,11 +24,22 @@ fn compare(p: &PlanarParams) {
         for (i, j) in map {
             let d = (a.q[i] - b.q[j]).abs();
             worst = worst.max(d);
-            assert!(d < 1e-8, "t = {}: planar q[{i}] = {} vs spatial q[{j}] = {}", a.t, a.q[i], b.q[j]);
+            assert!(
+                d < 1e-8,
+                "t = {}: planar q[{i}] = {} vs spatial q[{j}] = {}",
+                a.t,
+                a.q[i],
+                b.q[j]
+            );
         }
         // Out of the plane: nothing moves.
         for j in [2, 3, 4, 6, 9] {
-            assert!(b.q[j].abs() < 1e-9, "t = {}: out-of-plane q[{j}] = {}", b.t, b.q[j]);
+            assert!(
+                b.q[j].abs() < 1e-9,
+                "t = {}: out-of-plane q[{j}] = {}",
+                b.t,
+                b.q[j]
+            );
         }
     }
     let ev = |e: &fbd_sim::Event| (e.step, e.leg, e.point, e.from, e.to);
@@ -41,7 +52,11 @@ fn compare(p: &PlanarParams) {
         summary3.limit_events.iter().map(lev).collect::<Vec<_>>(),
         "limit events differ"
     );
-    println!("{} rows, {} events, max |Δq| = {worst:.2e}", rows.len(), planar.len());
+    println!(
+        "{} rows, {} events, max |Δq| = {worst:.2e}",
+        rows.len(),
+        planar.len()
+    );
 }
 
 #[test]

@@ -19,7 +19,10 @@ fn drop_smoke() {
         summary.events.len()
     );
     for e in summary.events.iter().take(40) {
-        println!("{:.4} leg{} {} {:?}->{:?}", e.t, e.leg, e.point, e.from, e.to);
+        println!(
+            "{:.4} leg{} {} {:?}->{:?}",
+            e.t, e.leg, e.point, e.from, e.to
+        );
     }
     for r in rows.iter().step_by(100) {
         println!(
@@ -30,7 +33,10 @@ fn drop_smoke() {
             r.q[4],
             r.q[5],
             r.kinetic + r.potential,
-            r.contacts.iter().map(|c| c.state.as_str()).collect::<Vec<_>>()
+            r.contacts
+                .iter()
+                .map(|c| c.state.as_str())
+                .collect::<Vec<_>>()
         );
     }
 }

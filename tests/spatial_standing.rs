@@ -21,10 +21,23 @@ fn at_rest_the_forces_and_torques_are_the_static_ones() {
     let mech = &model.mech;
     let weight = mech.total_mass() * p.gravity;
     let normal: f64 = last.contacts.iter().map(|c| c.force[1]).sum();
-    println!("Σ N = {normal:.9} N, weight {weight:.9} N, events {}", summary.events.len());
-    assert!((normal - weight).abs() < 1e-6 * weight, "Σ N = {normal}, weight {weight}");
+    println!(
+        "Σ N = {normal:.9} N, weight {weight:.9} N, events {}",
+        summary.events.len()
+    );
+    assert!(
+        (normal - weight).abs() < 1e-6 * weight,
+        "Σ N = {normal}, weight {weight}"
+    );
     for c in &last.contacts {
-        assert_eq!(c.state.as_str(), if c.kind.as_str() == "tip" { "ST2" } else { "ST1" });
+        assert_eq!(
+            c.state.as_str(),
+            if c.kind.as_str() == "tip" {
+                "ST2"
+            } else {
+                "ST1"
+            }
+        );
     }
     let mut kin = SpatialKin::new(&model.mech);
     kin.eval(mech, &last.q);

@@ -31,4 +31,3 @@ pub fn stance() -> SpatialParams {
     p.q0[1] = -tip_y;
     p
 }
-

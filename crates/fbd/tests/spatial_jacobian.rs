@@ -126,7 +126,14 @@ fn check(surface: &Surface, first_step: bool, limits_at: bool) {
     z[..lay.nq].copy_from_slice(&q_at(&mech, 0.003));
     let mut r = vec![0.0; n];
     let mut jac = vec![0.0; n * n];
-    eval(&mech, surface, &mut data, &z, &mut r, &mut Dense { n, m: &mut jac });
+    eval(
+        &mech,
+        surface,
+        &mut data,
+        &z,
+        &mut r,
+        &mut Dense { n, m: &mut jac },
+    );
     // The declared pattern covers every non-zero entry.
     let mut entries = Vec::new();
     pattern(&mech, &data, &mut entries);

@@ -77,7 +77,10 @@ fn angular_momentum_is_exact() {
     let (_, ls) = scheme(&w0, 0.01, 2000);
     let l0 = ls[0];
     let worst = ls.iter().map(|l| (l - l0).norm()).fold(0.0, f64::max);
-    assert!(worst < 1e-12 * l0.norm(), "angular momentum drifts by {worst:e}");
+    assert!(
+        worst < 1e-12 * l0.norm(),
+        "angular momentum drifts by {worst:e}"
+    );
 }
 
 #[test]
@@ -108,7 +111,10 @@ fn second_order_against_euler_equations() {
     let (e1, e2, e3) = (err(100), err(200), err(400));
     let (p1, p2) = ((e1 / e2).log2(), (e2 / e3).log2());
     println!("errors {e1:.3e} {e2:.3e} {e3:.3e}, orders {p1:.3} {p2:.3}");
-    assert!((1.9..2.1).contains(&p1) && (1.9..2.1).contains(&p2), "orders {p1} {p2}");
+    assert!(
+        (1.9..2.1).contains(&p1) && (1.9..2.1).contains(&p2),
+        "orders {p1} {p2}"
+    );
 }
 
 #[test]
@@ -131,7 +137,10 @@ fn spinning_near_the_intermediate_axis_flips() {
     let wy_ref: Vec<f64> = ref_run.iter().map(|(_, w)| w.y).collect();
     let t_ref = first_flip(&wy_ref, t_end / 240_000.0).expect("Euler's equations flip");
     println!("first flip: scheme {t_scheme:.4} s, Runge–Kutta {t_ref:.4} s");
-    assert!((t_scheme - t_ref).abs() < 0.01 * t_ref, "{t_scheme} vs {t_ref}");
+    assert!(
+        (t_scheme - t_ref).abs() < 0.01 * t_ref,
+        "{t_scheme} vs {t_ref}"
+    );
     // And it flips back: ω_y returns positive.
     let back = wy.iter().skip_while(|v| **v > 0.0).position(|v| *v > 0.0);
     assert!(back.is_some(), "the spin flips back");

@@ -37,13 +37,12 @@ pub struct Predictor {
     /// Number of coordinates `q` at the front of the unknowns.
     nq: usize,
     /// Per coordinate, its backward differences at the newest step,
-    /// `∇ʲq_i[k]` for `j = 0..=MAX_Q_ORDER + 1` (the higher ones
-    /// meaningful only as far as `steps` and `smooth` allow; the last one
-    /// measures the error of the highest order).
-    q: Vec<[f64; MAX_Q_ORDER + 2]>,
+    /// `∇ʲq_i[k]` for `j = 0..=MAX_Q_ORDER` (the higher ones meaningful
+    /// only as far as `steps` and `smooth` allow).
+    q: Vec<[f64; MAX_Q_ORDER + 1]>,
     /// Per force (the unknowns after `q`), the backward differences of its
     /// solutions at the newest step.
-    f: Vec<[f64; MAX_FORCE_ORDER + 2]>,
+    f: Vec<[f64; MAX_FORCE_ORDER + 1]>,
     /// Accepted steps recorded (`k`).
     steps: usize,
     /// How many recorded steps before the newest were solved in the
@@ -116,8 +115,8 @@ impl Predictor {
         );
         let (zq, zf) = z.split_at(self.nq);
         self.orders = [
-            argmin(&record_history(&mut self.q, zq)[1..=MAX_Q_ORDER]) + 1,
-            argmin(&record_history(&mut self.f, zf)[..=MAX_FORCE_ORDER]),
+            argmin(&record_history(&mut self.q, zq)[1..]) + 1,
+            argmin(&record_history(&mut self.f, zf)),
         ];
         self.smooth = if same_states {
             (self.smooth + 1).min(MAX_Q_ORDER - 1)
@@ -147,20 +146,17 @@ fn extrapolate(d: &[f64], p: usize) -> f64 {
 /// Records `values` as the newest step of the histories whose backward
 /// differences are `hist` (`∇ʲv[k]` → `∇ʲv[k+1] = ∇ʲ⁻¹v[k+1] −
 /// ∇ʲ⁻¹v[k]`), and returns, for each extrapolation order `p`, the largest
-/// error with which it would have predicted them, `|∇ᵖ⁺¹v[k+1]|` (the
-/// highest order's error is not known: infinity).
+/// error with which it would have predicted them, `|∇ᵖ⁺¹v[k+1]|` (for
+/// the highest order, `∇ᴺv[k+1]` is computed but not stored).
 fn record_history<const N: usize>(hist: &mut [[f64; N]], values: &[f64]) -> [f64; N] {
     let mut err = [0.0f64; N];
-    err[N - 1] = f64::INFINITY;
     for (d, &v) in hist.iter_mut().zip(values) {
         let mut new = v;
-        for j in 0..N {
-            let old = d[j];
-            d[j] = new;
+        for (dj, e) in d.iter_mut().zip(err.iter_mut()) {
+            let old = *dj;
+            *dj = new;
             new -= old;
-            if j + 1 < N {
-                err[j] = err[j].max(new.abs());
-            }
+            *e = e.max(new.abs());
         }
     }
     err

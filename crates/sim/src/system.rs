@@ -67,28 +67,32 @@ pub(crate) fn row_scales(
     let k = fbd.position_gain;
     let force = fbd.total_mass * mech.gravity.abs().max(1.0) + 1e-6 * k * (1.0 + extent);
     let moment = force * fbd.length_scale;
+    let position = 1e-3 * k * (1.0 + extent);
+    // Each row takes one of three scales: `(scale, weight)` pairs, three
+    // divisions per system.
+    let [force, moment, position] = [force, moment, position].map(|s| (s, 1.0 / s));
+    let mut set = |row: usize, (s, w): (f64, f64)| {
+        scales[row] = s;
+        weights[row] = w;
+    };
     for b in 0..lay.bodies {
         let row = lay.body_row(b);
-        scales[row] = force;
-        scales[row + 1] = force;
-        scales[row + 2] = moment;
+        set(row, force);
+        set(row + 1, force);
+        set(row + 2, moment);
     }
     for (c, eq) in fbd.contact.iter().enumerate() {
         let row = lay.contact_row(c);
-        let position = 1e-3 * k * (1.0 + extent);
         let (s0, s1) = match eq.state {
             ContactState::Free => (force, force),
             ContactState::Stick { .. } => (position, position),
             ContactState::Slide { .. } => (force, position),
         };
-        scales[row] = s0;
-        scales[row + 1] = s1;
+        set(row, s0);
+        set(row + 1, s1);
     }
     // A joint-limit row is a moment, free (λ) or at an end (Kθ·δθ).
     for l in 0..lay.limits {
-        scales[lay.limit_row(l)] = moment;
-    }
-    for (w, &s) in weights.iter_mut().zip(scales.iter()) {
-        *w = 1.0 / s;
+        set(lay.limit_row(l), moment);
     }
 }

@@ -51,6 +51,14 @@ pub struct SpatialSummary {
     pub newton_iterations: usize,
     /// Newton iterations of one step (every state trial): mean and largest.
     pub newton_iterations_per_step: PerStep,
+    /// Of `newton_iterations`, the chord steps (a factorisation kept from
+    /// an earlier iterate or step).
+    pub chord_iterations: usize,
+    /// Of `newton_iterations`, the full Newton steps (the Jacobian factored
+    /// at the iterate).
+    pub full_newton_iterations: usize,
+    /// Numeric LU factorisations over the whole run.
+    pub numeric_factorizations: u64,
     /// Time in the stepping loop alone (s).
     pub wall_seconds: f64,
     /// `steps / wall_seconds` (null when not measurable).
@@ -262,6 +270,9 @@ impl Collector {
                 },
                 max: self.iter_max,
             },
+            chord_iterations: run.chord_iterations,
+            full_newton_iterations: run.newton_iterations - run.chord_iterations,
+            numeric_factorizations: run.numeric_factorizations,
             wall_seconds: run.wall_seconds,
             steps_per_second: (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds),
             symbolic_factorizations: run.symbolic_factorizations,

@@ -81,11 +81,10 @@ pub fn half_momentum(
     dt: f64,
 ) -> (Vector3<f64>, Matrix3<f64>) {
     let psi = so3::log(&(r_k.transpose() * r_next));
-    let half = so3::exp(&(0.5 * psi));
-    let r_mid = r_k * half;
+    let r_mid = r_k * so3::exp(&(0.5 * psi));
     let ipsi = inertia * psi;
     // The same operations as `half_momentum_value`: bit-identical values.
-    let l = r_k * (half * ipsi) / dt;
+    let l = r_k * so3::rotate(&(0.5 * psi), &ipsi) / dt;
     let d = r_mid
         * (inertia - 0.5 * so3::hat(&ipsi) * so3::right_jacobian(&(0.5 * psi)))
         * so3::right_jacobian_inv(&psi)
@@ -102,7 +101,7 @@ pub fn half_momentum_value(
     dt: f64,
 ) -> Vector3<f64> {
     let psi = so3::log(&(r_k.transpose() * r_next));
-    r_k * (so3::exp(&(0.5 * psi)) * (inertia * psi)) / dt
+    r_k * so3::rotate(&(0.5 * psi), &(inertia * psi)) / dt
 }
 
 /// Mutable workspace of the spatial assembly (allocated once).
@@ -141,6 +140,15 @@ pub struct SpatialFbdData {
     pub force: Vec<Vector3<f64>>,
     /// Per body, the sum of applied moments about its CoM at k (N·m).
     pub moment: Vec<Vector3<f64>>,
+    /// `L[k+½]` of every body at the accepted `q[k+1]` over a step of
+    /// `l_carry_dt`, handed to the next step's [`prepare_step`] as its
+    /// `L[k−½]` (the same function of the same rotations, so the same
+    /// numbers) when `l_carry_valid`; the stepping loop sets it.
+    pub l_carry: Vec<Vector3<f64>>,
+    /// The step length of `l_carry`.
+    pub l_carry_dt: f64,
+    /// Whether `l_carry` holds the last accepted step's momenta.
+    pub l_carry_valid: bool,
     /// `ε = STOP_SPEED·Δt` (m) of [`slip_direction`].
     pub slip_bias: f64,
     /// Per contact, the slip direction `ŝ` at the last evaluated iterate
@@ -155,6 +163,8 @@ pub struct SpatialFbdData {
     pub slip_len: Vec<f64>,
     slip_n: Vec<f64>,
     rot_d: Vec<Matrix3<f64>>,
+    /// The `q` `kin_next` was last evaluated at (NaN: none).
+    kin_next_q: Vec<f64>,
     next_is_candidate: bool,
 }
 
@@ -202,6 +212,9 @@ impl SpatialFbdData {
             hip_dir: vec![Vector3::zeros(); nl],
             knee_dir: vec![[Vector3::zeros(); 2]; nl],
             l_next: vec![Vector3::zeros(); nb],
+            l_carry: vec![Vector3::zeros(); nb],
+            l_carry_dt: 0.0,
+            l_carry_valid: false,
             slip_bias: 0.0,
             slip_hat: vec![[0.0; 2]; mech.contacts.len()],
             slip_len: vec![1.0; mech.contacts.len()],
@@ -210,6 +223,7 @@ impl SpatialFbdData {
             force: vec![Vector3::zeros(); nb],
             moment: vec![Vector3::zeros(); nb],
             rot_d: vec![Matrix3::zeros(); nb],
+            kin_next_q: vec![f64::NAN; mech.layout().nq],
             next_is_candidate: false,
         }
     }
@@ -246,6 +260,8 @@ pub fn prepare_step(
 ) {
     data.dt = dt;
     data.slip_bias = STOP_SPEED * dt;
+    let carried = data.l_carry_valid;
+    data.l_carry_valid = false;
     data.position_gain = mech.total_mass() / (dt * dt);
     let l = mech.length_scale();
     data.limit_gain = data.position_gain * l * l;
@@ -255,12 +271,16 @@ pub fn prepare_step(
             History::Previous => BodyStep3 {
                 c_next: 1.0,
                 x_const: -2.0 * com_k + data.kin_prev.com[b],
-                l_const: half_momentum_value(
-                    &data.kin_prev.rot[b],
-                    &data.kin.rot[b],
-                    &mech.bodies[b].inertia,
-                    dt,
-                ),
+                l_const: if carried && data.l_carry_dt == dt {
+                    data.l_carry[b]
+                } else {
+                    half_momentum_value(
+                        &data.kin_prev.rot[b],
+                        &data.kin.rot[b],
+                        &mech.bodies[b].inertia,
+                        dt,
+                    )
+                },
                 com_k,
             },
             History::Initial { qdot } => {
@@ -287,7 +307,11 @@ pub fn prepare_step(
 /// Evaluates the kinematics at a candidate `q[k+1]` into `kin_next` (after
 /// the solve), so that [`advance`] can accept it.
 pub fn evaluate_next(mech: &SpatialMechanism, data: &mut SpatialFbdData, q_next: &[f64]) {
-    data.kin_next.eval(mech, q_next);
+    // The last evaluation is usually at the solution already.
+    if data.kin_next_q != q_next {
+        data.kin_next.eval(mech, q_next);
+        data.kin_next_q.copy_from_slice(q_next);
+    }
     data.next_is_candidate = true;
 }
 
@@ -303,6 +327,7 @@ pub fn advance(data: &mut SpatialFbdData) {
     );
     std::mem::swap(&mut data.kin_prev, &mut data.kin);
     std::mem::swap(&mut data.kin, &mut data.kin_next);
+    data.kin_next_q.fill(f64::NAN);
     data.next_is_candidate = false;
 }
 
@@ -372,7 +397,10 @@ pub fn eval<S: JacobianSink>(
     let lay = mech.layout();
     assert_eq!(z.len(), lay.dim(), "unknown vector has the wrong length");
     assert_eq!(r.len(), lay.dim(), "residual vector has the wrong length");
-    data.kin_next.eval(mech, &z[..lay.nq]);
+    if data.kin_next_q[..] != z[..lay.nq] {
+        data.kin_next.eval(mech, &z[..lay.nq]);
+        data.kin_next_q.copy_from_slice(&z[..lay.nq]);
+    }
     data.next_is_candidate = false;
     let dt = data.dt;
     for (b, body) in mech.bodies.iter().enumerate() {

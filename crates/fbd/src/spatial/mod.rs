@@ -65,8 +65,9 @@ pub mod mechanism;
 pub mod so3;
 
 pub use assemble::{
-    BodyStep3, SpatialContactEquation, SpatialFbdData, advance, eval, evaluate_next, half_momentum,
-    momentum, pattern, pattern_key, prepare_step, set_configuration, set_previous,
+    BodyStep3, STOP_SPEED, SpatialContactEquation, SpatialFbdData, advance, eval, evaluate_next,
+    half_momentum, half_momentum_value, momentum, pattern, pattern_key, prepare_step,
+    set_configuration, set_previous, slip_direction,
 };
 pub use kin::{Columns, SpatialKin};
 pub use mechanism::{

@@ -40,6 +40,8 @@ pub struct SpatialData {
     pub retries: Vec<RetryEvent>,
     /// Newton iterations so far.
     pub newton_iterations: usize,
+    /// Of the Newton iterations, the chord steps (a factorisation reused).
+    pub chord_iterations: usize,
     /// Most Newton iterations of one step so far.
     pub max_step_iterations: usize,
     /// Cycling state searches closed by their least inconsistent trial.
@@ -47,6 +49,8 @@ pub struct SpatialData {
     /// Joint torques `(τ1, τ2, τ3)` per leg applied at the next step
     /// instead of the controller's, when `Some` (kept until changed).
     pub external_torque: Option<Vec<[f64; 3]>>,
+    /// The predictor of each step's unknowns ([`crate::predictor`]).
+    pub predictor: crate::predictor::Predictor,
     /// The record of the last step (refilled every step).
     pub record: SpatialRecord,
     /// The gait generator's workspace (gait control only).
@@ -119,6 +123,7 @@ impl SpatialData {
             _ => None,
         };
         let free = vec![LimitState::Free; lay.limits];
+        let predictor = crate::predictor::Predictor::new(q0, &z);
         Self {
             k: 0,
             q_prev: q0.clone(),
@@ -133,9 +138,11 @@ impl SpatialData {
             limit_events: Vec::with_capacity(64),
             retries: Vec::with_capacity(16),
             newton_iterations: 0,
+            chord_iterations: 0,
             max_step_iterations: 0,
             resolved_cycles: 0,
             external_torque: None,
+            predictor,
             record,
             gait,
             scales: vec![1.0; lay.dim()],

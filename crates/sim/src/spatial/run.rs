@@ -37,6 +37,7 @@ fn summary(
         steps: data.k,
         newton_iterations: data.newton_iterations,
         max_newton_iterations: data.max_step_iterations,
+        chord_iterations: data.chord_iterations,
         numeric_factorizations: data.solver.numeric_factorizations(),
         wall_seconds: wall,
         symbolic_factorizations: data.symbolic_factorizations(),

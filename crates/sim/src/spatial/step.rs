@@ -4,8 +4,7 @@
 //! 1. **kinematics at k** — every body's constants, the constraint
 //!    directions ([`fbd_dynamics::spatial::prepare_step`]);
 //! 2. **joint torques at k** ([`super::control`]);
-//! 3. **predictor** — quadratic extrapolation of `q` (the initial velocity
-//!    at k = 0, linear at k = 1);
+//! 3. **predictor** — [`crate::predictor`] (the initial velocity at k = 0);
 //! 4. **solve** — Newton on the FBD equations with the trial contact and
 //!    limit states;
 //! 5. **state check** — every touchdown and limit arrival at once, the most
@@ -31,7 +30,7 @@ use fbd_contact::spatial::{clearance, frame, point_at_distance, project};
 use fbd_contact::{SpatialState, SpatialTrial, transition_spatial};
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
-    half_momentum, pattern, pattern_key, prepare_step, set_previous,
+    half_momentum_value, pattern, pattern_key, prepare_step, set_previous,
 };
 use fbd_dynamics::{History, LimitEquation, LimitState, NoJacobian};
 use fbd_kinematics::nalgebra::Vector3;
@@ -96,7 +95,9 @@ pub fn step(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimError
     let first = match solve(model, data) {
         Ok((iterations, trials)) => {
             make_record(model, data, iterations, trials, model.dt());
-            accept(model, data, t);
+            let same = accept(model, data, t);
+            data.fbd.l_carry_valid = true;
+            data.predictor.record(&data.z, same);
             data.k += 1;
             return Ok(());
         }
@@ -159,13 +160,13 @@ pub fn prepare(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimEr
     };
     prepare_step(mech, &mut data.fbd, history, dt);
     joint_torques(model, data)?;
-    let nq = model.nq();
-    for i in 0..nq {
-        data.z[i] = match k {
-            0 => data.q[i] + dt * model.params.qdot0[i],
-            1 => 2.0 * data.q[i] - data.q_prev[i],
-            _ => 3.0 * (data.q[i] - data.q_prev[i]) + data.q_prev2[i],
-        };
+    // The initial velocity at k = 0, then the shared predictor.
+    if k == 0 {
+        for i in 0..model.nq() {
+            data.z[i] = data.q[i] + dt * model.params.qdot0[i];
+        }
+    } else {
+        data.predictor.predict(&mut data.z);
     }
     start_search(data);
     Ok(())
@@ -296,6 +297,7 @@ fn solve(model: &SpatialModel, data: &mut SpatialData) -> Result<(usize, usize),
             }
         };
         newton_iterations += report.iterations;
+        data.chord_iterations += report.chord_iterations;
         if data.z.iter().any(|v| !v.is_finite()) {
             return Err(Failure::NonFinite {
                 residual: report.residual,
@@ -614,8 +616,9 @@ fn describe_states(model: &SpatialModel, states: &[SpatialState]) -> String {
         .join(" ")
 }
 
-/// Stage 6.
-fn accept(model: &SpatialModel, data: &mut SpatialData, t: f64) {
+/// Stage 6; `true` when no contact or limit state changed.
+fn accept(model: &SpatialModel, data: &mut SpatialData, t: f64) -> bool {
+    let (events, limit_events) = (data.events.len(), data.limit_events.len());
     let mech = &model.mech;
     let k = data.k;
     for (c, spec) in mech.contacts.iter().enumerate() {
@@ -662,6 +665,7 @@ fn accept(model: &SpatialModel, data: &mut SpatialData, t: f64) {
     let nq = model.nq();
     data.q.copy_from_slice(&data.z[..nq]);
     advance(&mut data.fbd);
+    data.events.len() == events && data.limit_events.len() == limit_events
 }
 
 fn save_grid(data: &mut SpatialData) {
@@ -726,10 +730,11 @@ fn substeps(model: &SpatialModel, data: &mut SpatialData, n: usize) -> Result<()
             data.record.newton_iterations += iterations;
             data.record.state_trials += trials;
         }
-        accept(model, data, t + i as f64 * h);
+        let _ = accept(model, data, t + i as f64 * h);
     }
     data.q_prev.copy_from_slice(&data.grid_q);
     data.q_prev2.copy_from_slice(&data.grid_q_prev);
+    data.predictor.record(&data.z, false);
     set_previous(mech, &mut data.fbd, &data.grid_q);
     Ok(())
 }
@@ -799,8 +804,10 @@ fn make_record(
         let r = joint_rates(model, data, s);
         data.record.legs[s].rate = r;
     }
-    // Energies and momenta over the step k → k+1 (the scheme's own).
-    let fbd = &data.fbd;
+    // Energies and momenta over the step k → k+1 (the scheme's own); the
+    // momenta are the next step's L[k−½] when this step is accepted whole.
+    let fbd = &mut data.fbd;
+    let mut carry = std::mem::take(&mut fbd.l_carry);
     let g = model.params.gravity;
     let (mut kinetic, mut potential) = (0.0, 0.0);
     let (mut p, mut hmom) = (Vector3::zeros(), Vector3::zeros());
@@ -809,13 +816,16 @@ fn make_record(
         let v = (c1 - c0) / h;
         let psi =
             fbd_dynamics::spatial::so3::log(&(fbd.kin.rot[b].transpose() * fbd.kin_next.rot[b]));
-        let (l, _) = half_momentum(&fbd.kin.rot[b], &fbd.kin_next.rot[b], &body.inertia, h);
+        let l = half_momentum_value(&fbd.kin.rot[b], &fbd.kin_next.rot[b], &body.inertia, h);
+        carry[b] = l;
         kinetic +=
             0.5 * body.mass * v.norm_squared() + 0.5 * psi.dot(&(body.inertia * psi)) / (h * h);
         potential += body.mass * g * 0.5 * (c0.y + c1.y);
         p += body.mass * v;
         hmom += body.mass * c0.cross(&v) + l;
     }
+    fbd.l_carry = carry;
+    fbd.l_carry_dt = h;
     let rec = &mut data.record;
     rec.kinetic = kinetic;
     rec.potential = potential;

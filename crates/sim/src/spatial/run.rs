@@ -47,7 +47,6 @@ fn summary(
         retries: data.retries,
         resolved_cycles: data.resolved_cycles,
         interrupted,
-        ..RunSummary::default()
     }
 }
 

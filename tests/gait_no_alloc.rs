@@ -30,15 +30,25 @@ fn gait_steps_do_not_allocate() {
     // A first step outside the count (one-time lazy initialisations of the
     // process, if any).
     step(&m, &mut data, 0).expect("reachable");
-    let region = Region::new(GLOBAL);
-    for k in 0..=m.steps {
-        step(&m, &mut data, k).expect("reachable");
+    // The counters are process-global: an allocation by another thread of
+    // the test harness during the measurement would count too. A step that
+    // allocates does so in every pass (1001 steps), so the best of three
+    // passes is the gait's own count.
+    let mut best = None;
+    for _ in 0..3 {
+        let region = Region::new(GLOBAL);
+        for k in 0..=m.steps {
+            step(&m, &mut data, k).expect("reachable");
+        }
+        let stats = region.change();
+        let counts = (stats.allocations, stats.reallocations, stats.deallocations);
+        if best.is_none_or(|(b, _)| counts < b) {
+            best = Some((counts, stats));
+        }
+        if counts == (0, 0, 0) {
+            break;
+        }
     }
-    let stats = region.change();
-    assert_eq!(
-        (stats.allocations, stats.reallocations, stats.deallocations),
-        (0, 0, 0),
-        "{} steps: {stats:?}",
-        m.steps + 1
-    );
+    let (counts, stats) = best.expect("three passes");
+    assert_eq!(counts, (0, 0, 0), "{} steps: {stats:?}", m.steps + 1);
 }

@@ -147,7 +147,14 @@ def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call():
     import _thread
     import threading
 
-    long = {"time": {"dt": 1e-4, "duration": 100.0}, "terrain": {"kind": "none"}}
+    # Long enough to outlast the timer at any speed (3e6 steps of a free
+    # fall, a row every 10 steps: the signals are looked at every 4096
+    # rows).
+    long = {
+        "time": {"dt": 1e-4, "duration": 300.0},
+        "terrain": {"kind": "none"},
+        "output": {"stride": 10},
+    }
     timer = threading.Timer(0.3, _thread.interrupt_main)
     timer.start()
     with pytest.raises(KeyboardInterrupt, match="interrupted after"):

@@ -150,7 +150,14 @@ def test_ctrl_c_interrupts_a_dynamic_run():
     import _thread
     import threading
 
-    long = {"model": "hexapod", "time": {"dt": 0.001, "duration": 20.0}}
+    # Long enough to outlast the timer at any speed (a robot at rest
+    # steps fastest: 2e5 steps, a row every 10; the signals are looked at
+    # every 4096 rows).
+    long = {
+        "model": "hexapod",
+        "time": {"dt": 0.001, "duration": 200.0},
+        "output": {"stride": 10},
+    }
     timer = threading.Timer(0.3, _thread.interrupt_main)
     timer.start()
     with pytest.raises(KeyboardInterrupt, match="interrupted after"):

@@ -47,3 +47,15 @@ def run_cli(cli: pathlib.Path, *args: str) -> subprocess.CompletedProcess:
 def tmp(tmp_path: pathlib.Path) -> pathlib.Path:
     yield tmp_path
     shutil.rmtree(tmp_path, ignore_errors=True)
+
+
+@pytest.fixture
+def sigint_raises():
+    """Python's own SIGINT handler for the test: a shell that starts the
+    suite in the background makes SIGINT ignored, and an ignored signal is
+    never raised (not even by `_thread.interrupt_main`)."""
+    import signal
+
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)

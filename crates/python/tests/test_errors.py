@@ -143,7 +143,7 @@ def test_unwritable_out_is_an_os_error(tmp):
         fbd.run("[time]\nduration = 0.05\n", out=f)
 
 
-def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call():
+def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call(sigint_raises):
     import _thread
     import threading
 

@@ -146,7 +146,7 @@ def test_a_two_legged_dynamic_hexapod(tmp):
     assert np.allclose(r["ry"][free], 0.6 - 0.5 * G * t[free] ** 2, atol=1e-9)
 
 
-def test_ctrl_c_interrupts_a_dynamic_run():
+def test_ctrl_c_interrupts_a_dynamic_run(sigint_raises):
     import _thread
     import threading
 

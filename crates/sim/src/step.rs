@@ -40,6 +40,7 @@ use crate::energy;
 use crate::record::{
     Event, LimitCode, LimitEvent, MAX_CONTACTS, MAX_JOINTS, RetryEvent, StepRecord,
 };
+use crate::rules::{MAX_STATE_TRIALS, limit_arrival, limit_release, regularization};
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
@@ -555,35 +556,11 @@ fn set_contact_equations(model: &Model, data: &mut Data) {
     }
 }
 
-/// The (sub)step length at which the contact and stop rows carry the
-/// regularisation [`fbd_contact::ContactParams::regularization`] itself
-/// (s): the default Δt.
-const REGULARIZATION_DT: f64 = 0.01;
-
 /// The regularisation β of the contact and stop rows for a (sub)step of
-/// length `h`: `ContactParams::regularization · (0.01 s / h)²`, so that the
-/// compliance it stands for, `β·h²/M` (m/N), is the same at every Δt
-/// (7.8e-14 m/N on the default robot) instead of shrinking as `h²`. A
-/// compliance that shrinks with `h²` makes the split of the forces of a
-/// statically indeterminate set (a robot lying on six sticking points)
-/// round-off: at Δt = 1 ms one ulp of a coordinate (1.1e-16 m) was 0.14 N
-/// of internal friction, enough to make a lightly loaded foot at rest flip
-/// between sticking and sliding every few steps. The fixed compliance is
-/// still far too stiff for its spring to be resolved (its period on a
-/// 1.1 kg link is 2 µs): contacts stay rigid and plastic.
+/// length `h` ([`crate::rules::regularization`]).
 fn beta(model: &Model, h: f64) -> f64 {
-    let r = REGULARIZATION_DT / h;
-    model.contact.regularization * r * r
+    regularization(model.contact.regularization, h)
 }
-
-/// Most solves of one (sub)step's state search: a search that has not
-/// settled by then is treated as a cycle (the step is retried in
-/// substeps). The default experiment needs at most 6.
-const MAX_STATE_TRIALS: usize = 64;
-
-/// A joint whose trial angle is beyond an end by more than this (rad)
-/// reaches the limit: far below any physical scale, above round-off.
-const LIMIT_ANGLE_TOL: f64 = 1e-10;
 
 /// Applies the switching rules to the trial solution; `true` if any point
 /// or joint limit switched. Every touchdown (ST1 → ST2) and every joint
@@ -657,32 +634,21 @@ fn check_states(model: &Model, data: &mut Data) -> bool {
     for (l, &j) in model.mech.limits.iter().enumerate() {
         let angle = data.z[model.mech.joints[j].q_index];
         let joint = model.limit_joint[l];
-        match data.limit_trial[l] {
-            LimitState::Free => {
-                let limits = &model.params.joint_limits;
-                let side = limits
-                    .violated(joint, angle - LIMIT_ANGLE_TOL)
-                    .and(limits.violated(joint, angle + LIMIT_ANGLE_TOL));
-                if let Some(side) = side {
-                    data.limit_trial[l] = LimitState::At {
-                        side,
-                        angle: limits.end(joint, side),
-                    };
-                    touchdown = true;
-                }
+        let state = data.limit_trial[l];
+        if !state.is_at() {
+            if let Some(at) = limit_arrival(&model.params.joint_limits, joint, angle) {
+                data.limit_trial[l] = at;
+                touchdown = true;
             }
-            LimitState::At { side, .. } => {
-                // The stop's moment, as a force at the length scale; it
-                // must push away from the end.
-                let push = side.sign() * data.z[lay.limit_moment(l)] / length;
-                if push < -model.contact.force_tol {
-                    let priority = 2e12 - push;
-                    let beats_contact = best.is_none_or(|b| priority > b.2);
-                    if beats_contact && release.is_none_or(|r| priority > r.1) {
-                        release = Some((l, priority));
-                    }
-                }
-            }
+        } else if let Some(priority) = limit_release(
+            &state,
+            data.z[lay.limit_moment(l)],
+            length,
+            model.contact.force_tol,
+        ) && best.is_none_or(|b| priority > b.2)
+            && release.is_none_or(|r| priority > r.1)
+        {
+            release = Some((l, priority));
         }
     }
     if !touchdown {

@@ -1,19 +1,9 @@
 //! One step's FBD equations seen as a [`NewtonSystem`].
 
+use crate::rules::Sink;
 use fbd_contact::{ContactState, Terrain};
-use fbd_dynamics::{FbdData, JacobianSink, Mechanism, NoJacobian};
+use fbd_dynamics::{FbdData, Mechanism, NoJacobian};
 use fbd_solver::NewtonSystem;
-
-/// Adapts the solver's sink to the assembly's sink trait.
-struct Sink<'s, 'a>(&'s mut fbd_solver::JacobianSink<'a>);
-
-impl JacobianSink for Sink<'_, '_> {
-    const ACTIVE: bool = true;
-    #[inline]
-    fn add(&mut self, row: usize, col: usize, v: f64) {
-        self.0.add(row, col, v);
-    }
-}
 
 /// One step's FBD equations as a [`NewtonSystem`] (borrowing the model and
 /// the workspace); built by [`crate::step::system`].

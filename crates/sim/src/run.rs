@@ -1,9 +1,9 @@
 //! The stepping loop of a whole run.
 
 use crate::record::{Event, LimitEvent, RetryEvent, StepRecord};
+use crate::rules::step_loop;
 use crate::{Data, Model, SimError, step};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::Instant;
+use std::sync::atomic::AtomicBool;
 
 /// Outcome of [`run`].
 #[derive(Clone, Debug, Default)]
@@ -66,33 +66,15 @@ pub fn run_until(
     mut on_row: impl FnMut(&StepRecord),
 ) -> RunSummary {
     let mut data = Data::new(model);
-    let stride = model.params.stride.max(1);
-    let mut error = None;
-    let mut interrupted = false;
-    // The loop's time minus the observer's: the clock is read around the
-    // loop and around each written row only, not around every step.
-    let mut observer = std::time::Duration::ZERO;
-    let start = Instant::now();
-    for k in 0..model.steps {
-        if stop.load(Ordering::Relaxed) {
-            interrupted = true;
-            break;
-        }
-        match step(model, &mut data) {
-            Ok(rec) => {
-                if k % stride == 0 {
-                    let t = Instant::now();
-                    on_row(&rec);
-                    observer += t.elapsed();
-                }
-            }
-            Err(e) => {
-                error = Some(e);
-                break;
-            }
-        }
-    }
-    let wall = start.elapsed().saturating_sub(observer).as_secs_f64();
+    let end = step_loop(
+        &mut data,
+        model.steps,
+        model.params.stride,
+        stop,
+        |d| step(model, d),
+        |rec, _| on_row(rec),
+    );
+    let (wall, error, interrupted) = (end.wall, end.error, end.interrupted);
     RunSummary {
         steps: data.k,
         newton_iterations: data.newton_iterations,

@@ -9,23 +9,34 @@
 
 use crate::{Data, Model};
 
-/// A joint-space target trajectory of one leg: `(θ2, θ3)` (rad) at `times`
-/// (s), linear in between, held before the first and after the last point.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct LegTrajectory {
+/// A joint-space target trajectory of one leg: `N` joint angles (rad) at
+/// `times` (s), linear in between, held before the first and after the
+/// last point. The planar model's is `(θ2, θ3)` (`N = 2`), the spatial
+/// model's `(θ1, θ2, θ3)` ([`crate::spatial::LegTrajectory3`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LegTrajectory<const N: usize = 2> {
     /// Strictly increasing times (s), at least one.
     pub times: Vec<f64>,
-    /// `(θ2, θ3)` (rad) at each time.
-    pub targets: Vec<[f64; 2]>,
+    /// The joint angles (rad) at each time.
+    pub targets: Vec<[f64; N]>,
 }
 
-impl LegTrajectory {
+impl<const N: usize> Default for LegTrajectory<N> {
+    fn default() -> Self {
+        Self {
+            times: Vec::new(),
+            targets: Vec::new(),
+        }
+    }
+}
+
+impl<const N: usize> LegTrajectory<N> {
     /// The target at time `t`.
-    pub fn at(&self, t: f64) -> [f64; 2] {
+    pub fn at(&self, t: f64) -> [f64; N] {
         let (ts, xs) = (&self.times, &self.targets);
         let n = ts.len().min(xs.len());
         if n == 0 {
-            return [0.0; 2];
+            return [0.0; N];
         }
         if t <= ts[0] {
             return xs[0];
@@ -35,10 +46,7 @@ impl LegTrajectory {
         }
         let i = ts[..n].partition_point(|&s| s <= t) - 1;
         let u = (t - ts[i]) / (ts[i + 1] - ts[i]);
-        [
-            xs[i][0] + u * (xs[i + 1][0] - xs[i][0]),
-            xs[i][1] + u * (xs[i + 1][1] - xs[i][1]),
-        ]
+        std::array::from_fn(|j| xs[i][j] + u * (xs[i + 1][j] - xs[i][j]))
     }
 }
 

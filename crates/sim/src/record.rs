@@ -17,6 +17,15 @@ pub enum LimitCode {
 }
 
 impl LimitCode {
+    /// The code of a joint limit's state.
+    pub fn of(state: &fbd_dynamics::LimitState) -> Self {
+        match state.key() {
+            0 => LimitCode::Free,
+            1 => LimitCode::Min,
+            _ => LimitCode::Max,
+        }
+    }
+
     /// `"free"`, `"min"` or `"max"`.
     pub fn as_str(self) -> &'static str {
         match self {

@@ -164,3 +164,38 @@ pub(crate) fn step_loop<D, R>(
     end.wall = start.elapsed().saturating_sub(observer).as_secs_f64();
     end
 }
+
+/// Why one attempt at a step (whole or in substeps) failed; made into a
+/// [`SimError`] only when every retry has failed (no allocation before).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Failure {
+    Newton(fbd_solver::SolverError),
+    Cycle { residual: f64 },
+    NonFinite { residual: f64 },
+}
+
+impl Failure {
+    /// The retry event's cause.
+    pub(crate) fn cause(self) -> &'static str {
+        match self {
+            Failure::Newton(_) => "newton",
+            Failure::Cycle { .. } => "cycle",
+            Failure::NonFinite { .. } => "non-finite",
+        }
+    }
+
+    /// The run's error for step `step` at `t`; `states` names the state
+    /// combination of a cycle (called only then).
+    pub(crate) fn error(self, step: usize, t: f64, states: impl FnOnce() -> String) -> SimError {
+        match self {
+            Failure::Newton(source) => SimError::Newton { step, t, source },
+            Failure::Cycle { residual } => SimError::Cycling {
+                step,
+                t,
+                states: states(),
+                residual,
+            },
+            Failure::NonFinite { residual } => SimError::NonFinite { step, t, residual },
+        }
+    }
+}

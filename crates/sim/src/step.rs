@@ -40,7 +40,7 @@ use crate::energy;
 use crate::record::{
     Event, LimitCode, LimitEvent, MAX_CONTACTS, MAX_JOINTS, RetryEvent, StepRecord,
 };
-use crate::rules::{MAX_STATE_TRIALS, limit_arrival, limit_release, regularization};
+use crate::rules::{Failure, MAX_STATE_TRIALS, limit_arrival, limit_release, regularization};
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
@@ -48,26 +48,7 @@ use fbd_contact::{ContactState, Trial, transition};
 use fbd_dynamics::{
     ContactEquation, History, LimitEquation, LimitState, advance, evaluate_next, prepare_step,
 };
-use fbd_solver::{NewtonSolver, SolverError};
-
-/// Why one attempt at a step (whole or in substeps) failed; made into a
-/// [`SimError`] only when every retry has failed (no allocation before).
-#[derive(Clone, Copy, Debug)]
-enum Failure {
-    Newton(SolverError),
-    Cycle { residual: f64 },
-    NonFinite { residual: f64 },
-}
-
-impl Failure {
-    fn cause(self) -> &'static str {
-        match self {
-            Failure::Newton(_) => "newton",
-            Failure::Cycle { .. } => "cycle",
-            Failure::NonFinite { .. } => "non-finite",
-        }
-    }
-}
+use fbd_solver::NewtonSolver;
 
 /// Solves step `data.k` and advances the state to `k + 1`, retrying in
 /// substeps when the whole step cannot be solved (see the module docs).
@@ -114,20 +95,9 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
             }
         }
     }
-    Err(match first {
-        Failure::Newton(source) => SimError::Newton { step: k, t, source },
-        Failure::Cycle { residual } => SimError::Cycling {
-            step: k,
-            t,
-            states: describe_states(model, &data.failed_trial, &data.failed_limits),
-            residual,
-        },
-        Failure::NonFinite { residual } => SimError::NonFinite {
-            step: k,
-            t,
-            residual,
-        },
-    })
+    Err(first.error(k, t, || {
+        describe_states(model, &data.failed_trial, &data.failed_limits)
+    }))
 }
 
 /// Stages 4–5: solves the current (sub)step until its contact and limit
@@ -218,8 +188,8 @@ fn accept(model: &Model, data: &mut Data, t: f64) -> bool {
     }
     for (l, &j) in mech.limits.iter().enumerate() {
         let (from, to) = (
-            limit_code(&data.limit_states[l]),
-            limit_code(&data.limit_trial[l]),
+            LimitCode::of(&data.limit_states[l]),
+            LimitCode::of(&data.limit_trial[l]),
         );
         if from != to {
             data.limit_events.push(LimitEvent {
@@ -769,14 +739,6 @@ fn states_key(data: &Data) -> u64 {
     data.limit_trial.iter().fold(k, |k, s| k * 3 + s.key())
 }
 
-fn limit_code(s: &LimitState) -> LimitCode {
-    match s.key() {
-        0 => LimitCode::Free,
-        1 => LimitCode::Min,
-        _ => LimitCode::Max,
-    }
-}
-
 fn describe_states(model: &Model, states: &[ContactState], limits: &[LimitState]) -> String {
     let mut parts: Vec<String> = model
         .mech
@@ -788,7 +750,7 @@ fn describe_states(model: &Model, states: &[ContactState], limits: &[LimitState]
     for (l, s) in limits.iter().enumerate() {
         if s.is_at() {
             let j = &model.mech.joints[model.mech.limits[l]];
-            parts.push(format!("{}={}", j.name, limit_code(s).as_str()));
+            parts.push(format!("{}={}", j.name, LimitCode::of(s).as_str()));
         }
     }
     parts.join(" ")
@@ -821,7 +783,7 @@ fn make_record(
     }
     for (l, &j) in mech.limits.iter().enumerate() {
         if j < MAX_JOINTS {
-            r.limit[j] = limit_code(&data.limit_trial[l]);
+            r.limit[j] = LimitCode::of(&data.limit_trial[l]);
             r.limit_moment[j] = data.z[lay.limit_moment(l)];
         }
     }

@@ -100,8 +100,18 @@ pub fn half_momentum_value(
     inertia: &Matrix3<f64>,
     dt: f64,
 ) -> Vector3<f64> {
+    half_momentum_and_rotation(r_k, r_next, inertia, dt).0
+}
+
+/// [`half_momentum_value`] and the step's rotation `ψ` it is made of.
+pub fn half_momentum_and_rotation(
+    r_k: &Matrix3<f64>,
+    r_next: &Matrix3<f64>,
+    inertia: &Matrix3<f64>,
+    dt: f64,
+) -> (Vector3<f64>, Vector3<f64>) {
     let psi = so3::log(&(r_k.transpose() * r_next));
-    r_k * so3::rotate(&(0.5 * psi), &(inertia * psi)) / dt
+    (r_k * so3::rotate(&(0.5 * psi), &(inertia * psi)) / dt, psi)
 }
 
 /// Mutable workspace of the spatial assembly (allocated once).

@@ -66,8 +66,8 @@ pub mod so3;
 
 pub use assemble::{
     BodyStep3, STOP_SPEED, SpatialContactEquation, SpatialFbdData, advance, eval, evaluate_next,
-    half_momentum, half_momentum_value, momentum, pattern, pattern_key, prepare_step,
-    set_configuration, set_previous, slip_direction,
+    half_momentum, half_momentum_and_rotation, half_momentum_value, momentum, pattern, pattern_key,
+    prepare_step, set_configuration, set_previous, slip_direction,
 };
 pub use kin::{Columns, SpatialKin};
 pub use mechanism::{

@@ -2,11 +2,10 @@
 
 use super::params::{SpatialControl, SpatialParams};
 use crate::SimError;
-use crate::record::LimitCode;
 use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
+use fbd_dynamics::PointKind;
 use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism};
-use fbd_dynamics::{LimitState, PointKind};
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::leg::LegGeometry;
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
@@ -293,14 +292,5 @@ impl SpatialModel {
     /// Gravity vector (m/s²).
     pub fn gravity(&self) -> Vector3<f64> {
         Vector3::new(0.0, -self.params.gravity, 0.0)
-    }
-}
-
-/// The limit code of a limit state.
-pub(crate) fn limit_code(s: &LimitState) -> LimitCode {
-    match s.key() {
-        0 => LimitCode::Free,
-        1 => LimitCode::Min,
-        _ => LimitCode::Max,
     }
 }

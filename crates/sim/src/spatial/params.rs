@@ -7,35 +7,8 @@ use fbd_contact::{ContactParams, Friction, Surface};
 use fbd_dynamics::mechanism::ContactPoints;
 use fbd_kinematics::JointLimits;
 
-/// A joint-space target trajectory of one leg: `(θ1, θ2, θ3)` (rad) at
-/// `times` (s), linear in between, held before the first and after the last.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct LegTrajectory3 {
-    /// Strictly increasing times (s), at least one.
-    pub times: Vec<f64>,
-    /// `(θ1, θ2, θ3)` (rad) at each time.
-    pub targets: Vec<[f64; 3]>,
-}
-
-impl LegTrajectory3 {
-    /// The target at time `t`.
-    pub fn at(&self, t: f64) -> [f64; 3] {
-        let (ts, xs) = (&self.times, &self.targets);
-        let n = ts.len().min(xs.len());
-        if n == 0 {
-            return [0.0; 3];
-        }
-        if t <= ts[0] {
-            return xs[0];
-        }
-        if t >= ts[n - 1] {
-            return xs[n - 1];
-        }
-        let i = ts[..n].partition_point(|&s| s <= t) - 1;
-        let u = (t - ts[i]) / (ts[i + 1] - ts[i]);
-        std::array::from_fn(|j| xs[i][j] + u * (xs[i + 1][j] - xs[i][j]))
-    }
-}
+/// A joint-space target trajectory of one leg, `(θ1, θ2, θ3)` (rad).
+pub type LegTrajectory3 = crate::control::LegTrajectory<3>;
 
 /// The joint controller of a spatial run: torques at step `k` computed
 /// explicitly from `q[k]` and `q[k−1]`, `τ = kp·(θ* − θ) + kd·(θ̇* − θ̇)`,

@@ -22,36 +22,19 @@
 
 use super::control::{joint_rates, joint_torques};
 use super::data::SpatialData;
-use super::model::{SpatialModel, limit_code};
+use super::model::SpatialModel;
 use crate::SimError;
-use crate::record::{Event, LimitEvent, RetryEvent};
-use crate::rules::{MAX_STATE_TRIALS, Sink, limit_arrival, limit_release, regularization};
+use crate::record::{Event, LimitCode, LimitEvent, RetryEvent};
+use crate::rules::{Failure, MAX_STATE_TRIALS, Sink, limit_arrival, limit_release, regularization};
 use fbd_contact::spatial::{clearance, frame, point_at_distance, project};
 use fbd_contact::{SpatialState, SpatialTrial, transition_spatial};
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
-    half_momentum_value, pattern, pattern_key, prepare_step, set_previous,
+    half_momentum_and_rotation, pattern, pattern_key, prepare_step, set_previous,
 };
 use fbd_dynamics::{History, LimitEquation, LimitState, NoJacobian};
 use fbd_kinematics::nalgebra::Vector3;
-use fbd_solver::{NewtonSolver, NewtonSystem, SolverError};
-
-#[derive(Clone, Copy, Debug)]
-enum Failure {
-    Newton(SolverError),
-    Cycle { residual: f64 },
-    NonFinite { residual: f64 },
-}
-
-impl Failure {
-    fn cause(self) -> &'static str {
-        match self {
-            Failure::Newton(_) => "newton",
-            Failure::Cycle { .. } => "cycle",
-            Failure::NonFinite { .. } => "non-finite",
-        }
-    }
-}
+use fbd_solver::{NewtonSolver, NewtonSystem};
 
 /// One spatial step's equations as a [`NewtonSystem`].
 pub struct SpatialSystem<'a> {
@@ -126,20 +109,7 @@ pub fn step(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimError
             }
         }
     }
-    Err(match first {
-        Failure::Newton(source) => SimError::Newton { step: k, t, source },
-        Failure::Cycle { residual } => SimError::Cycling {
-            step: k,
-            t,
-            states: describe_states(model, &data.failed_trial),
-            residual,
-        },
-        Failure::NonFinite { residual } => SimError::NonFinite {
-            step: k,
-            t,
-            residual,
-        },
-    })
+    Err(first.error(k, t, || describe_states(model, &data.failed_trial)))
 }
 
 /// Stages 1–3: constants, torques, predictor; the search starts from the
@@ -637,8 +607,8 @@ fn accept(model: &SpatialModel, data: &mut SpatialData, t: f64) -> bool {
     }
     for (l, lim) in mech.limits.iter().enumerate() {
         let (from, to) = (
-            limit_code(&data.limit_states[l]),
-            limit_code(&data.limit_trial[l]),
+            LimitCode::of(&data.limit_states[l]),
+            LimitCode::of(&data.limit_trial[l]),
         );
         if from != to {
             data.limit_events.push(LimitEvent {
@@ -776,12 +746,12 @@ fn make_record(
         let [z0, z1, z2] = fbd.axes[s];
         let tau = fbd.torque[s];
         let mut stop = [0.0; 3];
-        let mut limit = [crate::record::LimitCode::Free; 3];
+        let mut limit = [LimitCode::Free; 3];
         for (l, lim) in mech.limits.iter().enumerate() {
             if lim.slot == s {
                 let j = lim.joint.index();
                 stop[j] = z[lay.limit_moment(l)];
-                limit[j] = limit_code(&data.limit_trial[l]);
+                limit[j] = LimitCode::of(&data.limit_trial[l]);
             }
         }
         let v = |i: usize| Vector3::new(z[i], z[i + 1], z[i + 2]);
@@ -814,9 +784,8 @@ fn make_record(
     for (b, body) in mech.bodies.iter().enumerate() {
         let (c0, c1) = (fbd.kin.com[b], fbd.kin_next.com[b]);
         let v = (c1 - c0) / h;
-        let psi =
-            fbd_dynamics::spatial::so3::log(&(fbd.kin.rot[b].transpose() * fbd.kin_next.rot[b]));
-        let l = half_momentum_value(&fbd.kin.rot[b], &fbd.kin_next.rot[b], &body.inertia, h);
+        let (l, psi) =
+            half_momentum_and_rotation(&fbd.kin.rot[b], &fbd.kin_next.rot[b], &body.inertia, h);
         carry[b] = l;
         kinetic +=
             0.5 * body.mass * v.norm_squared() + 0.5 * psi.dot(&(body.inertia * psi)) / (h * h);

@@ -101,7 +101,7 @@ fn lying() -> Csc {
     for _ in 0..1500 {
         fbd_sim::step(&model, &mut data).expect("step");
     }
-    fbd_sim::step::prepare(&model, &mut data);
+    fbd_sim::step::prepare(&model, &mut data).expect("prepare");
     let (mut sys, _, z) = fbd_sim::step::system(&model, &mut data);
     let z = z.to_vec();
     Csc::of(&mut sys, &z)

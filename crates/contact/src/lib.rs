@@ -4,19 +4,21 @@
 //! `y = ϱ(x)` with its local tangent and normal ([`terrain`]), and the
 //! three-state contact machine ST1 (no contact), ST2 (contact without
 //! sliding), ST3 (contact with sliding) with every switching rule
-//! ([`mode`]).
+//! ([`mode`]), written once for the plane and 3D ([`machine`]).
 //!
 //! The crate is pure logic: it decides which equations a contact point
 //! contributes; `fbd-dynamics` assembles them and `fbd-sim` re-solves a step
 //! until the states are consistent.
 
 pub mod error;
+pub mod machine;
 pub mod mode;
 pub mod spatial;
 pub mod surface;
 pub mod terrain;
 
 pub use error::ContactError;
+pub use machine::{ContactMode, ContactTrial, switch};
 pub use mode::{ContactParams, ContactState, Friction, StateCode, Trial, transition};
 pub use spatial::{SpatialState, SpatialTrial, transition_spatial};
 pub use surface::Surface;

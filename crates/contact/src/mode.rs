@@ -235,39 +235,7 @@ pub fn transition(
     friction: &Friction,
     params: &ContactParams,
 ) -> Option<ContactState> {
-    match *state {
-        ContactState::Free => {
-            if terrain.clearance(trial.p_next) < -params.penetration_tol {
-                Some(ContactState::Stick {
-                    anchor: terrain.crossing(trial.p_k, trial.p_next),
-                })
-            } else {
-                None
-            }
-        }
-        ContactState::Stick { .. } => {
-            if trial.n < -params.force_tol {
-                Some(ContactState::Free)
-            } else if trial.fa.abs() > friction.mu_static * trial.n + params.force_tol {
-                Some(ContactState::Slide {
-                    dir: -trial.fa.signum(),
-                })
-            } else {
-                None
-            }
-        }
-        ContactState::Slide { dir } => {
-            if trial.n < -params.force_tol {
-                Some(ContactState::Free)
-            } else if trial.slide_velocity() * dir <= params.speed_tol {
-                Some(ContactState::Stick {
-                    anchor: [trial.p_k[0], terrain.height(trial.p_k[0])],
-                })
-            } else {
-                None
-            }
-        }
-    }
+    crate::machine::switch(state, trial, terrain, friction, params)
 }
 
 #[cfg(test)]

@@ -204,40 +204,7 @@ pub fn transition_spatial(
     friction: &Friction,
     params: &ContactParams,
 ) -> Option<SpatialState> {
-    match *state {
-        SpatialState::Free => {
-            (clearance(surface, trial.p_next) < -params.penetration_tol).then(|| {
-                SpatialState::Stick {
-                    anchor: crossing(surface, trial.p_k, trial.p_next),
-                }
-            })
-        }
-        SpatialState::Stick { .. } => {
-            let ft = trial.ft[0].hypot(trial.ft[1]);
-            if trial.n < -params.force_tol {
-                Some(SpatialState::Free)
-            } else if ft > friction.mu_static * trial.n + params.force_tol {
-                Some(SpatialState::Slide {
-                    dir: [-trial.ft[0] / ft, -trial.ft[1] / ft],
-                })
-            } else {
-                None
-            }
-        }
-        SpatialState::Slide { dir } => {
-            if trial.n < -params.force_tol {
-                return Some(SpatialState::Free);
-            }
-            let s = trial.slip();
-            let along = (s[0] * dir[0] + s[1] * dir[1]) / trial.dt;
-            if along <= params.speed_tol.max(STOP_SPEED) {
-                return Some(SpatialState::Stick {
-                    anchor: project(surface, trial.p_k),
-                });
-            }
-            None
-        }
-    }
+    crate::machine::switch(state, trial, surface, friction, params)
 }
 
 #[cfg(test)]

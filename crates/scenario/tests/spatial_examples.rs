@@ -1,8 +1,9 @@
 //! The hexapod dynamics examples do what their headers say: the stand and
 //! the slope come to rest with every foot sticking and the normal forces
 //! carrying the weight, the drop lands on its feet and body, the walk
-//! walks without a loaded stance foot slipping, on ice the feet slip, and
-//! the slope slides with μS = 0.1.
+//! walks up its slope without a loaded stance foot slipping, on ice the
+//! feet slip down the slope and the robot walks less far, and the slope
+//! slides with μS = 0.1.
 
 use std::path::Path;
 
@@ -121,15 +122,72 @@ fn loaded_slips(rec: &[SpatialRecord]) -> (usize, usize) {
     (loaded.len(), slipping)
 }
 
+/// The feet's slides along X (m): the mean over the feet on the ground
+/// (touching at both ends of a step) of their displacement over the step,
+/// summed over the run — how far the stance feet let the body slip back —
+/// and the total of every foot's slides down (−X) and up (+X).
+fn foot_slides_x(rec: &[SpatialRecord]) -> (f64, f64, f64) {
+    let (mut mean, mut down, mut up) = (0.0, 0.0, 0.0);
+    for w in rec.windows(2) {
+        let (mut sum, mut n) = (0.0, 0usize);
+        for (a, b) in tips(&w[0]).zip(tips(&w[1])) {
+            assert_eq!((a.leg, a.kind), (b.leg, b.kind));
+            if a.state == StateCode::St1 || b.state == StateCode::St1 {
+                continue;
+            }
+            let dx = b.point[0] - a.point[0];
+            sum += dx;
+            n += 1;
+            if dx < 0.0 {
+                down -= dx;
+            } else {
+                up += dx;
+            }
+        }
+        if n > 0 {
+            mean += sum / n as f64;
+        }
+    }
+    (mean, down, up)
+}
+
 #[test]
-fn walk_keeps_its_stance_feet_and_ice_slips() {
-    let (_, dry) = run("hexapod_walk.toml", &[]);
+fn walk_keeps_its_stance_feet_and_ice_slips_back_down_the_slope() {
+    // Up a 3.5° slope rising towards +X, the robot facing +X.
+    let (m, dry) = run("hexapod_walk.toml", &[]);
     let (loaded, slipping) = loaded_slips(&dry);
-    assert!(loaded > 10_000 && slipping == 0, "{slipping} of {loaded}");
-    // 0.1 m/s for 2 s less the two half-ramps: 0.15 m forward (−Z).
-    let rz = dry.last().unwrap().q[2];
-    assert!((rz + 0.15).abs() < 5e-3, "rz {rz}");
+    assert!(
+        loaded > 10_000 && slipping == 0,
+        "dry: {slipping} of {loaded}"
+    );
+    // 0.1 m/s for 2 s less the two half-ramps: 0.15 m forward (+X).
+    let x_dry = dry.last().unwrap().q[0];
+    assert!((x_dry - 0.15).abs() < 5e-3, "dry: rx {x_dry}");
+    let (slide, _, _) = foot_slides_x(&dry);
+    assert!(slide.abs() < 1e-4, "dry: feet slid {slide} m");
+
     let (_, ice) = run("hexapod_walk_ice.toml", &[]);
     let (loaded, slipping) = loaded_slips(&ice);
-    assert!(slipping > loaded / 10, "{slipping} of {loaded}");
+    assert!(
+        slipping > loaded / 5,
+        "ice: {slipping} of {loaded} loaded foot rows slipping"
+    );
+    // The slope's pull (tan 3.5° = 0.06 of the 0.1 ice gives) makes the
+    // slides go down it.
+    let (slide, down, up) = foot_slides_x(&ice);
+    assert!(down > 4.0 * up, "ice: feet slid {down} m down, {up} m up");
+    // The joints track angles relative to the body: what the feet slid
+    // back is lost, and is what the body lost against the dry walk.
+    let x_ice = ice.last().unwrap().q[0];
+    let lost = x_dry - x_ice;
+    assert!(
+        lost > 0.1 * x_dry,
+        "ice: rx {x_ice} vs dry {x_dry}: lost {lost} m"
+    );
+    assert!(
+        (lost + slide).abs() < 0.1 * lost,
+        "ice: lost {lost} m, mean slide of the feet {slide} m"
+    );
+    // At the end it stands on the slope (tan 3.5° < 0.1).
+    at_rest_on_the_ground("walk on ice", &m, ice.last().unwrap());
 }

@@ -6,7 +6,8 @@
 //! * [`Model`] (immutable, validated from [`PlanarParams`]) and [`Data`]
 //!   (the mutable workspace built from it);
 //! * [`step`] — one staged time step (kinematics → predictor → solve →
-//!   contact check → accept), see [`mod@step`];
+//!   contact check → accept), see [`mod@step`]; the step is one generic
+//!   source for the planar and the spatial model ([`engine`]);
 //! * [`run`] — the whole loop with per-row callback and a [`RunSummary`].
 //! * [`gait`] — the kinematic gait of the 24-DOF hexapod (gait schedule,
 //!   body path, footholds, swing, IK with rates and accelerations, static
@@ -25,6 +26,7 @@
 pub mod control;
 mod data;
 pub mod energy;
+pub mod engine;
 mod error;
 pub mod gait;
 mod model;
@@ -39,6 +41,7 @@ mod system;
 
 pub use control::{Control, LegTrajectory};
 pub use data::Data;
+pub use engine::{Engine, RunData};
 pub use error::SimError;
 pub use fbd_kinematics::{Joint, JointLimits, LimitSide};
 pub use model::Model;

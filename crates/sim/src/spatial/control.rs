@@ -64,7 +64,8 @@ pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(),
             ..
         } => (*kp, *kd, *torque_limit),
     };
-    if let (SpatialControl::Gait { gait, .. }, Some(g)) = (&model.params.control, &mut data.gait) {
+    if let (SpatialControl::Gait { gait, .. }, Some(g)) = (&model.params.control, &mut data.control)
+    {
         let k = data.k.min(gait.steps);
         crate::gait::step(gait, g, k).map_err(|e| SimError::Control {
             step: data.k,
@@ -85,7 +86,7 @@ pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(),
                 )
             }
             SpatialControl::Gait { .. } => {
-                let g = data.gait.as_ref().expect("gait workspace");
+                let g = data.control.as_ref().expect("gait workspace");
                 let leg = &g.legs[model.mech.legs[s] - 1];
                 (leg.theta, leg.rate)
             }

@@ -1,0 +1,208 @@
+//! The mutable workspace of a run of any model ([`RunData`]): what the
+//! generic step keeps, sized from the model's layout, plus the model's own
+//! assembly workspace, record and controller state.
+
+use super::Engine;
+use crate::predictor::Predictor;
+use crate::record::{Event, LimitEvent, RetryEvent};
+use fbd_contact::ContactMode;
+use fbd_dynamics::LimitState;
+use fbd_solver::NewtonSolver;
+
+/// Everything that changes during a run. All buffers are allocated when it
+/// is built, once; the stepping loop reuses them. The planar
+/// [`crate::Data`] and the spatial [`crate::spatial::SpatialData`] are this
+/// type for their models.
+pub struct RunData<M: Engine> {
+    /// Index of the next step to solve.
+    pub k: usize,
+    /// `q[k−1]` (meaningful for `k ≥ 1`).
+    pub q_prev: Vec<f64>,
+    /// `q[k−2]` (meaningful for `k ≥ 2`; the predictor's third point).
+    pub q_prev2: Vec<f64>,
+    /// `q[k]`.
+    pub q: Vec<f64>,
+    /// Unknowns of the step: `[q[k+1] | joint reactions | contact forces |
+    /// stop moments]`; the last solution.
+    pub z: Vec<f64>,
+    /// State each contact point was last solved in (accepted).
+    pub states: Vec<M::State>,
+    /// The FBD assembly's workspace.
+    pub fbd: M::Fbd,
+    /// Newton solver with its cached factorisations.
+    pub solver: NewtonSolver,
+    /// Contact events so far.
+    pub events: Vec<Event>,
+    /// State of each joint limit (order of the mechanism's limits), accepted.
+    pub limit_states: Vec<LimitState>,
+    /// Joint-limit events so far.
+    pub limit_events: Vec<LimitEvent>,
+    /// Steps solved in substeps so far.
+    pub retries: Vec<RetryEvent>,
+    /// Newton iterations so far (chord steps included).
+    pub newton_iterations: usize,
+    /// Of [`Self::newton_iterations`], the chord steps (a factorisation
+    /// kept from an earlier iterate or step, see
+    /// [`fbd_solver::NewtonParams::chord_steps`]).
+    pub chord_iterations: usize,
+    /// Most Newton iterations of one step so far (all its state trials and
+    /// substeps).
+    pub max_step_iterations: usize,
+    /// State searches that cycled and were closed by their least
+    /// inconsistent trial.
+    pub resolved_cycles: usize,
+    /// State searches that cycled and were closed by a consistent
+    /// combination found by trying every combination of the points and
+    /// joint limits involved (see [`super::search`]).
+    pub enumerated_cycles: usize,
+    /// Joint torques applied at the next step instead of the controller's,
+    /// when `Some`; kept until changed. For controllers outside the
+    /// simulator.
+    pub external_torque: Option<M::Torques>,
+    /// The predictor of each step's unknowns ([`crate::predictor`]).
+    pub predictor: Predictor,
+    /// The record of the last step (refilled every step).
+    pub record: M::Record,
+    /// The controller's workspace.
+    pub(crate) control: M::ControlData,
+    /// Per-row convergence scales of the current trial states.
+    pub(crate) scales: Vec<f64>,
+    /// Their reciprocals.
+    pub(crate) weights: Vec<f64>,
+    /// Trial states of the state search.
+    pub(crate) trial: Vec<M::State>,
+    /// Trial states of the joint limits.
+    pub(crate) limit_trial: Vec<LimitState>,
+    /// State combinations visited in the current (sub)step's search.
+    pub(crate) visited: Vec<u64>,
+    /// Per contact, bit `i` set when the point was solved in state code `i`
+    /// (0 = ST1, 1 = ST2, 2 = ST3) during the current search.
+    pub(crate) seen: Vec<u8>,
+    /// Per contact, the tangential force of its last sticking trial.
+    pub(crate) stick_ft: Vec<<M::State as ContactMode>::Tangent>,
+    /// Per contact, the anchor of its last sticking trial (meaningful when
+    /// bit 1 of `seen` is set).
+    pub(crate) stick_anchor: Vec<<M::State as ContactMode>::Anchor>,
+    /// The step's start, kept for a retry in substeps: `q[k]`, `q[k−1]`,
+    /// `q[k−2]`, the accepted states and the event counts.
+    pub(crate) grid_q: Vec<f64>,
+    pub(crate) grid_q_prev: Vec<f64>,
+    pub(crate) grid_q_prev2: Vec<f64>,
+    pub(crate) grid_states: Vec<M::State>,
+    pub(crate) grid_limits: Vec<LimitState>,
+    pub(crate) grid_events: [usize; 2],
+    /// The trial states at which the whole step failed (for the error).
+    pub(crate) failed_trial: Vec<M::State>,
+    pub(crate) failed_limits: Vec<LimitState>,
+    /// The unknowns the (sub)step's search started from (the predictor).
+    pub(crate) start_z: Vec<f64>,
+    /// The search's least inconsistent trial so far (see
+    /// [`super::search`]): its violation (N), unknowns and states.
+    pub(crate) best_violation: f64,
+    pub(crate) best_z: Vec<f64>,
+    pub(crate) best_trial: Vec<M::State>,
+    pub(crate) best_limits: Vec<LimitState>,
+    /// Set while solving the finest substeps of a retried step.
+    pub(crate) last_resort: bool,
+}
+
+/// What a model gives [`RunData::build`].
+pub(crate) struct Parts<M: Engine> {
+    /// `q[0]`.
+    pub q0: Vec<f64>,
+    /// Unknowns of the system.
+    pub dim: usize,
+    /// Joint limits.
+    pub limits: usize,
+    /// Contact states at `t = 0`.
+    pub initial_states: Vec<M::State>,
+    pub fbd: M::Fbd,
+    pub solver: NewtonSolver,
+    pub record: M::Record,
+    pub control: M::ControlData,
+}
+
+impl<M: Engine> RunData<M> {
+    /// A fresh workspace at `q[0]`, every buffer sized here.
+    pub(crate) fn build(parts: Parts<M>) -> Self {
+        let Parts {
+            q0,
+            dim,
+            limits,
+            initial_states,
+            fbd,
+            solver,
+            record,
+            control,
+        } = parts;
+        let contacts = initial_states.len();
+        let mut z = vec![0.0; dim];
+        z[..q0.len()].copy_from_slice(&q0);
+        let free = vec![LimitState::Free; limits];
+        Self {
+            k: 0,
+            q_prev: q0.clone(),
+            q_prev2: q0.clone(),
+            predictor: Predictor::new(&q0, &z),
+            z,
+            states: initial_states.clone(),
+            fbd,
+            solver,
+            events: Vec::with_capacity(64),
+            limit_states: free.clone(),
+            limit_events: Vec::with_capacity(64),
+            retries: Vec::with_capacity(16),
+            newton_iterations: 0,
+            chord_iterations: 0,
+            max_step_iterations: 0,
+            resolved_cycles: 0,
+            enumerated_cycles: 0,
+            external_torque: None,
+            record,
+            control,
+            scales: vec![1.0; dim],
+            weights: vec![1.0; dim],
+            trial: initial_states.clone(),
+            limit_trial: free.clone(),
+            visited: Vec::with_capacity(64),
+            seen: vec![0; contacts],
+            stick_ft: vec![Default::default(); contacts],
+            stick_anchor: vec![Default::default(); contacts],
+            grid_q: q0.clone(),
+            grid_q_prev: q0.clone(),
+            grid_q_prev2: q0.clone(),
+            grid_states: initial_states.clone(),
+            grid_limits: free.clone(),
+            grid_events: [0, 0],
+            failed_trial: initial_states.clone(),
+            failed_limits: free.clone(),
+            start_z: vec![0.0; dim],
+            best_violation: f64::INFINITY,
+            best_z: vec![0.0; dim],
+            best_trial: initial_states,
+            best_limits: free,
+            last_resort: false,
+            q: q0,
+        }
+    }
+
+    /// Symbolic factorisations done so far (one per contact-state pattern).
+    pub fn symbolic_factorizations(&self) -> usize {
+        self.solver.symbolic_factorizations()
+    }
+}
+
+impl<M: Engine> std::fmt::Debug for RunData<M>
+where
+    M::State: std::fmt::Debug,
+{
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunData")
+            .field("k", &self.k)
+            .field("q", &self.q)
+            .field("states", &self.states)
+            .field("limit_states", &self.limit_states)
+            .field("newton_iterations", &self.newton_iterations)
+            .finish_non_exhaustive()
+    }
+}

@@ -1,0 +1,165 @@
+//! One staged time step for every model: the planar 7-DOF two-leg model
+//! ([`crate::Model`]) and the spatial 24-DOF hexapod
+//! ([`crate::spatial::SpatialModel`]).
+//!
+//! The step's control flow — the stages, the contact and joint-limit state
+//! search with its cycle fallbacks, the retry in substeps, events and
+//! acceptance — is written once, in [`step`](mod@step) and [`search`],
+//! generic over an [`Engine`]: the model, which supplies what depends on
+//! the dimension (the FBD assembly and its Newton solve, the kinematics,
+//! the controller, a contact point's trial and geometry, the record).
+//! The workspace is one generic [`RunData`], sized from the model's
+//! layout. Contact states and their switching rules are
+//! [`fbd_contact::ContactMode`] and [`fbd_contact::switch`], one source
+//! for both dimensions.
+//!
+//! Stages of [`step::step`]:
+//!
+//! 1. **kinematics at k** ([`Engine::kinematics`]): the per-body constants
+//!    of the second differences;
+//! 2. **joint torques at k** ([`Engine::torques`]): the controller's
+//!    torques from `q[k]`, `q[k−1]`;
+//! 3. **predictor** ([`crate::predictor`]; the initial velocity at k = 0);
+//! 4. **solve** ([`Engine::solve`]): Newton on the FBD equations with the
+//!    trial contact and joint-limit states;
+//! 5. **state check** ([`search`]): every point's switching rule and every
+//!    joint limit's on the trial solution; any switch → back to 4;
+//! 6. **accept**: record, events, `q[k+1]` becomes the current state.
+
+pub mod data;
+pub mod search;
+pub mod step;
+
+pub use data::RunData;
+
+use crate::SimError;
+use fbd_contact::{ContactMode, ContactParams, ContactTrial, Friction};
+use fbd_dynamics::History;
+use fbd_kinematics::{Joint, JointLimits};
+use fbd_solver::{NewtonReport, SolverError};
+
+/// A joint limit's identity.
+#[derive(Clone, Copy, Debug)]
+pub struct LimitInfo {
+    /// Index of the joint's angle in `q`.
+    pub q_index: usize,
+    /// The joint index written to the limit events.
+    pub joint_index: usize,
+    /// Which joint of its leg it is.
+    pub joint: Joint,
+    /// Hexapod leg number.
+    pub leg: usize,
+}
+
+/// What the generic step needs from a model: its fixed data and the
+/// stages that depend on the dimension. Implemented by [`crate::Model`]
+/// (planar) and [`crate::spatial::SpatialModel`].
+pub trait Engine: Sized {
+    /// A contact point's state.
+    type State: ContactMode;
+    /// A contact point's view of a trial solution.
+    type Trial: ContactTrial<Mode = Self::State, Ground = Self::Ground>;
+    /// The ground (planar terrain, spatial surface).
+    type Ground: ?Sized;
+    /// The FBD assembly's workspace.
+    type Fbd;
+    /// The record of one step.
+    type Record;
+    /// Joint torques set from outside the simulator.
+    type Torques;
+    /// The controller's workspace.
+    type ControlData;
+
+    /// Time step Δt (s).
+    fn dt(&self) -> f64;
+    /// Finest subdivision of a retried step.
+    fn max_substeps(&self) -> usize;
+    /// Largest violation a cycling search may close with (N).
+    fn cycle_tolerance(&self) -> f64;
+    /// Initial generalised velocities.
+    fn qdot0(&self) -> &[f64];
+    /// Coordinates in `q`.
+    fn nq(&self) -> usize;
+    /// The ground.
+    fn ground(&self) -> &Self::Ground;
+    /// Coulomb friction.
+    fn friction(&self) -> &Friction;
+    /// Contact tolerances.
+    fn contact_params(&self) -> &ContactParams;
+    /// Joint ranges.
+    fn joint_limits(&self) -> &JointLimits;
+    /// Contact points.
+    fn contacts(&self) -> usize;
+    /// The body contact point `c` belongs to.
+    fn contact_body(&self, c: usize) -> usize;
+    /// Bodies.
+    fn bodies(&self) -> usize;
+    /// Hexapod leg number and kind (`"tip"`, `"knee"`, `"hip"`) of point `c`.
+    fn contact_identity(&self, c: usize) -> (usize, &'static str);
+    /// Name of point `c` in messages.
+    fn contact_name(&self, c: usize) -> &str;
+    /// Joint limits.
+    fn limits(&self) -> usize;
+    /// Joint limit `l`.
+    fn limit(&self, l: usize) -> LimitInfo;
+    /// Name of limit `l`'s joint in messages.
+    fn limit_name(&self, l: usize) -> String;
+    /// Index in the unknowns of limit `l`'s stop moment.
+    fn limit_moment_index(&self, l: usize) -> usize;
+
+    /// Stage 1: the constants of the (sub)step of length `h` from `q[k]`,
+    /// `q[k−1]` (or the initial velocity).
+    fn kinematics(&self, data: &mut RunData<Self>, history: History<'_>, h: f64);
+    /// Stage 2: the joint torques at k.
+    ///
+    /// # Errors
+    /// A controller failure.
+    fn torques(&self, data: &mut RunData<Self>) -> Result<(), SimError>;
+    /// Stage 4: Newton on the equations of the trial states, from and into
+    /// `data.z`.
+    ///
+    /// # Errors
+    /// The solver's.
+    fn solve(&self, data: &mut RunData<Self>) -> Result<NewtonReport, SolverError>;
+    /// After a solve: the kinematics at `q[k+1] = z[..nq]`.
+    fn evaluate_next(&self, data: &mut RunData<Self>);
+    /// Point `c`'s view of the last solution.
+    fn trial(&self, data: &RunData<Self>, c: usize) -> Self::Trial;
+    /// How far point `c`'s trial is from the law of its state (N).
+    fn contact_violation(&self, data: &RunData<Self>, c: usize, trial: &Self::Trial) -> f64;
+    /// The position gain of the stop rows over the length scale (N/rad),
+    /// which turns a joint's overshoot into a force.
+    fn limit_gain(&self, data: &RunData<Self>) -> f64;
+    /// The length scale turning moments into forces (m).
+    fn length_scale(&self, data: &RunData<Self>) -> f64;
+    /// The anchor of point `c`, which starts sticking on the body of
+    /// `reference`, anchored at `from`: the point of the ground at the two
+    /// points' distance, on `c`'s side of `reference` ([`search`]'s rigid
+    /// anchors).
+    fn anchor_at_distance(
+        &self,
+        data: &RunData<Self>,
+        reference: usize,
+        from: <Self::State as ContactMode>::Anchor,
+        c: usize,
+    ) -> <Self::State as ContactMode>::Anchor;
+    /// After a failed Newton solve: changes the trial states so that the
+    /// search may go on (`true`), or gives up (`false`, the default).
+    fn newton_fallback(&self, _data: &mut RunData<Self>) -> bool {
+        false
+    }
+    /// The kinematics at `q[k−1]` from `data.q_prev`.
+    fn set_previous(&self, data: &mut RunData<Self>);
+    /// The kinematics of the step's start again (`grid_q`, `grid_q_prev`)
+    /// after a failed attempt in substeps.
+    fn reset_kinematics(&self, data: &mut RunData<Self>);
+    /// Fills `data.record` for the solved (sub)step of length `h`.
+    fn make_record(&self, data: &mut RunData<Self>, iterations: usize, trials: usize, h: f64);
+    /// Adds a later substep's iterations and solves to the record.
+    fn add_to_record(record: &mut Self::Record, iterations: usize, trials: usize);
+    /// Stage 6's model part: the assembly's state moves to the next step;
+    /// `whole` when the step was solved whole (not in substeps).
+    fn advance(&self, data: &mut RunData<Self>);
+    /// After a step solved whole has been accepted.
+    fn accepted_whole(&self, _data: &mut RunData<Self>) {}
+}

@@ -101,7 +101,7 @@ fn lying() -> Csc {
     for _ in 0..1500 {
         fbd_sim::step(&model, &mut data).expect("step");
     }
-    fbd_sim::step::prepare(&model, &mut data).expect("prepare");
+    fbd_sim::engine::step::prepare(&model, &mut data).expect("prepare");
     let (mut sys, _, z) = fbd_sim::step::system(&model, &mut data);
     let z = z.to_vec();
     Csc::of(&mut sys, &z)
@@ -115,7 +115,7 @@ fn hexapod() -> Csc {
     for _ in 0..50 {
         fbd_sim::spatial::step(&model, &mut data).expect("step");
     }
-    fbd_sim::spatial::step::prepare(&model, &mut data).expect("prepare");
+    fbd_sim::engine::step::prepare(&model, &mut data).expect("prepare");
     let z = data.z.clone();
     let mut sys = fbd_sim::spatial::step::system_for_bench(&model, &mut data);
     Csc::of(&mut sys, &z)

@@ -132,7 +132,7 @@ pub fn warm_data(model: &Model, case: Case) -> Data {
 pub fn prepared(case: Case) -> (Model, Data) {
     let model = case.model();
     let mut data = warm_data(&model, case);
-    fbd_sim::step::prepare(&model, &mut data).expect("prepare");
+    fbd_sim::engine::step::prepare(&model, &mut data).expect("prepare");
     (model, data)
 }
 

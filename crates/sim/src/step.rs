@@ -15,17 +15,16 @@
 //! pull it there instead of pushing it away.
 
 use crate::energy;
-use crate::engine::{Engine, LimitInfo};
+use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::{LimitCode, MAX_CONTACTS, MAX_JOINTS, StepRecord};
 use crate::rules::regularization;
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
-use fbd_contact::{ContactParams, ContactState, Friction, Terrain, Trial};
+use fbd_contact::{ContactState, Terrain, Trial};
 use fbd_dynamics::{
     ContactEquation, FbdData, History, LimitEquation, advance, evaluate_next, prepare_step,
 };
-use fbd_kinematics::JointLimits;
 use fbd_solver::{NewtonReport, NewtonSolver, SolverError};
 
 /// Solves step `data.k` and advances the state to `k + 1`, retrying in
@@ -39,17 +38,6 @@ pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
     Ok(data.record)
 }
 
-/// Stages 1–3 of [`step`]: the per-body constants of step `data.k`, the
-/// joint torques and the predictor of the unknowns in `data.z`; the trial
-/// contact and limit states start from the accepted ones. Public for
-/// benchmarks, which time the stages one by one.
-///
-/// # Errors
-/// None for the planar controllers; the type is the generic stage's.
-pub fn prepare(model: &Model, data: &mut Data) -> Result<(), SimError> {
-    crate::engine::step::prepare(model, data)
-}
-
 impl Engine for Model {
     type State = ContactState;
     type Trial = Trial;
@@ -59,50 +47,29 @@ impl Engine for Model {
     type Torques = [f64; MAX_JOINTS];
     type ControlData = ();
 
-    fn dt(&self) -> f64 {
-        Model::dt(self)
-    }
-    fn max_substeps(&self) -> usize {
-        self.max_substeps
-    }
-    fn cycle_tolerance(&self) -> f64 {
-        self.cycle_tolerance
-    }
-    fn qdot0(&self) -> &[f64] {
-        &self.params.qdot0
-    }
-    fn nq(&self) -> usize {
-        self.mech.layout().nq
-    }
-    fn ground(&self) -> &Terrain {
-        &self.params.terrain
-    }
-    fn friction(&self) -> &Friction {
-        &self.params.friction
-    }
-    fn contact_params(&self) -> &ContactParams {
-        &self.contact
-    }
-    fn joint_limits(&self) -> &JointLimits {
-        &self.params.joint_limits
-    }
-    fn contacts(&self) -> usize {
-        self.mech.contacts.len()
+    fn settings(&self) -> Settings<'_, Terrain> {
+        Settings {
+            dt: Model::dt(self),
+            max_substeps: self.max_substeps,
+            cycle_tolerance: self.cycle_tolerance,
+            qdot0: &self.params.qdot0,
+            bodies: self.mech.bodies.len(),
+            contacts: self.mech.contacts.len(),
+            limits: self.mech.limits.len(),
+            ground: &self.params.terrain,
+            friction: &self.params.friction,
+            contact: &self.contact,
+            joint_limits: &self.params.joint_limits,
+        }
     }
     fn contact_body(&self, c: usize) -> usize {
         self.mech.contacts[c].body
-    }
-    fn bodies(&self) -> usize {
-        self.mech.bodies.len()
     }
     fn contact_identity(&self, c: usize) -> (usize, &'static str) {
         (self.contact_leg[c], self.contact_point[c])
     }
     fn contact_name(&self, c: usize) -> &str {
         &self.mech.contacts[c].name
-    }
-    fn limits(&self) -> usize {
-        self.mech.limits.len()
     }
     fn limit(&self, l: usize) -> LimitInfo {
         let j = self.mech.limits[l];

@@ -51,6 +51,34 @@ pub struct LimitInfo {
     pub leg: usize,
 }
 
+/// The fixed settings and sizes of a model's step.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings<'a, G: ?Sized> {
+    /// Time step Δt (s).
+    pub dt: f64,
+    /// Finest subdivision of a step that cannot be solved whole.
+    pub max_substeps: usize,
+    /// A cycling state search is closed by its least inconsistent trial
+    /// when that trial violates the laws by at most this force (N).
+    pub cycle_tolerance: f64,
+    /// Initial generalised velocities (one per coordinate of `q`).
+    pub qdot0: &'a [f64],
+    /// Rigid bodies.
+    pub bodies: usize,
+    /// Contact points.
+    pub contacts: usize,
+    /// Joint limits.
+    pub limits: usize,
+    /// The ground.
+    pub ground: &'a G,
+    /// Its Coulomb friction.
+    pub friction: &'a Friction,
+    /// The contact tolerances.
+    pub contact: &'a ContactParams,
+    /// The joint ranges.
+    pub joint_limits: &'a JointLimits,
+}
+
 /// What the generic step needs from a model: its fixed data and the
 /// stages that depend on the dimension. Implemented by [`crate::Model`]
 /// (planar) and [`crate::spatial::SpatialModel`].
@@ -70,36 +98,62 @@ pub trait Engine: Sized {
     /// The controller's workspace.
     type ControlData;
 
+    /// The fixed settings and sizes of the step.
+    fn settings(&self) -> Settings<'_, Self::Ground>;
     /// Time step Δt (s).
-    fn dt(&self) -> f64;
+    fn dt(&self) -> f64 {
+        self.settings().dt
+    }
     /// Finest subdivision of a retried step.
-    fn max_substeps(&self) -> usize;
+    fn max_substeps(&self) -> usize {
+        self.settings().max_substeps
+    }
     /// Largest violation a cycling search may close with (N).
-    fn cycle_tolerance(&self) -> f64;
+    fn cycle_tolerance(&self) -> f64 {
+        self.settings().cycle_tolerance
+    }
     /// Initial generalised velocities.
-    fn qdot0(&self) -> &[f64];
+    fn qdot0(&self) -> &[f64] {
+        self.settings().qdot0
+    }
     /// Coordinates in `q`.
-    fn nq(&self) -> usize;
+    fn nq(&self) -> usize {
+        self.settings().qdot0.len()
+    }
     /// The ground.
-    fn ground(&self) -> &Self::Ground;
+    fn ground(&self) -> &Self::Ground {
+        self.settings().ground
+    }
     /// Coulomb friction.
-    fn friction(&self) -> &Friction;
+    fn friction(&self) -> &Friction {
+        self.settings().friction
+    }
     /// Contact tolerances.
-    fn contact_params(&self) -> &ContactParams;
+    fn contact_params(&self) -> &ContactParams {
+        self.settings().contact
+    }
     /// Joint ranges.
-    fn joint_limits(&self) -> &JointLimits;
+    fn joint_limits(&self) -> &JointLimits {
+        self.settings().joint_limits
+    }
     /// Contact points.
-    fn contacts(&self) -> usize;
+    fn contacts(&self) -> usize {
+        self.settings().contacts
+    }
+    /// Bodies.
+    fn bodies(&self) -> usize {
+        self.settings().bodies
+    }
+    /// Joint limits.
+    fn limits(&self) -> usize {
+        self.settings().limits
+    }
     /// The body contact point `c` belongs to.
     fn contact_body(&self, c: usize) -> usize;
-    /// Bodies.
-    fn bodies(&self) -> usize;
     /// Hexapod leg number and kind (`"tip"`, `"knee"`, `"hip"`) of point `c`.
     fn contact_identity(&self, c: usize) -> (usize, &'static str);
     /// Name of point `c` in messages.
     fn contact_name(&self, c: usize) -> &str;
-    /// Joint limits.
-    fn limits(&self) -> usize;
     /// Joint limit `l`.
     fn limit(&self, l: usize) -> LimitInfo;
     /// Name of limit `l`'s joint in messages.

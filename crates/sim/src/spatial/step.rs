@@ -22,17 +22,16 @@ use super::control::{joint_rates, joint_torques};
 use super::data::SpatialData;
 use super::model::SpatialModel;
 use crate::SimError;
-use crate::engine::{Engine, LimitInfo};
+use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::LimitCode;
 use crate::rules::{Sink, regularization};
 use fbd_contact::spatial::{clearance, frame, point_at_distance, project};
-use fbd_contact::{ContactParams, Friction, SpatialState, SpatialTrial, Surface};
+use fbd_contact::{SpatialState, SpatialTrial, Surface};
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
     half_momentum_and_rotation, pattern, pattern_key, prepare_step, set_previous,
 };
 use fbd_dynamics::{History, LimitEquation, NoJacobian};
-use fbd_kinematics::JointLimits;
 use fbd_kinematics::nalgebra::Vector3;
 use fbd_solver::{NewtonReport, NewtonSolver, NewtonSystem, SolverError};
 
@@ -75,15 +74,6 @@ pub fn step(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimError
     crate::engine::step::step(model, data)
 }
 
-/// Stages 1–3: constants, torques, predictor; the search starts from the
-/// accepted states (for benchmarks).
-///
-/// # Errors
-/// A controller failure.
-pub fn prepare(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimError> {
-    crate::engine::step::prepare(model, data)
-}
-
 impl Engine for SpatialModel {
     type State = SpatialState;
     type Trial = SpatialTrial;
@@ -93,41 +83,23 @@ impl Engine for SpatialModel {
     type Torques = Vec<[f64; 3]>;
     type ControlData = Option<Box<crate::gait::GaitData>>;
 
-    fn dt(&self) -> f64 {
-        SpatialModel::dt(self)
-    }
-    fn max_substeps(&self) -> usize {
-        self.max_substeps
-    }
-    fn cycle_tolerance(&self) -> f64 {
-        self.cycle_tolerance
-    }
-    fn qdot0(&self) -> &[f64] {
-        &self.params.qdot0
-    }
-    fn nq(&self) -> usize {
-        SpatialModel::nq(self)
-    }
-    fn ground(&self) -> &Surface {
-        &self.params.terrain
-    }
-    fn friction(&self) -> &Friction {
-        &self.params.friction
-    }
-    fn contact_params(&self) -> &ContactParams {
-        &self.params.contact
-    }
-    fn joint_limits(&self) -> &JointLimits {
-        &self.params.joint_limits
-    }
-    fn contacts(&self) -> usize {
-        self.mech.contacts.len()
+    fn settings(&self) -> Settings<'_, Surface> {
+        Settings {
+            dt: SpatialModel::dt(self),
+            max_substeps: self.max_substeps,
+            cycle_tolerance: self.cycle_tolerance,
+            qdot0: &self.params.qdot0,
+            bodies: self.mech.bodies.len(),
+            contacts: self.mech.contacts.len(),
+            limits: self.mech.limits.len(),
+            ground: &self.params.terrain,
+            friction: &self.params.friction,
+            contact: &self.params.contact,
+            joint_limits: &self.params.joint_limits,
+        }
     }
     fn contact_body(&self, c: usize) -> usize {
         self.mech.contacts[c].body
-    }
-    fn bodies(&self) -> usize {
-        self.mech.bodies.len()
     }
     fn contact_identity(&self, c: usize) -> (usize, &'static str) {
         let spec = &self.mech.contacts[c];
@@ -135,9 +107,6 @@ impl Engine for SpatialModel {
     }
     fn contact_name(&self, c: usize) -> &str {
         &self.mech.contacts[c].name
-    }
-    fn limits(&self) -> usize {
-        self.mech.limits.len()
     }
     fn limit(&self, l: usize) -> LimitInfo {
         let lim = &self.mech.limits[l];

@@ -40,6 +40,7 @@
 pub mod assemble;
 pub mod body;
 pub mod mechanism;
+pub mod rows;
 pub mod spatial;
 
 pub use assemble::{

@@ -6,8 +6,9 @@
 use super::kin::{Columns, SpatialKin};
 use super::mechanism::{SpatialMechanism, lower_body, upper_body};
 use super::so3;
-use crate::assemble::{History, JacobianSink, LimitEquation, LimitState};
+use crate::assemble::{History, JacobianSink, LimitEquation};
 use crate::mechanism::PointKind;
+use crate::rows;
 use fbd_contact::spatial::clearance;
 use fbd_contact::{SpatialState, Surface};
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
@@ -343,17 +344,10 @@ pub fn advance(data: &mut SpatialFbdData) {
 
 /// The sparsity key: contact state codes in base 3, then one bit per limit.
 pub fn pattern_key(data: &SpatialFbdData) -> u64 {
-    let k = data.contact.iter().fold(0u64, |k, c| {
-        k * 3
-            + match c.state {
-                SpatialState::Free => 0,
-                SpatialState::Stick { .. } => 1,
-                SpatialState::Slide { .. } => 2,
-            }
-    });
-    data.limit
-        .iter()
-        .fold(k, |k, l| k * 2 + u64::from(l.state.is_at()))
+    rows::pattern_key(
+        data.contact.iter().map(|c| c.state.code()),
+        data.limit.iter().map(|l| l.state.is_at()),
+    )
 }
 
 /// Pushes every structural `(row, col)` of the Jacobian for the current
@@ -478,17 +472,19 @@ pub fn eval<S: JacobianSink>(
         let row = lay.contact_row(c);
         let fl = v3(z, lay.contact_force(c, 0));
         let p = data.kin_next.point(mech, slot_of(spec.point), spec.kind);
+        let out = &mut r[row..row + 3];
         match eq.state {
-            SpatialState::Free => {
-                for i in 0..3 {
-                    r[row + i] = fl[i];
-                }
-            }
+            SpatialState::Free => rows::free_rows(fl.as_slice(), out),
             SpatialState::Stick { anchor } => {
                 let f = frame_force(eq, fl);
-                for i in 0..3 {
-                    r[row + i] = k * (p[i] - anchor[i]) + eq.regularization * f[i];
-                }
+                rows::stick_rows(
+                    k,
+                    p.as_slice(),
+                    &anchor,
+                    eq.regularization,
+                    f.as_slice(),
+                    out,
+                );
             }
             SpatialState::Slide { dir } => {
                 let d = p - data.kin.point(mech, slot_of(spec.point), spec.kind);
@@ -505,21 +501,22 @@ pub fn eval<S: JacobianSink>(
                 data.slip_hat[c] = u;
                 data.slip_len[c] = len;
                 data.slip_n[c] = fl[1];
-                r[row] = fl[0] + u[0] * eq.mu_dynamic * fl[1];
-                r[row + 1] = k * clearance(surface, [p.x, p.y, p.z]) + eq.regularization * fl[1];
-                r[row + 2] = fl[2] + u[1] * eq.mu_dynamic * fl[1];
+                rows::slide_rows(
+                    fl.as_slice(),
+                    &u,
+                    eq.mu_dynamic,
+                    k,
+                    clearance(surface, [p.x, p.y, p.z]),
+                    eq.regularization,
+                    out,
+                );
             }
         }
     }
     for (li, lim) in mech.limits.iter().enumerate() {
         let lambda = z[lay.limit_moment(li)];
         let eq = &data.limit[li];
-        r[lay.limit_row(li)] = match eq.state {
-            LimitState::Free => lambda,
-            LimitState::At { angle, .. } => {
-                data.limit_gain * (z[lim.q_index] - angle) + eq.regularization * lambda
-            }
-        };
+        r[lay.limit_row(li)] = rows::limit_row(eq, lambda, z[lim.q_index], data.limit_gain);
     }
     if S::ACTIVE {
         force_entries(mech, data, jac);
@@ -626,12 +623,11 @@ fn force_entries<S: JacobianSink>(mech: &SpatialMechanism, data: &SpatialFbdData
             jac.add(lay.body_row(child) + 3 + i, col, -axis[i]);
             jac.add(lay.body_row(parent) + 3 + i, col, axis[i]);
         }
-        let eq = &data.limit[li];
-        let d = match eq.state {
-            LimitState::Free => 1.0,
-            LimitState::At { .. } => eq.regularization,
-        };
-        jac.add(lay.limit_row(li), col, d);
+        jac.add(
+            lay.limit_row(li),
+            col,
+            rows::limit_row_diagonal(&data.limit[li]),
+        );
     }
 }
 

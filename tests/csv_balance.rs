@@ -8,6 +8,7 @@ mod common;
 
 use common::physics::worst_body_imbalance;
 use fbd_contact::StateCode;
+use fbd_dynamics::PointKind;
 use fbd_sim::{Model, PlanarParams, StepRecord};
 use std::path::Path;
 
@@ -56,20 +57,24 @@ fn read_rows(path: &Path, model: &Model) -> Vec<StepRecord> {
             for (i, c) in q_cols.iter().enumerate() {
                 r.q[i] = f(&rec, c);
             }
-            for (c, leg) in [3, 4].iter().enumerate() {
-                r.point[c] = [
-                    f(&rec, &format!("tip{leg}_x")),
-                    f(&rec, &format!("tip{leg}_y")),
-                ];
-                r.state[c] = state(&rec[col(&format!("state{leg}"))]);
-                r.fa[c] = f(&rec, &format!("fa{leg}"));
-                r.n[c] = f(&rec, &format!("n{leg}"));
-            }
-            for (c, spec) in model.mech.contacts.iter().enumerate().skip(2) {
-                let name = &spec.name;
-                r.state[c] = state(&rec[col(&format!("{name}_state"))]);
-                r.fa[c] = f(&rec, &format!("{name}_fa"));
-                r.n[c] = f(&rec, &format!("{name}_n"));
+            // Each contact point's columns by its `{leg, kind}`: the
+            // contract's `tip{leg}_x, state{leg}, fa{leg}, n{leg}` for a
+            // tip, `{kind}{leg}_state, _fa, _n` for a knee or hip.
+            for (c, spec) in model.mech.contacts.iter().enumerate() {
+                let leg = spec.leg;
+                let [s, fa, n] = if spec.kind == PointKind::Tip {
+                    r.point[c] = [
+                        f(&rec, &format!("tip{leg}_x")),
+                        f(&rec, &format!("tip{leg}_y")),
+                    ];
+                    [format!("state{leg}"), format!("fa{leg}"), format!("n{leg}")]
+                } else {
+                    let kind = spec.kind.as_str();
+                    ["state", "fa", "n"].map(|a| format!("{kind}{leg}_{a}"))
+                };
+                r.state[c] = state(&rec[col(&s)]);
+                r.fa[c] = f(&rec, &fa);
+                r.n[c] = f(&rec, &n);
             }
             for (j, name) in joints.iter().enumerate() {
                 r.joint_force[j] = [

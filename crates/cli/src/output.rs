@@ -8,6 +8,9 @@
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
+use fbd_contact::StateCode;
+use fbd_dynamics::{ContactSpec, PointKind};
+use fbd_kinematics::planar::hexapod_leg_number;
 use fbd_sim::{Event, LimitEvent, RetryEvent, RunSummary, StepRecord};
 use serde::Serialize;
 use tempfile::NamedTempFile;
@@ -220,23 +223,192 @@ pub fn prepare_dir(dir: &Path) -> Result<(), CliError> {
     temp_in(dir, "probe").map(drop)
 }
 
-/// The trajectory columns for a model whose contact points are named
-/// `contacts` (e.g. `["tip3", "tip4", "knee3", "knee4"]`): the contract's list,
-/// then `<name>_state, <name>_fa, <name>_n` for every contact point that is
-/// not a tip, then [`TAIL_COLUMNS`].
-pub fn trajectory_columns(contacts: &[String]) -> Vec<String> {
-    let mut c: Vec<String> = SPEC_COLUMNS.iter().map(|s| (*s).to_owned()).collect();
-    for name in contacts.iter().filter(|n| !is_tip(n)) {
-        for suffix in ["state", "fa", "n"] {
-            c.push(format!("{name}_{suffix}"));
+/// The legs of the planar model by their hexapod numbers (3, 4), in the
+/// order of the contract's per-leg columns (`tip3_x`, …, `tip4_x`, …).
+pub const PLANAR_LEGS: [usize; 2] = [hexapod_leg_number(0), hexapod_leg_number(1)];
+
+/// The columns of a contact point's state, tangential and normal force,
+/// named from its `{leg, kind}`: the contract's `state{leg}, fa{leg},
+/// n{leg}` for a tip, `{kind}{leg}_state, {kind}{leg}_fa, {kind}{leg}_n`
+/// (`knee3_state`, `hip4_n`) for a knee or a hip.
+pub fn contact_columns(leg: usize, kind: PointKind) -> [String; 3] {
+    match kind {
+        PointKind::Tip => [format!("state{leg}"), format!("fa{leg}"), format!("n{leg}")],
+        PointKind::Knee | PointKind::Hip => {
+            ["state", "fa", "n"].map(|s| format!("{}{leg}_{s}", kind.as_str()))
         }
     }
-    c.extend(TAIL_COLUMNS.iter().map(|s| (*s).to_owned()));
-    c
 }
 
-fn is_tip(name: &str) -> bool {
-    name == "tip3" || name == "tip4"
+/// Where the values of each contact point go in a row of
+/// `trajectory.csv`, found by the points' `{leg, kind}` (never by name).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ContactSlots {
+    /// Per leg of [`PLANAR_LEGS`]: the index of its tip among the contact
+    /// points; `None` when the tip is not one (the row then holds a NaN
+    /// position, `ST1` and zero forces).
+    pub tips: [Option<usize>; 2],
+    /// Every other contact point (knees and hips), in the model's order:
+    /// its index, leg and kind.
+    pub extras: Vec<(usize, usize, PointKind)>,
+}
+
+impl ContactSlots {
+    /// The slots of a model whose contact points are `contacts` (record
+    /// order, e.g. `model.mech.contacts`).
+    pub fn of(contacts: &[ContactSpec]) -> Self {
+        let tips = PLANAR_LEGS.map(|leg| {
+            contacts
+                .iter()
+                .position(|c| c.kind == PointKind::Tip && c.leg == leg)
+        });
+        let extras = contacts
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| !tips.contains(&Some(*i)))
+            .map(|(i, c)| (i, c.leg, c.kind))
+            .collect();
+        Self { tips, extras }
+    }
+
+    /// The trajectory columns: the contract's list ([`SPEC_COLUMNS`]), then
+    /// the [`contact_columns`] of every extra point, then [`TAIL_COLUMNS`].
+    pub fn columns(&self) -> Vec<String> {
+        let mut c: Vec<String> = SPEC_COLUMNS.iter().map(|s| (*s).to_owned()).collect();
+        for &(_, leg, kind) in &self.extras {
+            c.extend(contact_columns(leg, kind));
+        }
+        c.extend(TAIL_COLUMNS.iter().map(|s| (*s).to_owned()));
+        c
+    }
+}
+
+/// The trajectory columns for a model whose contact points are `contacts`
+/// (e.g. tips, knees and hips of legs 3 and 4): the contract's list, then
+/// `knee3_state, knee3_fa, knee3_n`, … for every contact point that is not
+/// a tip ([`contact_columns`]), then [`TAIL_COLUMNS`].
+pub fn trajectory_columns(contacts: &[ContactSpec]) -> Vec<String> {
+    ContactSlots::of(contacts).columns()
+}
+
+/// Receives the values of one row of `trajectory.csv`, column by column
+/// in the order of the file's columns: the files' writers and the
+/// in-memory columns of the Python package share the row builders
+/// ([`row_values`], [`crate::spatial::csv::row_values`]), one source of
+/// the values.
+pub trait RowSink {
+    /// `t`: the time of step `step` (`t = step·Δt`; the file writes the
+    /// exact decimal of `step·Δt`, [`StepTimes`]).
+    fn time(&mut self, step: usize, t: f64);
+    /// A number (m, rad, N, N·m, J).
+    fn num(&mut self, x: f64);
+    /// A contact state (`ST1`, `ST2`, `ST3`).
+    fn state(&mut self, s: StateCode);
+    /// A count (`newton_iterations`).
+    fn count(&mut self, n: usize);
+}
+
+/// Hands the values of the planar row of `r` to `sink`, in the order of
+/// [`ContactSlots::columns`]. No allocation.
+pub fn row_values(slots: &ContactSlots, r: &StepRecord, sink: &mut dyn RowSink) {
+    sink.time(r.step, r.t);
+    for &x in &r.q {
+        sink.num(x);
+    }
+    for c in slots.tips {
+        let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
+        sink.num(p[0]);
+        sink.num(p[1]);
+    }
+    for c in slots.tips {
+        sink.state(c.map_or(StateCode::St1, |c| r.state[c]));
+    }
+    for c in slots.tips {
+        let (fa, n) = c.map_or((0.0, 0.0), |c| (r.fa[c], r.n[c]));
+        sink.num(fa);
+        sink.num(n);
+    }
+    for j in &r.joint_force {
+        sink.num(j[0]);
+        sink.num(j[1]);
+    }
+    for &(c, _, _) in &slots.extras {
+        sink.state(r.state[c]);
+        sink.num(r.fa[c]);
+        sink.num(r.n[c]);
+    }
+    for &t in &r.torque {
+        sink.num(t);
+    }
+    sink.num(r.kinetic);
+    sink.num(r.potential);
+    sink.num(r.kinetic + r.potential);
+    sink.count(r.newton_iterations);
+    for &m in &r.limit_moment {
+        sink.num(m);
+    }
+}
+
+/// One row of a CSV file: comma-separated values, the first I/O error
+/// kept (later values of the row are skipped).
+pub(crate) struct CsvRow<'a, W: Write> {
+    out: &'a mut W,
+    num: &'a mut ryu::Buffer,
+    times: &'a StepTimes,
+    error: Option<io::Error>,
+    first: bool,
+}
+
+impl<'a, W: Write> CsvRow<'a, W> {
+    /// A row written to `out`, numbers with `num`, times with `times`.
+    pub(crate) fn new(out: &'a mut W, num: &'a mut ryu::Buffer, times: &'a StepTimes) -> Self {
+        Self {
+            out,
+            num,
+            times,
+            error: None,
+            first: true,
+        }
+    }
+
+    /// Ends the row with a newline; the first error of the row, if any.
+    pub(crate) fn end(self) -> io::Result<()> {
+        match self.error {
+            Some(e) => Err(e),
+            None => self.out.write_all(b"\n"),
+        }
+    }
+
+    fn put(&mut self, f: impl FnOnce(&mut W, &mut ryu::Buffer) -> io::Result<()>) {
+        if self.error.is_some() {
+            return;
+        }
+        let r = if self.first {
+            self.first = false;
+            Ok(())
+        } else {
+            self.out.write_all(b",")
+        };
+        if let Err(e) = r.and_then(|()| f(&mut *self.out, &mut *self.num)) {
+            self.error = Some(e);
+        }
+    }
+}
+
+impl<W: Write> RowSink for CsvRow<'_, W> {
+    fn time(&mut self, step: usize, t: f64) {
+        let times = self.times;
+        self.put(|out, _| times.write(out, step, t));
+    }
+    fn num(&mut self, x: f64) {
+        self.put(|out, num| out.write_all(num.format(x).as_bytes()));
+    }
+    fn state(&mut self, s: StateCode) {
+        self.put(|out, _| out.write_all(s.as_str().as_bytes()));
+    }
+    fn count(&mut self, n: usize) {
+        self.put(|out, _| write!(out, "{n}"));
+    }
 }
 
 /// Streams `trajectory.csv` through a buffer into a temporary file; no
@@ -246,16 +418,16 @@ pub struct TrajectoryWriter {
     dest: PathBuf,
     num: ryu::Buffer,
     times: StepTimes,
-    tips: [Option<usize>; 2],
-    extras: Vec<usize>,
+    slots: ContactSlots,
     error: Option<io::Error>,
     rows: usize,
 }
 
 impl TrajectoryWriter {
-    /// Opens the temporary file in `dir` and writes the header; `dt` is
-    /// the time step (times are written as the decimal of k·Δt).
-    pub fn create(dir: &Path, contacts: &[String], dt: f64) -> Result<Self, CliError> {
+    /// Opens the temporary file in `dir` and writes the header for a model
+    /// whose contact points are `contacts` (record order); `dt` is the time
+    /// step (times are written as the decimal of k·Δt).
+    pub fn create(dir: &Path, contacts: &[ContactSpec], dt: f64) -> Result<Self, CliError> {
         let dest = dir.join("trajectory.csv");
         let tmp = temp_in(dir, "trajectory.csv")?;
         let mut w = Self {
@@ -263,17 +435,11 @@ impl TrajectoryWriter {
             dest,
             num: ryu::Buffer::new(),
             times: StepTimes::new(dt),
-            tips: [
-                contacts.iter().position(|n| n == "tip3"),
-                contacts.iter().position(|n| n == "tip4"),
-            ],
-            extras: (0..contacts.len())
-                .filter(|&i| !is_tip(&contacts[i]))
-                .collect(),
+            slots: ContactSlots::of(contacts),
             error: None,
             rows: 0,
         };
-        let header = trajectory_columns(contacts).join(",");
+        let header = w.slots.columns().join(",");
         if let Err(e) = writeln!(w.out, "{header}") {
             return Err(CliError::io(w.dest.display(), &e));
         }
@@ -297,56 +463,10 @@ impl TrajectoryWriter {
         }
     }
 
-    fn f(&mut self, x: f64) -> io::Result<()> {
-        self.out.write_all(b",")?;
-        self.out.write_all(self.num.format(x).as_bytes())
-    }
-
-    fn s(&mut self, s: &str) -> io::Result<()> {
-        self.out.write_all(b",")?;
-        self.out.write_all(s.as_bytes())
-    }
-
     fn write_row(&mut self, r: &StepRecord) -> io::Result<()> {
-        self.times.write(&mut self.out, r.step, r.t)?;
-        for &x in &r.q {
-            self.f(x)?;
-        }
-        let tips = self.tips;
-        for c in tips {
-            let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
-            self.f(p[0])?;
-            self.f(p[1])?;
-        }
-        for c in tips {
-            self.s(c.map_or("ST1", |c| r.state[c].as_str()))?;
-        }
-        for c in tips {
-            let (fa, n) = c.map_or((0.0, 0.0), |c| (r.fa[c], r.n[c]));
-            self.f(fa)?;
-            self.f(n)?;
-        }
-        for j in &r.joint_force {
-            self.f(j[0])?;
-            self.f(j[1])?;
-        }
-        for k in 0..self.extras.len() {
-            let c = self.extras[k];
-            self.s(r.state[c].as_str())?;
-            self.f(r.fa[c])?;
-            self.f(r.n[c])?;
-        }
-        for &t in &r.torque {
-            self.f(t)?;
-        }
-        self.f(r.kinetic)?;
-        self.f(r.potential)?;
-        self.f(r.kinetic + r.potential)?;
-        write!(self.out, ",{}", r.newton_iterations)?;
-        for &m in &r.limit_moment {
-            self.f(m)?;
-        }
-        self.out.write_all(b"\n")
+        let mut row = CsvRow::new(&mut self.out, &mut self.num, &self.times);
+        row_values(&self.slots, r, &mut row);
+        row.end()
     }
 
     /// Flushes and renames the file into place.
@@ -381,6 +501,9 @@ pub fn events_csv(events: &[Event], dt: f64) -> String {
     }
     s
 }
+
+/// The `point` of a retried step's event (`events.csv`, `summary.json`).
+pub const RETRY_POINT: &str = "substeps";
 
 /// An event as written to `summary.json`.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -427,7 +550,7 @@ impl EventJson {
         Self {
             t: times.value(e.step, e.t),
             leg: None,
-            point: "substeps".to_owned(),
+            point: RETRY_POINT.to_owned(),
             from: "1".to_owned(),
             to: e.substeps.to_string(),
         }
@@ -588,4 +711,157 @@ pub struct Summary {
     pub peak_joint_force_max: f64,
     /// Energy at the last solved step (null if none).
     pub final_energy: Option<Energy>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A contact point named `name` (deliberately unrelated to its
+    /// identity: nothing may decide by it).
+    fn point(name: &str, leg: usize, kind: PointKind) -> ContactSpec {
+        ContactSpec {
+            name: name.to_owned(),
+            leg,
+            kind,
+            body: 0,
+            point: 0,
+        }
+    }
+
+    /// Counts the values of a row.
+    #[derive(Default)]
+    struct Count(usize);
+
+    impl RowSink for Count {
+        fn time(&mut self, _: usize, _: f64) {
+            self.0 += 1;
+        }
+        fn num(&mut self, _: f64) {
+            self.0 += 1;
+        }
+        fn state(&mut self, _: StateCode) {
+            self.0 += 1;
+        }
+        fn count(&mut self, _: usize) {
+            self.0 += 1;
+        }
+    }
+
+    #[test]
+    fn points_are_placed_by_leg_and_kind_not_by_name() {
+        let contacts = [
+            point("tip3", 4, PointKind::Hip),
+            point("knee4", 4, PointKind::Tip),
+            point("hip3", 3, PointKind::Knee),
+            point("x", 3, PointKind::Tip),
+        ];
+        let slots = ContactSlots::of(&contacts);
+        assert_eq!(slots.tips, [Some(3), Some(1)]);
+        assert_eq!(
+            slots.extras,
+            [(0, 4, PointKind::Hip), (2, 3, PointKind::Knee)]
+        );
+        let c = trajectory_columns(&contacts);
+        let n = SPEC_COLUMNS.len();
+        assert_eq!(c[..n], SPEC_COLUMNS.map(str::to_owned));
+        assert_eq!(
+            c[n..n + 6],
+            [
+                "hip4_state",
+                "hip4_fa",
+                "hip4_n",
+                "knee3_state",
+                "knee3_fa",
+                "knee3_n"
+            ]
+            .map(str::to_owned)
+        );
+        assert_eq!(c[n + 6..], TAIL_COLUMNS.map(str::to_owned));
+    }
+
+    #[test]
+    fn tip_columns_are_the_contracts_and_no_column_repeats() {
+        for leg in PLANAR_LEGS {
+            for c in contact_columns(leg, PointKind::Tip)
+                .into_iter()
+                .chain([format!("tip{leg}_x"), format!("tip{leg}_y")])
+            {
+                assert!(SPEC_COLUMNS.contains(&c.as_str()), "{c}");
+            }
+        }
+        let all: Vec<ContactSpec> = PointKind::ALL
+            .into_iter()
+            .flat_map(|kind| PLANAR_LEGS.map(|leg| point("p", leg, kind)))
+            .collect();
+        let mut c = trajectory_columns(&all);
+        assert_eq!(c.len(), SPEC_COLUMNS.len() + 12 + TAIL_COLUMNS.len());
+        c.sort();
+        let n = c.len();
+        c.dedup();
+        assert_eq!(c.len(), n, "a column name repeats");
+    }
+
+    #[test]
+    fn every_row_has_one_value_per_column_in_place() {
+        let tip3 = point("a", 3, PointKind::Tip);
+        let tip4 = point("b", 4, PointKind::Tip);
+        let knee4 = point("c", 4, PointKind::Knee);
+        let hip3 = point("d", 3, PointKind::Hip);
+        let layouts: [Vec<ContactSpec>; 4] = [
+            vec![],
+            vec![tip3.clone(), tip4.clone()],
+            vec![tip3.clone(), knee4.clone(), hip3.clone()],
+            vec![hip3, tip4, knee4, tip3],
+        ];
+        for contacts in &layouts {
+            let slots = ContactSlots::of(contacts);
+            let mut r = StepRecord::zeroed(3, 0.03, contacts.len());
+            for c in 0..contacts.len() {
+                r.point[c] = [10.0 + c as f64, 20.0 + c as f64];
+                r.state[c] = StateCode::St2;
+                r.fa[c] = 30.0 + c as f64;
+                r.n[c] = 40.0 + c as f64;
+            }
+            let mut count = Count::default();
+            row_values(&slots, &r, &mut count);
+            let columns = slots.columns();
+            assert_eq!(count.0, columns.len(), "{contacts:?}");
+
+            let mut bytes = Vec::new();
+            let (mut num, times) = (ryu::Buffer::new(), StepTimes::new(0.01));
+            let mut row = CsvRow::new(&mut bytes, &mut num, &times);
+            row_values(&slots, &r, &mut row);
+            row.end().unwrap();
+            let line = String::from_utf8(bytes).unwrap();
+            let cell: std::collections::HashMap<&str, &str> = columns
+                .iter()
+                .map(String::as_str)
+                .zip(line.trim_end().split(','))
+                .collect();
+            assert_eq!(cell["t"], "0.03");
+            // Every point's values are under its own `{leg, kind}` columns.
+            for (c, p) in contacts.iter().enumerate() {
+                let [s, fa, n] = contact_columns(p.leg, p.kind);
+                assert_eq!(cell[s.as_str()], "ST2", "{s}");
+                assert_eq!(cell[fa.as_str()].parse::<f64>(), Ok(30.0 + c as f64));
+                assert_eq!(cell[n.as_str()].parse::<f64>(), Ok(40.0 + c as f64));
+                if p.kind == PointKind::Tip {
+                    let x = format!("tip{}_x", p.leg);
+                    assert_eq!(cell[x.as_str()].parse::<f64>(), Ok(10.0 + c as f64));
+                }
+            }
+            // A tip that is not a contact point: no position, ST1, no force.
+            for leg in PLANAR_LEGS {
+                if !contacts
+                    .iter()
+                    .any(|p| p.leg == leg && p.kind == PointKind::Tip)
+                {
+                    assert_eq!(cell[format!("tip{leg}_x").as_str()], "NaN");
+                    assert_eq!(cell[format!("state{leg}").as_str()], "ST1");
+                    assert_eq!(cell[format!("n{leg}").as_str()], "0.0");
+                }
+            }
+        }
+    }
 }

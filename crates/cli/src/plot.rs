@@ -21,7 +21,10 @@
 //!   top of the plot; events closer than a few pixels share a label.
 
 use fbd_contact::{StateCode, Terrain};
+use fbd_dynamics::{ContactSpec, PointKind};
 use fbd_sim::{Event, StepRecord};
+
+use crate::output::{ContactSlots, PLANAR_LEGS};
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -77,6 +80,8 @@ pub struct PlotData {
     pub normal: Vec<Trace>,
     /// Tangential force of the same points, same order (N).
     pub tangential: Vec<Trace>,
+    /// The leg and kind of the same points, same order (their colours).
+    pub points: Vec<(usize, PointKind)>,
     /// Joint angles θ2₃, θ3₃, θ2₄, θ3₄ (degrees).
     pub joints: Vec<Trace>,
     /// Joint torques, hip 3, knee 3, hip 4, knee 4 (N·m); empty when every
@@ -182,6 +187,7 @@ impl MinMax {
 /// the rows of `trajectory.csv`).
 pub struct PlotRecorder {
     names: Vec<String>,
+    points: Vec<(usize, PointKind)>,
     tips: [Option<usize>; 2],
     touched: Vec<bool>,
     tip: [MinMax; 4],
@@ -195,19 +201,18 @@ pub struct PlotRecorder {
 
 impl PlotRecorder {
     /// For a run from `t = 0` to `t_end` of a model whose contact points
-    /// are `names` (record order).
-    pub fn new(names: &[String], t_end: f64) -> Self {
+    /// are `contacts` (record order); the tips are found by `{leg, kind}`
+    /// ([`ContactSlots`]).
+    pub fn new(contacts: &[ContactSpec], t_end: f64) -> Self {
         let m = || MinMax::new(0.0, t_end);
         Self {
-            names: names.to_vec(),
-            tips: [
-                names.iter().position(|n| n == "tip3"),
-                names.iter().position(|n| n == "tip4"),
-            ],
-            touched: vec![false; names.len()],
+            names: contacts.iter().map(|c| c.name.clone()).collect(),
+            points: contacts.iter().map(|c| (c.leg, c.kind)).collect(),
+            tips: ContactSlots::of(contacts).tips,
+            touched: vec![false; contacts.len()],
             tip: std::array::from_fn(|_| m()),
-            normal: names.iter().map(|_| m()).collect(),
-            tangential: names.iter().map(|_| m()).collect(),
+            normal: contacts.iter().map(|_| m()).collect(),
+            tangential: contacts.iter().map(|_| m()).collect(),
             joints: std::array::from_fn(|_| m()),
             torques: std::array::from_fn(|_| m()),
             torque_used: false,
@@ -259,14 +264,17 @@ impl PlotRecorder {
         };
         let mut normal = Vec::new();
         let mut tangential = Vec::new();
-        for (((name, n), fa), touched) in self
+        let mut points = Vec::new();
+        for ((((name, point), n), fa), touched) in self
             .names
             .iter()
+            .zip(&self.points)
             .zip(self.normal)
             .zip(self.tangential)
             .zip(&self.touched)
         {
             if *touched {
+                points.push(*point);
                 normal.push(Trace {
                     label: format!("n {name}"),
                     pts: n.finish(),
@@ -281,6 +289,7 @@ impl PlotRecorder {
             tips: traces(&["tip3 x", "tip3 y", "tip4 x", "tip4 y"], self.tip.into()),
             normal,
             tangential,
+            points,
             joints: traces(
                 &["θ2 leg 3", "θ3 leg 3", "θ2 leg 4", "θ3 leg 4"],
                 self.joints.into(),
@@ -749,24 +758,19 @@ pub fn tips_svg(d: &PlotData) -> PlotResult<String> {
     )
 }
 
-/// The colour of a contact point by its name (`tip3`, `knee4`, …).
-fn point_color(label: &str, fallback: usize) -> RGBColor {
-    let name = label.rsplit(' ').next().unwrap_or(label);
-    let kind = match name.trim_end_matches(|c: char| c.is_ascii_digit()) {
-        "tip" => Some(0),
-        "knee" => Some(1),
-        "hip" => Some(2),
-        _ => None,
-    };
-    let leg = match name.chars().last() {
-        Some('3') => Some(0),
-        Some('4') => Some(1),
-        _ => None,
-    };
-    match (kind, leg) {
-        (Some(k), Some(l)) => POINT_COLORS[k][l],
-        _ => PALETTE[fallback % PALETTE.len()],
-    }
+/// The colour of a contact point by its `{leg, kind}` ([`POINT_COLORS`]);
+/// `PALETTE[fallback]` for a point of another leg or none.
+fn point_color(point: Option<&(usize, PointKind)>, fallback: usize) -> RGBColor {
+    let colors = point.and_then(|&(leg, kind)| {
+        let l = PLANAR_LEGS.iter().position(|&n| n == leg)?;
+        let k = match kind {
+            PointKind::Tip => 0,
+            PointKind::Knee => 1,
+            PointKind::Hip => 2,
+        };
+        Some(POINT_COLORS[k][l])
+    });
+    colors.unwrap_or(PALETTE[fallback % PALETTE.len()])
 }
 
 /// `color` mixed with white by `f` (0 = unchanged).
@@ -780,7 +784,7 @@ fn lighter(c: RGBColor, f: f64) -> RGBColor {
 pub fn forces_svg(d: &PlotData) -> PlotResult<String> {
     let mut series = Vec::new();
     for (i, (n, fa)) in d.normal.iter().zip(&d.tangential).enumerate() {
-        let c = point_color(&n.label, i);
+        let c = point_color(d.points.get(i), i);
         series.push((
             n,
             Style {
@@ -1046,10 +1050,19 @@ mod tests {
 
     #[test]
     fn plots_of_a_600000_step_run_stay_small() {
-        let names: Vec<String> = ["tip3", "tip4"].map(str::to_owned).to_vec();
+        let tips: Vec<ContactSpec> = PLANAR_LEGS
+            .iter()
+            .map(|&leg| ContactSpec {
+                name: format!("tip{leg}"),
+                leg,
+                kind: PointKind::Tip,
+                body: 0,
+                point: 0,
+            })
+            .collect();
         let steps = 600_000;
         let dt = 1e-5;
-        let mut rec = PlotRecorder::new(&names, (steps - 1) as f64 * dt);
+        let mut rec = PlotRecorder::new(&tips, (steps - 1) as f64 * dt);
         let mut r = StepRecord::zeroed(0, 0.0, 2);
         for k in 0..steps {
             let t = k as f64 * dt;
@@ -1079,6 +1092,8 @@ mod tests {
         // Only the point that touched is in forces.svg.
         assert_eq!(d.normal.len(), 1);
         assert_eq!(d.normal[0].label, "n tip3");
+        assert_eq!(d.points, [(3, PointKind::Tip)]);
+        assert_eq!(point_color(d.points.first(), 5), LEG3);
         assert!(torques_svg(&d).is_none());
     }
 

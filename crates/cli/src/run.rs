@@ -5,6 +5,7 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
+use fbd_dynamics::PointKind;
 use fbd_kinematics::planar::PlanarChains;
 use fbd_sim::{Model, RunSummary, StepRecord};
 
@@ -29,9 +30,10 @@ struct Collector {
 }
 
 impl Collector {
-    fn new(model: &Model, names: &[String]) -> Self {
+    fn new(model: &Model) -> Self {
+        let contacts = &model.mech.contacts;
         let steps = model.steps.max(1);
-        let plot = PlotRecorder::new(names, (steps - 1) as f64 * model.params.dt);
+        let plot = PlotRecorder::new(contacts, (steps - 1) as f64 * model.params.dt);
         let last_step = steps - 1;
         let mut snapshot_steps: Vec<usize> = (0..=STANCE_INTERVALS)
             .map(|i| ((i * last_step) as f64 / STANCE_INTERVALS as f64).round() as usize)
@@ -42,7 +44,7 @@ impl Collector {
             snapshot_steps,
             plot,
             last: None,
-            peak_contact: vec![PeakForce::default(); names.len()],
+            peak_contact: vec![PeakForce::default(); contacts.len()],
             peak_joint: [0.0; 4],
         }
     }
@@ -94,15 +96,22 @@ impl Collector {
     }
 }
 
+/// The time of the first event of leg `leg`'s tip (the contact point of
+/// `{leg, kind: Tip}`) for which `pred` holds.
 fn first_time(
+    model: &Model,
     run: &RunSummary,
     times: &StepTimes,
     leg: usize,
     pred: impl Fn(&fbd_sim::Event) -> bool,
 ) -> Option<f64> {
+    let contacts = &model.mech.contacts;
     run.events
         .iter()
-        .find(|e| e.leg == leg && e.point == "tip" && pred(e))
+        .find(|e| {
+            let c = &contacts[e.contact];
+            c.leg == leg && c.kind == PointKind::Tip && pred(e)
+        })
         .map(|e| times.value(e.step, e.t))
 }
 
@@ -117,11 +126,15 @@ fn summary(
 ) -> Summary {
     use fbd_contact::StateCode;
     let times = StepTimes::new(model.params.dt);
-    let legs = ["leg3", "leg4"];
     let by_leg = |pred: &dyn Fn(&fbd_sim::Event) -> bool| -> BTreeMap<String, Option<f64>> {
-        legs.iter()
-            .zip([3, 4])
-            .map(|(name, leg)| ((*name).to_owned(), first_time(run, &times, leg, pred)))
+        output::PLANAR_LEGS
+            .iter()
+            .map(|&leg| {
+                (
+                    format!("leg{leg}"),
+                    first_time(model, run, &times, leg, pred),
+                )
+            })
             .collect()
     };
     let steps_per_second = (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds);
@@ -166,9 +179,11 @@ fn summary(
         first_touchdown: by_leg(&|e| e.from == StateCode::St1 && e.to != StateCode::St1),
         first_slip: by_leg(&|e| e.to == StateCode::St3),
         peak_contact_force: names.iter().cloned().zip(peaks).collect(),
-        peak_joint_force: ["hip3", "knee3", "hip4", "knee4"]
+        peak_joint_force: model
+            .mech
+            .joints
             .iter()
-            .map(|s| (*s).to_owned())
+            .map(|j| j.name.clone())
             .zip(joints)
             .collect(),
         peak_joint_force_max: joints.iter().copied().fold(0.0, f64::max),
@@ -187,7 +202,7 @@ fn summary(
 /// step) reads `t=0.5 s  substeps  1 -> 4`. `t` is the time as written in
 /// `events.csv` (the decimal of k·Δt).
 pub fn event_line(t: &str, e: &EventJson) -> String {
-    let point = if e.point == "tip" {
+    let point = if e.point == PointKind::Tip.as_str() {
         String::new()
     } else {
         format!("{}  ", e.point)
@@ -240,11 +255,15 @@ pub fn simulate(
     let mut traj = match out_dir {
         Some(dir) => {
             output::prepare_dir(dir)?;
-            Some(TrajectoryWriter::create(dir, &names, model.dt())?)
+            Some(TrajectoryWriter::create(
+                dir,
+                &model.mech.contacts,
+                model.dt(),
+            )?)
         }
         None => None,
     };
-    let mut collect = Collector::new(&model, &names);
+    let mut collect = Collector::new(&model);
     // The simulator hands over every `stride`-th step; the plots and peaks
     // want them all, so stride is applied here.
     let stride = model.params.stride.max(1);

@@ -701,10 +701,12 @@ fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
             .filter_map(serde_json::Value::as_f64)
             .reduce(f64::min)
     });
-    let peak_foot_n = s["peak_contact_force"].as_object().and_then(|m| {
-        m.iter()
-            .filter(|(k, _)| k.starts_with("tip"))
-            .filter_map(|(_, v)| v["n"].as_f64())
+    // The feet are the `{leg, kind: tip}` points of the model's legs.
+    let tip = fbd_dynamics::PointKind::Tip.as_str();
+    let peak_foot_n = s["legs"].as_array().and_then(|legs| {
+        legs.iter()
+            .filter_map(serde_json::Value::as_u64)
+            .filter_map(|n| s["peak_contact_force"][format!("{tip}{n}")]["n"].as_f64())
             .reduce(f64::max)
     });
     Row {

@@ -56,6 +56,10 @@ pub enum PointKind {
 }
 
 impl PointKind {
+    /// The three kinds, in the order of a leg's contact points in the
+    /// mechanism (tips, then knees, then hips).
+    pub const ALL: [PointKind; 3] = [PointKind::Tip, PointKind::Knee, PointKind::Hip];
+
     /// `"tip"`, `"knee"` or `"hip"`, as written to the output files.
     pub fn as_str(self) -> &'static str {
         match self {

@@ -1,8 +1,10 @@
 //! Every column of `trajectory.csv`, kept in memory: the same names
-//! ([`fbd_cli::output::trajectory_columns`]) and the same values, so that a
-//! run from Python equals the CLI's file bit for bit (the test suite
-//! compares them).
+//! ([`fbd_cli::output::trajectory_columns`]) and the same values, from the
+//! same row builders ([`fbd_cli::output::row_values`],
+//! [`fbd_cli::spatial::csv::row_values`]), so that a run from Python equals
+//! the CLI's file bit for bit (the test suite compares them).
 
+use fbd_cli::output::{ContactSlots, RowSink};
 use fbd_cli::steptime::StepTimes;
 use fbd_sim::StepRecord;
 use numpy::PyArray1;
@@ -24,25 +26,18 @@ pub struct Columns {
     names: Vec<String>,
     values: Vec<Values>,
     times: StepTimes,
-    tips: [Option<usize>; 2],
-    extras: Vec<usize>,
+    /// Where the planar contact points' values go (empty for
+    /// [`Columns::named`]).
+    slots: ContactSlots,
 }
 
 impl Columns {
-    /// Empty columns for a model with contact points `contacts` and time
-    /// step `dt`, with room for `rows` rows.
-    pub fn new(contacts: &[String], dt: f64, rows: usize) -> Self {
-        let names = fbd_cli::output::trajectory_columns(contacts);
-        let tips = [
-            contacts.iter().position(|n| n == "tip3"),
-            contacts.iter().position(|n| n == "tip4"),
-        ];
-        let extras: Vec<usize> = (0..contacts.len())
-            .filter(|&i| !tips.contains(&Some(i)))
-            .collect();
-        let mut c = Self::named(names, dt, rows);
-        c.tips = tips;
-        c.extras = extras;
+    /// Empty columns for a planar model whose contact points go to `slots`
+    /// (found by their `{leg, kind}`: [`ContactSlots::of`] the model's
+    /// contact points) and time step `dt`, with room for `rows` rows.
+    pub fn new(slots: ContactSlots, dt: f64, rows: usize) -> Self {
+        let mut c = Self::named(slots.columns(), dt, rows);
+        c.slots = slots;
         c
     }
 
@@ -66,8 +61,7 @@ impl Columns {
             names,
             values,
             times: StepTimes::new(dt),
-            tips: [None; 2],
-            extras: Vec::new(),
+            slots: ContactSlots::default(),
         }
     }
 
@@ -85,47 +79,15 @@ impl Columns {
 
     /// Appends the row of `r`, in the order of `trajectory.csv`.
     pub fn push(&mut self, r: &StepRecord) {
-        let mut w = Writer {
-            values: &mut self.values,
-            i: 0,
+        let mut sink = Sink {
+            w: Writer {
+                values: &mut self.values,
+                i: 0,
+            },
+            times: &self.times,
         };
-        w.f(self.times.value(r.step, r.t));
-        for &x in &r.q {
-            w.f(x);
-        }
-        for c in self.tips {
-            let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
-            w.f(p[0]);
-            w.f(p[1]);
-        }
-        for c in self.tips {
-            w.s(c.map_or("ST1", |c| r.state[c].as_str()));
-        }
-        for c in self.tips {
-            let (fa, n) = c.map_or((0.0, 0.0), |c| (r.fa[c], r.n[c]));
-            w.f(fa);
-            w.f(n);
-        }
-        for j in &r.joint_force {
-            w.f(j[0]);
-            w.f(j[1]);
-        }
-        for &c in &self.extras {
-            w.s(r.state[c].as_str());
-            w.f(r.fa[c]);
-            w.f(r.n[c]);
-        }
-        for &t in &r.torque {
-            w.f(t);
-        }
-        w.f(r.kinetic);
-        w.f(r.potential);
-        w.f(r.kinetic + r.potential);
-        w.i(r.newton_iterations as i64);
-        for &m in &r.limit_moment {
-            w.f(m);
-        }
-        debug_assert_eq!(w.i, self.names.len(), "a value for every column");
+        fbd_cli::output::row_values(&self.slots, r, &mut sink);
+        debug_assert_eq!(sink.w.i, self.names.len(), "a value for every column");
     }
 
     /// `(names, {name: numpy array})`; state columns are lists of str (the
@@ -180,7 +142,7 @@ pub struct Sink<'a> {
     times: &'a StepTimes,
 }
 
-impl fbd_cli::spatial::csv::RowSink for Sink<'_> {
+impl RowSink for Sink<'_> {
     fn time(&mut self, step: usize, t: f64) {
         self.w.f(self.times.value(step, t));
     }

@@ -4,6 +4,7 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use fbd_cli::output::ContactSlots;
 use fbd_cli::run::{Simulated, simulate};
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
@@ -104,18 +105,18 @@ pub fn run<'py>(
         let outcome = py.detach(|| {
             // The columns' names and capacity; an invalid model is reported
             // by `simulate` itself.
-            let (names, dt, rows) = match &loaded.config {
+            let (slots, dt, rows) = match &loaded.config {
                 fbd_scenario::Config::Planar(c) => match c.model(&loaded.source) {
                     Ok(m) => (
-                        m.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+                        ContactSlots::of(&m.mech.contacts),
                         m.dt(),
                         m.steps.div_ceil(m.params.stride.max(1)),
                     ),
-                    Err(_) => (Vec::new(), c.time.dt, 0),
+                    Err(_) => (ContactSlots::default(), c.time.dt, 0),
                 },
-                fbd_scenario::Config::Hexapod(c) => (Vec::new(), c.time.dt, 0),
+                fbd_scenario::Config::Hexapod(c) => (ContactSlots::default(), c.time.dt, 0),
             };
-            let mut cols = Columns::new(&names, dt, rows);
+            let mut cols = Columns::new(slots, dt, rows);
             let stop = AtomicBool::new(false);
             let mut watch = SignalWatch::default();
             simulate(

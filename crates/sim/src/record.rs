@@ -149,7 +149,12 @@ pub struct LimitEvent {
 impl LimitEvent {
     /// `"hip_limit"` (θ2), `"knee_limit"` (θ3) or `"theta1_limit"`.
     pub fn point(&self) -> &'static str {
-        match self.joint {
+        Self::point_of(self.joint)
+    }
+
+    /// The `point` of a limit event of `joint` (`events.csv`).
+    pub fn point_of(joint: Joint) -> &'static str {
+        match joint {
             Joint::Theta1 => "theta1_limit",
             Joint::Theta2 => "hip_limit",
             Joint::Theta3 => "knee_limit",

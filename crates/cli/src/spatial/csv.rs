@@ -12,7 +12,7 @@ use tempfile::NamedTempFile;
 
 use super::Layout;
 use crate::CliError;
-use crate::output;
+use crate::output::{self, CsvRow};
 use crate::steptime::StepTimes;
 
 /// The body pose columns after `t`.
@@ -118,21 +118,9 @@ impl Slots {
     }
 }
 
-/// Receives the values of one row of `trajectory.csv`, column by column
-/// in the order of [`columns`]: the file's writer and the in-memory
-/// columns of the Python package share [`row_values`], one source of the
-/// values.
-pub trait RowSink {
-    /// `t`: the time of step `step` (`t = step·Δt`; the file writes the
-    /// exact decimal of `step·Δt`, [`StepTimes`]).
-    fn time(&mut self, step: usize, t: f64);
-    /// A number (m, rad, N, N·m, J).
-    fn num(&mut self, x: f64);
-    /// A contact state (`ST1`, `ST2`, `ST3`).
-    fn state(&mut self, s: StateCode);
-    /// A count (`newton_iterations`).
-    fn count(&mut self, n: usize);
-}
+/// Receives the values of a row ([`row_values`]); the planar and the 3D
+/// files share it.
+pub use crate::output::RowSink;
 
 /// Hands the values of the row of `r` to `sink`, in the order of
 /// [`columns`]`(layout)`; `slots` are those of `layout` ([`Slots::of`]),
@@ -190,51 +178,6 @@ pub fn row_values(
     sink.num(r.kinetic);
     sink.num(r.potential);
     sink.count(r.newton_iterations);
-}
-
-/// One row of the file: comma-separated, the first I/O error kept.
-struct CsvRow<'a> {
-    out: &'a mut BufWriter<NamedTempFile>,
-    num: &'a mut ryu::Buffer,
-    times: &'a StepTimes,
-    error: Option<io::Error>,
-    first: bool,
-}
-
-impl CsvRow<'_> {
-    fn put(
-        &mut self,
-        f: impl FnOnce(&mut BufWriter<NamedTempFile>, &mut ryu::Buffer) -> io::Result<()>,
-    ) {
-        if self.error.is_some() {
-            return;
-        }
-        let r = if self.first {
-            self.first = false;
-            Ok(())
-        } else {
-            self.out.write_all(b",")
-        };
-        if let Err(e) = r.and_then(|()| f(&mut *self.out, &mut *self.num)) {
-            self.error = Some(e);
-        }
-    }
-}
-
-impl RowSink for CsvRow<'_> {
-    fn time(&mut self, step: usize, t: f64) {
-        let times = self.times;
-        self.put(|out, _| times.write(out, step, t));
-    }
-    fn num(&mut self, x: f64) {
-        self.put(|out, num| out.write_all(num.format(x).as_bytes()));
-    }
-    fn state(&mut self, s: StateCode) {
-        self.put(|out, _| out.write_all(s.as_str().as_bytes()));
-    }
-    fn count(&mut self, n: usize) {
-        self.put(|out, _| write!(out, "{n}"));
-    }
 }
 
 /// Streams `trajectory.csv` through a buffer into a temporary file; no
@@ -297,18 +240,9 @@ impl TrajectoryWriter {
 
     fn write_row(&mut self, r: &SpatialRecord) -> io::Result<()> {
         let slots = self.slots.take().unwrap_or_default();
-        let mut sink = CsvRow {
-            out: &mut self.out,
-            num: &mut self.num,
-            times: &self.times,
-            error: None,
-            first: true,
-        };
-        row_values(&self.layout, &slots, &mut self.feet, r, &mut sink);
-        let result = match sink.error.take() {
-            Some(e) => Err(e),
-            None => self.out.write_all(b"\n"),
-        };
+        let mut row = CsvRow::new(&mut self.out, &mut self.num, &self.times);
+        row_values(&self.layout, &slots, &mut self.feet, r, &mut row);
+        let result = row.end();
         self.slots = Some(slots);
         result
     }

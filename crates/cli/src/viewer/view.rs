@@ -7,9 +7,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use fbd_contact::StateCode;
+use fbd_dynamics::PointKind;
 use fbd_kinematics::body::LEG_COUNT;
 use fbd_kinematics::hexapod::NQ;
-use fbd_sim::{Event, Model, StepRecord};
+use fbd_sim::{Event, Joint, LimitEvent, Model, StepRecord};
 
 use super::hexapod::{HexDynamics, HexFrame, HexapodScene};
 use super::planar::PlanarScene;
@@ -80,19 +81,6 @@ fn state(s: &str) -> Option<StateCode> {
     }
 }
 
-/// Contact columns of a point: `state3, fa3, n3` for the tips (the contract's
-/// names), `knee3_state, knee3_fa, knee3_n` for the others.
-fn contact_columns(name: &str) -> [String; 3] {
-    match name.strip_prefix("tip") {
-        Some(leg) => [format!("state{leg}"), format!("fa{leg}"), format!("n{leg}")],
-        None => [
-            format!("{name}_state"),
-            format!("{name}_fa"),
-            format!("{name}_n"),
-        ],
-    }
-}
-
 /// The step records of a planar run's `trajectory.csv`.
 fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliError> {
     let q_cols = [
@@ -106,7 +94,7 @@ fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliEr
         .contacts
         .iter()
         .map(|c| {
-            let [s, fa, n] = contact_columns(&c.name);
+            let [s, fa, n] = crate::output::contact_columns(c.leg, c.kind);
             Ok([table.column(&s)?, table.column(&fa)?, table.column(&n)?])
         })
         .collect::<Result<_, CliError>>()?;
@@ -174,18 +162,25 @@ fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, CliError> {
                 r + 2
             ))
         };
-        let n = cell(row, leg).trim();
-        let kind = cell(row, point).trim();
-        // Joint-limit and retried-step rows are not contact events.
-        if kind.ends_with("_limit") || kind == "substeps" {
-            continue;
-        }
-        let name = format!("{kind}{n}");
+        let point = cell(row, point).trim();
+        let Some(kind) = PointKind::ALL.into_iter().find(|k| k.as_str() == point) else {
+            // Joint-limit and retried-step rows are not contact events.
+            if point == crate::output::RETRY_POINT
+                || Joint::ALL
+                    .into_iter()
+                    .any(|j| LimitEvent::point_of(j) == point)
+            {
+                continue;
+            }
+            return Err(bad("point"));
+        };
+        let n: usize = cell(row, leg).trim().parse().map_err(|_| bad("leg"))?;
+        // The model's contact point of that `{leg, kind}`.
         let contact = model
             .mech
             .contacts
             .iter()
-            .position(|c| c.name == name)
+            .position(|c| c.leg == n && c.kind == kind)
             .ok_or_else(|| bad("point"))?;
         out.push(Event {
             t: table.number(row, r, t)?,
@@ -321,10 +316,8 @@ pub fn spatial_frames(
         .extra_points
         .iter()
         .map(|&(n, kind)| {
-            let (k, prefix) = match kind {
-                fbd_dynamics::PointKind::Hip => (1, "hippoint"),
-                _ => (0, "kneepoint"),
-            };
+            let k = usize::from(kind == PointKind::Hip);
+            let prefix = crate::spatial::csv::point_prefix(kind);
             Ok((
                 n,
                 k,

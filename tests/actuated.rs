@@ -51,8 +51,11 @@ fn slope_stand(mu_static: f64, mu_dynamic: f64) -> PlanarParams {
     p.friction.mu_static = mu_static;
     p.friction.mu_dynamic = mu_dynamic;
     p.q0[2] = 10f64.to_radians();
+    // The geometry only: no ground, no controller (its gains are for the
+    // robot standing, not floating).
     let model = Model::planar(&PlanarParams {
         terrain: Terrain::None,
+        control: Control::None,
         ..p.clone()
     })
     .unwrap();

@@ -11,10 +11,32 @@ import pytest
 import fbd
 from conftest import run_cli
 
-# A failing experiment: an explicit PD controller far too stiff for its
-# time step (kp·Δt² ≫ the knee's inertia, no damping) makes the joints
-# oscillate with a growing amplitude until Newton's method fails; in the
-# air, so that no contact logic is involved.
+# A failing experiment: in the air, so that no contact logic is involved,
+# a trajectory controller (kp = 10 N·m/rad, stable) told to turn both hips
+# by 10⁶° between t = 0.25 s and 0.26 s: a torque of 1.7e5 N·m in one step,
+# which Newton's method cannot solve (at step 26).
+FAILING = """
+[time]
+duration = 1.0
+[leg]
+theta2_deg = [-1e6, 1e6]
+theta3_deg = [-1e6, 1e6]
+[terrain]
+kind = "none"
+[control]
+kind = "trajectory"
+kp = 10.0
+[control.leg3]
+times = [0.0, 0.25, 0.26]
+target_deg = [[0.0, 245.0], [0.0, 245.0], [1e6, 245.0]]
+[control.leg4]
+times = [0.0, 0.25, 0.26]
+target_deg = [[0.0, 255.0], [0.0, 255.0], [1e6, 255.0]]
+"""
+
+# An explicit PD controller far too stiff for its time step (kp·Δt² ≫ the
+# joints' effective inertia, no damping): its torques would oscillate with
+# a growing amplitude, so it is refused before the run.
 UNSTABLE_PD = """
 [time]
 duration = 1.0
@@ -102,12 +124,24 @@ def test_simulator_config_errors():
     assert info.value.key == "time.duration"
 
 
-def test_failing_run_raises_simulation_error_with_partial_rows():
-    with pytest.raises(fbd.SimulationError) as info:
+def test_an_unstable_pd_gain_is_a_config_error_naming_the_key():
+    with pytest.raises(fbd.ConfigError) as info:
         fbd.run(UNSTABLE_PD)
     e = info.value
+    assert e.key == "control.kp", str(e)
+    assert "unstable" in str(e) and "time.dt below" in str(e), str(e)
+    with pytest.raises(fbd.ConfigError) as info:
+        fbd.run(UNSTABLE_PD.replace("kp = 5000.0\nkd = 0.0", "kp = 100.0\nkd = 50.0"))
+    assert info.value.key == "control.kd", str(info.value)
+
+
+def test_failing_run_raises_simulation_error_with_partial_rows():
+    with pytest.raises(fbd.SimulationError) as info:
+        fbd.run(FAILING)
+    e = info.value
     assert isinstance(e, RuntimeError)
-    assert e.step is not None and 2 <= e.step < 100
+    # The step of the commanded jump.
+    assert e.step == 26
     assert e.time == pytest.approx(e.step * 0.01, abs=1e-12)
     assert f"step {e.step}" in str(e)
     r = e.result
@@ -117,15 +151,11 @@ def test_failing_run_raises_simulation_error_with_partial_rows():
     assert r.error == str(e) and r.summary["status"] == "error"
     assert r.summary["steps"] == e.step
     assert np.all(np.isfinite(r["theta3_3"]))
-    # The instability the error stops: the knee's error from its target
-    # grows without bound (explicit PD beyond its stability limit).
-    err = np.abs(r["theta2_3"] - np.radians(1.0))
-    assert err[-1] > 10 * err[1]
 
 
 def test_failing_run_with_out_writes_every_file(cli, tmp):
-    cfg = tmp / "unstable.toml"
-    cfg.write_text(UNSTABLE_PD)
+    cfg = tmp / "failing.toml"
+    cfg.write_text(FAILING)
     with pytest.raises(fbd.SimulationError) as info:
         fbd.run(cfg, out=tmp / "py")
     p = run_cli(cli, "run", str(cfg), "--out", str(tmp / "cli"))

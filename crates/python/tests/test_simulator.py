@@ -181,11 +181,11 @@ def test_bad_torques():
 
 
 def test_failing_step_raises_and_refuses_until_reset():
-    from test_errors import UNSTABLE_PD
+    from test_errors import FAILING
 
     with pytest.raises(fbd.SimulationError) as ref:
-        fbd.run(UNSTABLE_PD)
-    sim = fbd.Simulator(UNSTABLE_PD)
+        fbd.run(FAILING)
+    sim = fbd.Simulator(FAILING)
     with pytest.raises(fbd.SimulationError) as info:
         sim.step(steps=100)
     assert info.value.step == ref.value.step and info.value.time == ref.value.time

@@ -30,12 +30,12 @@ def test_sweep_runs_equal_single_runs(examples, tmp):
 
 
 def test_sweep_with_failing_runs_reports_them(tmp):
-    from test_errors import UNSTABLE_PD
+    from test_errors import FAILING
 
-    (tmp / "base.toml").write_text(UNSTABLE_PD)
+    (tmp / "base.toml").write_text(FAILING)
     sweep_file = tmp / "sweep.toml"
-    # kp = 5000 is beyond the explicit PD's stability limit at Δt = 0.01 s.
-    sweep_file.write_text('base = "base.toml"\nmode = "zip"\n\n[vary]\n"control.kp" = [5000.0, 50.0]\n"control.kd" = [0.0, 1.0]\n')
+    # The base fails at t = 0.26 s; stopped at 0.2 s it does not.
+    sweep_file.write_text('base = "base.toml"\nmode = "zip"\n\n[vary]\n"time.duration" = [1.0, 0.2]\n')
     res = fbd.sweep(sweep_file, tmp / "out")
     assert res.failed is not None and "1 of 2 runs failed" in res.failed
     assert list(res.index["status"]) == ["error", "ok"]

@@ -29,6 +29,7 @@ pub mod energy;
 pub mod engine;
 mod error;
 pub mod gait;
+pub mod joint_inertia;
 mod model;
 mod params;
 pub mod predictor;

@@ -1,11 +1,13 @@
 //! The immutable [`Model`] of a planar run, validated from [`PlanarParams`].
 
+use crate::control::Control;
+use crate::joint_inertia::{fastest_mode, planar_feet_jacobian, planar_mass_matrix};
 use crate::rules::{check, positive};
 use crate::{PlanarParams, SimError};
 use fbd_contact::{ContactParams, ContactState};
 use fbd_dynamics::{Mechanism, PointKind, TwoLegInertia};
 use fbd_kinematics::Joint;
-use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex};
+use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex, theta2_index, theta3_index};
 use fbd_solver::NewtonParams;
 
 /// Everything fixed during a run: parameters, mechanism, tolerances.
@@ -235,6 +237,7 @@ impl Model {
             }
         }
         let mech = mech.with_limits(limited);
+        pd_stability(p, &mech, &index)?;
         let contact = ContactParams::default();
         let contact_leg: Vec<usize> = mech.contacts.iter().map(|c| c.leg).collect();
         let contact_point: Vec<&'static str> =
@@ -293,4 +296,57 @@ impl Model {
     pub fn dt(&self) -> f64 {
         self.params.dt
     }
+}
+
+/// The stability rule of the explicit joint controller
+/// ([`crate::rules::pd_stability`]) on the smallest effective joint
+/// inertia of the robot standing on both feet (floating, without ground;
+/// [`crate::joint_inertia`]) at the commanded poses: the initial one and
+/// every target (each knot of a trajectory).
+fn pd_stability(p: &PlanarParams, mech: &Mechanism, index: &TwoLegIndex) -> Result<(), SimError> {
+    let (kp, kd, times) = match &p.control {
+        Control::None => return Ok(()),
+        Control::Pd { kp, kd, .. } => (*kp, *kd, vec![0.0]),
+        Control::Trajectory { kp, kd, legs, .. } => {
+            let mut t: Vec<f64> = legs.iter().flat_map(|l| l.times.iter().copied()).collect();
+            t.sort_by(f64::total_cmp);
+            (*kp, *kd, t)
+        }
+    };
+    if kp == 0.0 && kd == 0.0 {
+        return Ok(());
+    }
+    let joints: Vec<usize> = mech.joints.iter().map(|j| j.q_index).collect();
+    // Without ground no foot ever stands: the free robot's modes.
+    let feet: &[usize] = if p.terrain.exists() { &index.tip } else { &[] };
+    let mut poses = vec![p.q0];
+    for t in times {
+        let mut q = p.q0;
+        for leg in 0..2 {
+            if let Some([t2, t3]) = p.control.target(leg, t) {
+                q[theta2_index(leg)] = t2;
+                q[theta3_index(leg)] = t3;
+            }
+        }
+        poses.push(q);
+    }
+    let (mut inertia, mut joint) = (f64::INFINITY, 0);
+    for q in &poses {
+        let mode = fastest_mode(
+            &planar_mass_matrix(mech, q),
+            &planar_feet_jacobian(mech, feet, q),
+            &joints,
+        );
+        if mode.inertia < inertia {
+            (inertia, joint) = (mode.inertia, mode.joint);
+        }
+    }
+    let spec = &mech.joints[joint];
+    crate::rules::pd_stability(
+        kp,
+        kd,
+        inertia,
+        p.dt,
+        &format!("leg {} {}", spec.leg, spec.joint.name()),
+    )
 }

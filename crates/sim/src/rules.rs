@@ -100,6 +100,87 @@ pub(crate) fn positive(key: &str, v: f64) -> Result<(), SimError> {
     )
 }
 
+/// Whether the explicit PD torques are stable on a joint of effective
+/// inertia `I`: with `a = kp·Δt²/I` and `b = kd·Δt/I` (both ≥ 0), the
+/// step `I·(θ[k+1] − 2θ[k] + θ[k−1])/Δt² = −kp·θ[k] − kd·(θ[k] − θ[k−1])/Δt`
+/// has the characteristic polynomial `z² − (2 − a − b)·z + (1 − b)`, whose
+/// roots lie in the closed unit disc if and only if `a + 2b ≤ 4`
+/// (Jury: `|1 − b| ≤ 1`, `a ≥ 0`, `4 − a − 2b ≥ 0`; `a ≥ 0`, `b ≥ 0` make
+/// the last one the only binding condition). At `a + 2b = 4` a root is
+/// −1 (an undamped oscillation from one step to the next), beyond it
+/// grows: stable means `a + 2b < 4`.
+#[inline]
+pub(crate) fn pd_stable(a: f64, b: f64) -> bool {
+    a + 2.0 * b < 4.0
+}
+
+/// The largest stable damping (N·m·s/rad) for stiffness `kp` on inertia
+/// `inertia` at step `dt`: `2·I/Δt − kp·Δt/2` ([`pd_stable`]; negative
+/// when `kp` alone is unstable).
+#[inline]
+pub(crate) fn pd_kd_limit(kp: f64, inertia: f64, dt: f64) -> f64 {
+    2.0 * inertia / dt - 0.5 * kp * dt
+}
+
+/// The largest stable step (s) for gains `kp`, `kd` on inertia `inertia`:
+/// the positive root of `kp·Δt² + 2·kd·Δt = 4·I` ([`pd_stable`]).
+#[inline]
+pub(crate) fn pd_dt_limit(kp: f64, kd: f64, inertia: f64) -> f64 {
+    if kp > 0.0 {
+        // (−kd + √(kd² + 4·kp·I))/kp, written without the cancellation.
+        4.0 * inertia / (kd + (kd * kd + 4.0 * kp * inertia).sqrt())
+    } else if kd > 0.0 {
+        2.0 * inertia / kd
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The stability rule of the explicit joint controller: `control.kd` (or
+/// `control.kp`, when the stiffness alone breaks it) must keep
+/// [`pd_stable`] on the smallest effective joint inertia `inertia`
+/// (kg·m², [`crate::joint_inertia`]) at step `dt`; `joint` names the
+/// joint that moves most in that fastest mode (e.g. `leg 3 θ2`).
+pub(crate) fn pd_stability(
+    kp: f64,
+    kd: f64,
+    inertia: f64,
+    dt: f64,
+    joint: &str,
+) -> Result<(), SimError> {
+    if pd_stable(kp * dt * dt / inertia, kd * dt / inertia) {
+        return Ok(());
+    }
+    let kd_max = pd_kd_limit(kp, inertia, dt);
+    let dt_max = pd_dt_limit(kp, kd, inertia);
+    let why = format!(
+        "makes the explicit joint torques unstable at time.dt = {dt} s: the fastest joint mode \
+         ({joint}, effective inertia {inertia:.3e} kg·m²) needs kp·Δt²/I + 2·kd·Δt/I < 4"
+    );
+    if kd_max > 0.0 {
+        check(
+            false,
+            "control.kd",
+            &why,
+            format!("{kd} N·m·s/rad"),
+            &format!(
+                "lower control.kd below {kd_max:.4} N·m·s/rad or time.dt below {dt_max:.3e} s"
+            ),
+        )
+    } else {
+        check(
+            false,
+            "control.kp",
+            &why,
+            format!("{kp} N·m/rad"),
+            &format!(
+                "lower control.kp below {:.4} N·m/rad or time.dt below {dt_max:.3e} s",
+                4.0 * inertia / (dt * dt)
+            ),
+        )
+    }
+}
+
 /// Adapts the solver's sink to the assembly's sink trait.
 pub(crate) struct Sink<'s, 'a>(pub(crate) &'s mut fbd_solver::JacobianSink<'a>);
 
@@ -197,5 +278,101 @@ impl Failure {
             },
             Failure::NonFinite { residual } => SimError::NonFinite { step, t, residual },
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{pd_dt_limit, pd_kd_limit, pd_stability, pd_stable};
+
+    /// Largest root modulus of `z² − (2 − a − b)·z + (1 − b)`, the
+    /// characteristic polynomial of the explicit PD on one joint.
+    fn spectral_radius(a: f64, b: f64) -> f64 {
+        let (p, q) = (-(2.0 - a - b), 1.0 - b);
+        let disc = p * p - 4.0 * q;
+        if disc >= 0.0 {
+            let r = disc.sqrt();
+            ((-p + r) / 2.0).abs().max(((-p - r) / 2.0).abs())
+        } else {
+            // Complex pair: |z|² = q.
+            q.sqrt()
+        }
+    }
+
+    /// The closed-form region against the roots over a grid of (a, b):
+    /// inside (by a margin) no root leaves the unit disc, and with a > 0,
+    /// b > 0 every root is strictly inside (the oscillation decays);
+    /// outside (by a margin) a root is outside.
+    #[test]
+    fn closed_form_limit_matches_the_roots() {
+        let mut inside = 0;
+        let mut outside = 0;
+        for i in 0..=400 {
+            for j in 0..=300 {
+                let (a, b) = (i as f64 * 0.0125, j as f64 * 0.01);
+                let rho = spectral_radius(a, b);
+                let margin = a + 2.0 * b - 4.0;
+                if margin < -1e-9 {
+                    assert!(pd_stable(a, b));
+                    assert!(rho <= 1.0 + 1e-12, "a = {a}, b = {b}: ρ = {rho}");
+                    if a > 0.0 && b > 0.0 {
+                        assert!(rho < 1.0, "a = {a}, b = {b}: ρ = {rho}");
+                    }
+                    inside += 1;
+                } else if margin > 1e-9 {
+                    assert!(!pd_stable(a, b));
+                    assert!(rho > 1.0, "a = {a}, b = {b}: ρ = {rho}");
+                    outside += 1;
+                }
+            }
+        }
+        assert!(inside > 10_000 && outside > 10_000, "{inside} / {outside}");
+    }
+
+    /// The recurrence itself, iterated: just inside the limit an initial
+    /// rate dies away, just outside it grows.
+    #[test]
+    fn the_recurrence_obeys_the_limit() {
+        let (inertia, dt, kp) = (0.0105, 1e-3, 1000.0);
+        let kd_max = pd_kd_limit(kp, inertia, dt);
+        let run = |kd: f64| {
+            let (mut prev, mut th) = (0.0, 1e-3);
+            for _ in 0..20_000 {
+                let tau = -kp * th - kd * (th - prev) / dt;
+                let next = 2.0 * th - prev + dt * dt * tau / inertia;
+                (prev, th) = (th, next);
+            }
+            th.abs().max(prev.abs())
+        };
+        assert!(run(0.99 * kd_max) < 1e-6, "{}", run(0.99 * kd_max));
+        assert!(run(1.01 * kd_max) > 1.0, "{}", run(1.01 * kd_max));
+        // The step limit is the same boundary.
+        let kd = 25.0;
+        let h = pd_dt_limit(kp, kd, inertia);
+        let lhs = kp * h * h / inertia + 2.0 * kd * h / inertia;
+        assert!((lhs - 4.0).abs() < 1e-12, "{lhs}");
+        assert!((pd_dt_limit(0.0, kd, inertia) - 2.0 * inertia / kd).abs() < 1e-18);
+    }
+
+    /// The error names the key, the limit and the remedy.
+    #[test]
+    fn the_error_names_the_key_and_the_remedy() {
+        assert!(pd_stability(1000.0, 15.0, 0.0105, 1e-3, "leg 1 θ2").is_ok());
+        let e = pd_stability(1000.0, 30.0, 0.0105, 1e-3, "leg 1 θ2")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("control.kd: "), "{e}");
+        assert!(
+            e.contains("lower control.kd below 20.5000 N·m·s/rad"),
+            "{e}"
+        );
+        assert!(e.contains("time.dt below 6.920e-4 s"), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+        // A stiffness that alone is unstable names control.kp.
+        let e = pd_stability(1e6, 0.0, 0.01, 1e-3, "leg 3 θ3")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("control.kp: "), "{e}");
+        assert!(e.contains("below 40000.0000 N·m/rad"), "{e}");
     }
 }

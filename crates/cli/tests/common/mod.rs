@@ -54,11 +54,15 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 /// The reference failing experiment, away from the contact model: the robot
-/// in space (no terrain, joint stops out of reach) driven by a stiff PD
-/// controller. Newton's method fails, deterministically at step
-/// [`FAIL_STEP`] (t = 0.26 s). A run that succeeds here is a regression of
-/// the tests that use it: pick another failing experiment.
-pub const FAILS: &str = "[time]\nduration = 1.0\n[leg]\ntheta2_deg = [-1e6, 1e6]\ntheta3_deg = [-1e6, 1e6]\n[terrain]\nkind = \"none\"\n[control]\nkind = \"pd\"\nkp = 300.0\n[control.leg3]\ntarget_deg = [30.0, 200.0]\n[control.leg4]\ntarget_deg = [30.0, 200.0]\n";
+/// in space (no terrain, joint stops out of reach) whose trajectory
+/// controller (kp = 10 N·m/rad, stable) is told to turn both hips by 10⁶°
+/// between t = 0.25 s and 0.26 s: a torque of 1.7e5 N·m in one step, which
+/// Newton's method cannot solve, deterministically at step [`FAIL_STEP`]
+/// (t = 0.26 s). (It was a stiff PD controller in space, which is now
+/// refused before the run: its explicit torques were unstable.) A run that
+/// succeeds here is a regression of the tests that use it: pick another
+/// failing experiment.
+pub const FAILS: &str = "[time]\nduration = 1.0\n[leg]\ntheta2_deg = [-1e6, 1e6]\ntheta3_deg = [-1e6, 1e6]\n[terrain]\nkind = \"none\"\n[control]\nkind = \"trajectory\"\nkp = 10.0\n[control.leg3]\ntimes = [0.0, 0.25, 0.26]\ntarget_deg = [[0.0, 245.0], [0.0, 245.0], [1e6, 245.0]]\n[control.leg4]\ntimes = [0.0, 0.25, 0.26]\ntarget_deg = [[0.0, 255.0], [0.0, 255.0], [1e6, 255.0]]\n";
 
 /// The step at which [`FAILS`] stops.
 pub const FAIL_STEP: usize = 26;

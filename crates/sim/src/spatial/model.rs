@@ -2,10 +2,11 @@
 
 use super::params::{SpatialControl, SpatialParams};
 use crate::SimError;
+use crate::joint_inertia::{fastest_mode, spatial_feet_jacobian, spatial_mass_matrix};
 use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
 use fbd_dynamics::PointKind;
-use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism};
+use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism, q_joint};
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::leg::LegGeometry;
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
@@ -224,6 +225,7 @@ impl SpatialModel {
             p.contact_points,
             &p.joint_limits,
         );
+        pd_stability(p, &mech)?;
         for lim in &mech.limits {
             if let Err(e) = p.joint_limits.check(lim.joint, p.q0[lim.q_index]) {
                 check(
@@ -293,4 +295,97 @@ impl SpatialModel {
     pub fn gravity(&self) -> Vector3<f64> {
         Vector3::new(0.0, -self.params.gravity, 0.0)
     }
+}
+
+/// Most gait steps at which [`pd_stability`] evaluates the effective
+/// inertia (evenly spread over the run).
+const GAIT_POSES: usize = 200;
+
+/// The stability rule of the explicit joint controller
+/// ([`crate::rules::pd_stability`]) on the smallest effective joint
+/// inertia ([`crate::joint_inertia`]) at the commanded poses: the initial
+/// one and every target (each knot of a trajectory) with every foot on
+/// the ground; for the gait, its joint angles along the run (at most
+/// [`GAIT_POSES`] steps) with its stance feet on the ground. Without
+/// ground, the free robot's.
+fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimError> {
+    let (kp, kd) = match &p.control {
+        SpatialControl::None => return Ok(()),
+        SpatialControl::Pd { kp, kd, .. }
+        | SpatialControl::Trajectory { kp, kd, .. }
+        | SpatialControl::Gait { kp, kd, .. } => (*kp, *kd),
+    };
+    if kp == 0.0 && kd == 0.0 {
+        return Ok(());
+    }
+    let nlegs = mech.legs.len();
+    // Without ground no foot ever stands: the free robot's modes.
+    let ground = p.terrain.exists();
+    let all: Vec<usize> = if ground {
+        (0..nlegs).collect()
+    } else {
+        Vec::new()
+    };
+    // (joint angles of every slot, the slots standing).
+    let mut poses: Vec<(Vec<[f64; 3]>, Vec<usize>)> = Vec::new();
+    let initial: Vec<[f64; 3]> = (0..nlegs)
+        .map(|s| std::array::from_fn(|j| p.q0[q_joint(s, j)]))
+        .collect();
+    poses.push((initial, all.clone()));
+    match &p.control {
+        SpatialControl::Pd { target, .. } => poses.push((target.clone(), all)),
+        SpatialControl::Trajectory { legs, .. } => {
+            for t in legs.iter().flat_map(|l| l.times.iter()) {
+                poses.push((legs.iter().map(|l| l.at(*t)).collect(), all.clone()));
+            }
+        }
+        SpatialControl::Gait { gait, .. } => {
+            let mut g = crate::gait::GaitData::new(gait);
+            let stride = gait.steps / GAIT_POSES + 1;
+            for k in 0..=gait.steps {
+                // A gait that cannot place a foot fails at that step of
+                // the run, with its own error.
+                if crate::gait::step(gait, &mut g, k).is_err() {
+                    break;
+                }
+                if k % stride == 0 {
+                    let stance = g.stance();
+                    poses.push((
+                        mech.legs.iter().map(|&n| g.legs[n - 1].theta).collect(),
+                        (0..nlegs)
+                            .filter(|&s| ground && stance[mech.legs[s] - 1])
+                            .collect(),
+                    ));
+                }
+            }
+        }
+        SpatialControl::None => {}
+    }
+    let joints: Vec<usize> = (0..nlegs)
+        .flat_map(|s| (0..3).map(move |j| q_joint(s, j)))
+        .collect();
+    let mut q = p.q0.clone();
+    let (mut inertia, mut joint) = (f64::INFINITY, 0);
+    for (angles, standing) in &poses {
+        for (s, a) in angles.iter().enumerate() {
+            for (j, v) in a.iter().enumerate() {
+                q[q_joint(s, j)] = *v;
+            }
+        }
+        let mode = fastest_mode(
+            &spatial_mass_matrix(mech, &q),
+            &spatial_feet_jacobian(mech, standing, &q),
+            &joints,
+        );
+        if mode.inertia < inertia {
+            (inertia, joint) = (mode.inertia, mode.joint);
+        }
+    }
+    crate::rules::pd_stability(
+        kp,
+        kd,
+        inertia,
+        p.dt,
+        &format!("leg {} theta{}", mech.legs[joint / 3], joint % 3 + 1),
+    )
 }

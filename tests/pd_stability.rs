@@ -1,0 +1,122 @@
+//! The stability rule of the explicit joint controller: the damping and
+//! stiffness that make the explicit PD torques unstable are refused before
+//! the run, with the key named; the rule's effective inertia and limit
+//! predict the engine's own stability boundary.
+
+use fbd_kinematics::nalgebra::DMatrix;
+use fbd_scenario::{Config, Override, load_with_overrides};
+use fbd_sim::joint_inertia::{fastest_mode, planar_mass_matrix};
+use fbd_sim::{Control, Data, Model, PlanarParams, step};
+use std::path::Path;
+
+fn example(name: &str, overrides: &[Override]) -> Result<(), String> {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name);
+    let file_s = file.display().to_string();
+    match load_with_overrides(&file, overrides).map_err(|e| e.to_string())? {
+        Config::Planar(p) => p.model(&file_s).map(|_| ()),
+        Config::Hexapod(h) => h.spatial_model(&file_s).map(|_| ()),
+    }
+    .map_err(|e| e.to_string())
+}
+
+#[test]
+fn the_walk_refuses_kd_30_and_22_and_keeps_15() {
+    example("hexapod_walk.toml", &[]).unwrap();
+    example("hexapod_walk.toml", &[Override::new("control.kd", 19.5)]).unwrap();
+    for kd in [22.0, 30.0] {
+        let e = example("hexapod_walk.toml", &[Override::new("control.kd", kd)]).unwrap_err();
+        assert!(e.contains("hexapod_walk.toml: control.kd: "), "{e}");
+        assert!(e.contains("lower control.kd below 19.7"), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+    }
+}
+
+#[test]
+fn every_shipped_controller_passes() {
+    for f in [
+        "hexapod_walk.toml",
+        "hexapod_walk_ice.toml",
+        "hexapod_stand.toml",
+        "hexapod_slope.toml",
+        "pd_stand.toml",
+        "squat.toml",
+        "slope_slide.toml",
+        "slope_stick.toml",
+    ] {
+        example(f, &[]).unwrap_or_else(|e| panic!("{f}: {e}"));
+    }
+}
+
+#[test]
+fn a_planar_pd_with_an_unstable_kd_is_refused() {
+    let e = example("pd_stand.toml", &[Override::new("control.kd", 30.0)]).unwrap_err();
+    assert!(e.contains("pd_stand.toml: control.kd: "), "{e}");
+    assert!(e.contains("lower control.kd below 23.18"), "{e}");
+    let e = example("pd_stand.toml", &[Override::new("time.dt", 0.01)]).unwrap_err();
+    // At Δt = 10 ms the stiffness alone is unstable.
+    assert!(
+        e.contains("control.kp: ") && e.contains("time.dt below 3.451e-3 s"),
+        "{e}"
+    );
+}
+
+/// The planar robot floating in space (no gravity), its joints kicked:
+/// the free robot's effective inertia (no foot on the ground) and the
+/// closed-form limit give the engine's stability boundary. 10 % below
+/// it the joints settle, 10 % above the kick grows tenfold and more.
+#[test]
+fn the_limit_is_the_engine_s_boundary_in_flight() {
+    let (kp, dt) = (1000.0, 0.002);
+    let mut p = PlanarParams {
+        dt,
+        duration: 1.0,
+        gravity: 0.0,
+        ..PlanarParams::default()
+    };
+    p.q0[1] = 100.0;
+    let target = [[p.q0[3], p.q0[4]], [p.q0[5], p.q0[6]]];
+    p.qdot0[4] = 1.0;
+    p.qdot0[5] = -1.0;
+    let probe = Model::planar(&p).unwrap();
+    let joints: Vec<usize> = probe.mech.joints.iter().map(|j| j.q_index).collect();
+    let free = fastest_mode(
+        &planar_mass_matrix(&probe.mech, &p.q0),
+        &DMatrix::zeros(0, 7),
+        &joints,
+    );
+    let kd_max = 2.0 * free.inertia / dt - 0.5 * kp * dt;
+    assert!(kd_max > 5.0, "{kd_max}");
+    let mut excursion = |kd: f64| {
+        p.control = Control::Pd {
+            kp,
+            kd,
+            torque_limit: None,
+            target,
+        };
+        let model = Model::planar(&p).expect("the standing robot's limit is higher");
+        let mut data = Data::new(&model);
+        let mut worst: f64 = 0.0;
+        for k in 0..model.steps {
+            match step(&model, &mut data) {
+                Ok(_) => {}
+                Err(_) => return f64::INFINITY,
+            }
+            if k > model.steps / 2 {
+                for &i in &joints {
+                    worst = worst.max((data.q[i] - p.q0[i]).abs());
+                }
+            }
+        }
+        worst
+    };
+    let below = excursion(0.9 * kd_max);
+    let above = excursion(1.1 * kd_max);
+    assert!(below < 1e-3, "kd = 0.9 × {kd_max}: {below} rad");
+    // The kick alone moves the joints by about 0.01 rad.
+    assert!(
+        above > 0.1 && above > 100.0 * below,
+        "kd = 1.1 × {kd_max}: {above} rad"
+    );
+}

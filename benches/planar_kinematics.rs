@@ -1,6 +1,10 @@
 //! Stage "kinematics": positions and analytic point Jacobians of the planar
-//! two-leg model (7 angles' `sin_cos`, 11 points), as evaluated at every
-//! Newton iterate.
+//! two-leg model (7 angles, 6 distinct, 11 points), as evaluated at every
+//! Newton iterate: `planar_eval_positions` at an iterate next to the last
+//! evaluation (the sines and cosines from their series, as at a step's
+//! later iterates), `planar_eval_positions_new_step` alternating two
+//! configurations 0.01 rad apart (every `sin_cos` evaluated, as at a
+//! step's first iterate).
 //!
 //! `cargo bench -p fbd-suite --bench planar_kinematics`
 
@@ -25,6 +29,15 @@ fn bench(c: &mut Criterion) {
 
     c.bench_function("planar_eval_positions", |b| {
         b.iter(|| chains.eval_positions(black_box(&q), &mut data))
+    });
+    let far = q.map(|v| v + 0.01);
+    let mut flip = false;
+    c.bench_function("planar_eval_positions_new_step", |b| {
+        b.iter(|| {
+            flip = !flip;
+            let x = if flip { &far } else { &q };
+            chains.eval_positions(black_box(x), &mut data)
+        })
     });
     chains.eval_positions(&q, &mut data);
     c.bench_function("planar_eval_jacobians", |b| {

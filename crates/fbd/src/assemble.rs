@@ -323,7 +323,7 @@ pub fn eval<S: JacobianSink>(
     if S::ACTIVE {
         mech.chains.eval_jacobians(&mut data.kin_next);
     }
-    let dt = data.dt;
+    let inv_dt2 = 1.0 / (data.dt * data.dt);
     // Sum of applied forces and moments per body, at configuration k.
     for (b, acc) in data.acc.iter_mut().enumerate() {
         *acc = [0.0, -mech.bodies[b].mass * mech.gravity, 0.0];
@@ -365,9 +365,9 @@ pub fn eval<S: JacobianSink>(
         let bs = &data.body[b];
         let row = lay.body_row(b);
         let a = data.acc[b];
-        r[row] = spec.mass * bs.acceleration(0, x[0], dt) - a[0];
-        r[row + 1] = spec.mass * bs.acceleration(1, x[1], dt) - a[1];
-        r[row + 2] = spec.versor_z * (spec.inertia * bs.acceleration(2, x[2], dt) - a[2]);
+        r[row] = spec.mass * bs.acceleration(0, x[0], inv_dt2) - a[0];
+        r[row + 1] = spec.mass * bs.acceleration(1, x[1], inv_dt2) - a[1];
+        r[row + 2] = spec.versor_z * (spec.inertia * bs.acceleration(2, x[2], inv_dt2) - a[2]);
     }
     let k = data.position_gain;
     for (ci, spec) in mech.contacts.iter().enumerate() {

@@ -90,7 +90,8 @@ pub struct PointDef {
     pub segments: Vec<(usize, f64)>,
 }
 
-/// Generic planar floating-base tree: the angles and points, immutable.
+/// Generic planar floating-base tree: the angles and points, immutable
+/// (built by [`PlanarChains::new`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct PlanarChains {
     /// Number of generalised coordinates; `q[0], q[1]` are the base position.
@@ -99,7 +100,99 @@ pub struct PlanarChains {
     pub angles: Vec<LinearAngle>,
     /// Every auxiliary point.
     pub points: Vec<PointDef>,
+    /// The flat evaluation order of [`Self::eval_positions`].
+    plan: Plan,
 }
+
+/// How [`PlanarChains::eval_positions`] evaluates the angles and points:
+/// flat lists, each distinct angle's sine and cosine once, and every point
+/// from the point whose segments begin its own (the same sums in the same
+/// order, so the same values to the bit as summing every point's segments
+/// from the base).
+#[derive(Clone, Debug, PartialEq)]
+struct Plan {
+    /// Per angle: its offset, its terms `terms[start..end]`, and the
+    /// earlier angle it equals (offset and terms alike), if one does.
+    angles: Vec<PlanAngle>,
+    /// `(index into q, coefficient)` of every angle, angle after angle.
+    terms: Vec<(usize, f64)>,
+    /// Per point: the earlier point its segments extend (itself when none
+    /// does: the base position) and its own segments
+    /// `segments[start..end]`.
+    points: Vec<PlanPoint>,
+    /// `(angle, length)` of every point's own segments, point after point.
+    segments: Vec<(usize, f64)>,
+    /// `(angle, earlier angle it equals)`: the values copied.
+    copies: Vec<(usize, usize)>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PlanAngle {
+    offset: f64,
+    start: usize,
+    end: usize,
+    same_as: Option<usize>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct PlanPoint {
+    /// The earlier point its segments extend; itself when none does (the
+    /// base position).
+    parent: usize,
+    start: usize,
+    end: usize,
+}
+
+impl Plan {
+    fn new(angles: &[LinearAngle], points: &[PointDef]) -> Self {
+        let mut plan = Plan {
+            angles: Vec::with_capacity(angles.len()),
+            terms: Vec::new(),
+            points: Vec::with_capacity(points.len()),
+            segments: Vec::new(),
+            copies: Vec::new(),
+        };
+        for (k, a) in angles.iter().enumerate() {
+            let start = plan.terms.len();
+            plan.terms.extend_from_slice(&a.terms);
+            let same_as = angles[..k].iter().position(|b| b == a);
+            if let Some(e) = same_as {
+                plan.copies.push((k, e));
+            }
+            plan.angles.push(PlanAngle {
+                offset: a.offset,
+                start,
+                end: plan.terms.len(),
+                same_as,
+            });
+        }
+        for (p, def) in points.iter().enumerate() {
+            // The earlier point with the longest segment list that begins
+            // this one's.
+            let parent = (0..p)
+                .filter(|&e| def.segments.starts_with(&points[e].segments))
+                .max_by_key(|&e| points[e].segments.len())
+                .filter(|&e| !points[e].segments.is_empty());
+            let skip = parent.map_or(0, |e| points[e].segments.len());
+            let start = plan.segments.len();
+            plan.segments.extend_from_slice(&def.segments[skip..]);
+            plan.points.push(PlanPoint {
+                parent: parent.unwrap_or(p),
+                start,
+                end: plan.segments.len(),
+            });
+        }
+        plan
+    }
+}
+
+/// Largest change of an angle (rad) from the last angle whose sine and
+/// cosine were evaluated in a [`PlanarData`] for which they follow from
+/// that one by the series `sin(b + δ) = sin b·(1 − δ²/2) + cos b·(δ − δ³/6)`
+/// (and the cosine's): the first term left out, `δ⁴/24`, is below 5e-18,
+/// under the rounding of the values themselves. Newton's iterates of one
+/// step differ by far less; every step's first evaluation is exact.
+const SERIES_MAX: f64 = 1e-4;
 
 /// Geometry of the two-leg planar model (both legs alike, as in the paper).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -216,46 +309,101 @@ impl PlanarChains {
             idx.upper_angle[leg] = up;
             idx.lower_angle[leg] = low;
         }
-        (
-            Self {
-                nq: NQ,
-                angles,
-                points,
-            },
-            idx,
-        )
+        (Self::new(NQ, angles, points), idx)
+    }
+
+    /// A tree of `nq` coordinates with these angles and points.
+    ///
+    /// # Panics
+    /// If a term or a segment refers to a coordinate or angle that does
+    /// not exist.
+    pub fn new(nq: usize, angles: Vec<LinearAngle>, points: Vec<PointDef>) -> Self {
+        for a in &angles {
+            assert!(a.terms.iter().all(|&(i, _)| i < nq), "angle term beyond q");
+        }
+        for p in &points {
+            assert!(
+                p.segments.iter().all(|&(a, _)| a < angles.len()),
+                "segment of point {} on no angle",
+                p.name
+            );
+        }
+        let plan = Plan::new(&angles, &points);
+        Self {
+            nq,
+            angles,
+            points,
+            plan,
+        }
     }
 
     /// A fresh workspace sized for this model.
     pub fn new_data(&self) -> PlanarData {
+        let na = self.angles.len();
         PlanarData {
-            angle: vec![0.0; self.angles.len()],
-            cos: vec![0.0; self.angles.len()],
-            sin: vec![0.0; self.angles.len()],
+            angle: vec![0.0; na],
+            cos: vec![0.0; na],
+            sin: vec![0.0; na],
             pos: vec![[0.0; 2]; self.points.len()],
             jac: vec![0.0; self.points.len() * 2 * self.nq],
             nq: self.nq,
+            base: vec![[f64::NAN; 3]; na],
         }
     }
 
     /// Evaluates every angle, its sine and cosine, and every point at `q`.
+    ///
+    /// An angle within [`SERIES_MAX`] of the last one whose sine and
+    /// cosine were evaluated in `data` takes them from that one by their
+    /// Taylor series, exact to rounding (the iterates of a Newton solve);
+    /// any other is evaluated (and kept as the next reference).
     pub fn eval_positions(&self, q: &[f64], data: &mut PlanarData) {
         assert_eq!(q.len(), self.nq, "q has the wrong length");
-        for (k, a) in self.angles.iter().enumerate() {
-            let v = a.value(q);
-            let (s, c) = v.sin_cos();
-            data.angle[k] = v;
-            data.sin[k] = s;
-            data.cos[k] = c;
-        }
-        for (p, def) in self.points.iter().enumerate() {
-            let mut x = q[RX];
-            let mut y = q[RY];
-            for &(a, l) in &def.segments {
-                x += l * data.cos[a];
-                y += l * data.sin[a];
+        let plan = &self.plan;
+        let n = plan.angles.len();
+        let values = data.angle[..n]
+            .iter_mut()
+            .zip(&mut data.sin[..n])
+            .zip(&mut data.cos[..n])
+            .zip(&mut data.base[..n]);
+        for (a, (((angle, sin), cos), base)) in plan.angles.iter().zip(values) {
+            if a.same_as.is_some() {
+                continue;
             }
-            data.pos[p] = [x, y];
+            let terms = &plan.terms[a.start..a.end];
+            let v = a.offset + terms.iter().map(|&(i, c)| c * q[i]).sum::<f64>();
+            let [b, bs, bc] = *base;
+            let d = v - b;
+            if d.abs() <= SERIES_MAX {
+                *sin = bs + d * (bc - d * (0.5 * bs + d * (bc * (1.0 / 6.0))));
+                *cos = bc - d * (bs + d * (0.5 * bc - d * (bs * (1.0 / 6.0))));
+            } else {
+                let (s, c) = v.sin_cos();
+                *base = [v, s, c];
+                *sin = s;
+                *cos = c;
+            }
+            *angle = v;
+        }
+        for &(k, e) in &plan.copies {
+            data.angle[k] = data.angle[e];
+            data.sin[k] = data.sin[e];
+            data.cos[k] = data.cos[e];
+        }
+        let (sin, cos) = (&data.sin[..n], &data.cos[..n]);
+        let np = plan.points.len();
+        let pos = &mut data.pos[..np];
+        for (p, pt) in plan.points.iter().enumerate() {
+            let [mut x, mut y] = if pt.parent < p {
+                pos[pt.parent]
+            } else {
+                [q[RX], q[RY]]
+            };
+            for &(a, l) in &plan.segments[pt.start..pt.end] {
+                x += l * cos[a];
+                y += l * sin[a];
+            }
+            pos[p] = [x, y];
         }
     }
 
@@ -316,6 +464,10 @@ pub struct PlanarData {
     /// Point Jacobians, `[point][axis][q index]` flattened.
     pub jac: Vec<f64>,
     nq: usize,
+    /// Per angle, the last angle whose sine and cosine were evaluated, and
+    /// those (the reference of the series in
+    /// [`PlanarChains::eval_positions`]).
+    base: Vec<[f64; 3]>,
 }
 
 impl PlanarData {
@@ -418,6 +570,63 @@ mod tests {
             FdTolerance::default(),
         )
         .unwrap_or_else(|e| panic!("{e}"));
+    }
+
+    #[test]
+    fn iterates_near_the_last_evaluation_match_fresh_evaluations() {
+        // A workspace that evaluated q takes the sines and cosines of the
+        // angles within SERIES_MAX of it from their series: the points
+        // agree with a fresh workspace's (every sine and cosine evaluated)
+        // to rounding, at changes from 1e-12 to just inside the limit,
+        // and every sine and cosine is a unit pair.
+        let (ch, _) = PlanarChains::two_leg(&PlanarGeometry::default());
+        let q = [0.1, 0.5, 0.3, 0.2, 4.0, -0.3, 4.3];
+        let dir = [0.3, -0.7, 1.0, -0.4, 0.9, 0.5, -1.0];
+        for &h in &[1e-12, 1e-9, 1e-6, 0.9 * SERIES_MAX / 3.0] {
+            let mut kept = ch.new_data();
+            ch.eval_positions(&q, &mut kept);
+            let x: Vec<f64> = q.iter().zip(dir).map(|(a, d)| a + h * d).collect();
+            ch.eval_positions(&x, &mut kept);
+            let mut fresh = ch.new_data();
+            ch.eval_positions(&x, &mut fresh);
+            for (k, (a, b)) in kept.pos.iter().zip(&fresh.pos).enumerate() {
+                for axis in 0..2 {
+                    assert!(
+                        (a[axis] - b[axis]).abs() <= 4e-16,
+                        "h = {h:e}, point {k} axis {axis}: {} vs {}",
+                        a[axis],
+                        b[axis]
+                    );
+                }
+            }
+            for (a, (s, c)) in kept.sin.iter().zip(&kept.cos).enumerate() {
+                assert!(
+                    (s * s + c * c - 1.0).abs() <= 4e-16,
+                    "h = {h:e}, angle {a}: sin² + cos² − 1 = {:e}",
+                    s * s + c * c - 1.0
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn points_follow_from_their_parents_bit_for_bit() {
+        // The plan evaluates each point from the point its segments extend;
+        // the sums are the same, in the same order, as from the base.
+        let (ch, _) = PlanarChains::two_leg(&PlanarGeometry::default());
+        let q = [0.1, 0.5, 0.3, 0.2, 4.0, -0.3, 4.3];
+        let mut d = ch.new_data();
+        ch.eval_positions(&q, &mut d);
+        for (p, def) in ch.points.iter().enumerate() {
+            let mut x = q[RX];
+            let mut y = q[RY];
+            for &(a, l) in &def.segments {
+                let (s, c) = ch.angles[a].value(&q).sin_cos();
+                x += l * c;
+                y += l * s;
+            }
+            assert_eq!(d.pos[p], [x, y], "point {}", def.name);
+        }
     }
 
     #[test]

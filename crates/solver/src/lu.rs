@@ -14,16 +14,19 @@
 //! * The numeric LU is faer's
 //!   [`simplicial::factorize_simplicial_numeric_lu`], called on a
 //!   [`SimplicialLu`] owned here, so that its `L` and `U` factors are at
-//!   hand. After each factorisation they are copied into two flat lists of
-//!   updates `w[i] −= v·w[j]` in elimination order ([`Factors::factor`]):
-//!   `L`'s, and `U`'s with each column divided by its pivot, so that the
-//!   Newton step `J Δx = −r` is the row permutation, one pass over each
-//!   list, and the column permutation with the reciprocal pivots
-//!   ([`Factors::solve`]) — the arithmetic of faer's
+//!   hand. The Newton step `J Δx = −r` is the row permutation, one sweep
+//!   `w[i] −= v·w[j]` over `L`'s columns in faer's own storage, one over
+//!   `U`'s, last column first, with each column's entries divided by its
+//!   pivot (the only copy made after a factorisation: `U`'s values,
+//!   scaled, [`Factors::factor`]), and the column permutation with the
+//!   reciprocal pivots ([`Factors::solve`]) — the arithmetic of faer's
 //!   `solve_in_place_with_conj`, without its per-column and generic
 //!   multi-column machinery, which cost about twice as much on these sizes.
 //!   It matters because a chord step (a step with a kept factorisation) is
 //!   one residual and one solve, and most steps are chord steps.
+//! * The pattern's structure is kept as faer's checked
+//!   [`SymbolicSparseColMat`], so that a factorisation does not check it
+//!   again.
 //! * faer's simplicial numeric LU stores `L`/`U` in `Vec`s that it grows on
 //!   demand (never shrinking). Their fill depends on the numerical row
 //!   pivoting, so a later refactorisation of the same pattern could need
@@ -47,7 +50,7 @@ use faer::sparse::linalg::lu::simplicial::{
     SimplicialLu, factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
 };
 use faer::sparse::linalg::lu::{LuSymbolicParams, SymbolicLu, factorize_symbolic_lu};
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 use crate::SolverError;
 
@@ -58,11 +61,12 @@ pub(crate) struct Pattern {
     /// [`Factors`]).
     id: usize,
     pub(crate) n: usize,
-    pub(crate) col_ptr: Vec<usize>,
-    pub(crate) row_idx: Vec<usize>,
     /// Dense `n × n` row-major map `(row, col) → index into the CSC values`,
     /// `u32::MAX` where the entry is not in the pattern.
     pub(crate) slot: Vec<u32>,
+    /// The CSC structure as faer's checked matrix structure, so that a
+    /// factorisation does not check it again.
+    structure: SymbolicSparseColMat<usize>,
     /// faer's symbolic LU: the fill-reducing column permutation.
     symbolic: SymbolicLu<usize>,
     /// Index of the numeric storage of this pattern's dimension.
@@ -112,7 +116,8 @@ impl Pattern {
             col_ptr[j + 1] += col_ptr[j];
         }
 
-        let a = SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx);
+        let structure = SymbolicSparseColMat::new_checked(n, n, col_ptr, None, row_idx);
+        let a = structure.as_ref();
         let params = LuSymbolicParams {
             supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
             ..Default::default()
@@ -122,15 +127,19 @@ impl Pattern {
         Self {
             id,
             n,
-            col_ptr,
-            row_idx,
             slot,
+            structure,
             symbolic,
             factors,
             solves_since: 0,
             chords_since: 0,
             last_chords: 0,
         }
+    }
+
+    /// Number of structural entries.
+    pub(crate) fn nnz(&self) -> usize {
+        self.structure.row_idx().len()
     }
 
     fn col_perm(&self) -> PermRef<'_, usize> {
@@ -154,17 +163,9 @@ impl Pattern {
     }
 }
 
-/// One update `w[i] −= v·w[j]` of a triangular sweep.
-#[derive(Clone, Copy, Debug)]
-struct Update {
-    i: u32,
-    j: u32,
-    v: f64,
-}
-
 /// Numeric LU storage for the patterns of one dimension: faer's simplicial
-/// `L`, `U` and row pivoting of the last factorisation, its sweeps, and the
-/// scratch of the solves.
+/// `L`, `U` and row pivoting of the last factorisation, `U` scaled for the
+/// solves, and the scratch of the solves.
 pub(crate) struct Factors {
     n: usize,
     lu: SimplicialLu<usize, f64>,
@@ -172,11 +173,9 @@ pub(crate) struct Factors {
     row_perm_inv: Vec<usize>,
     /// `1 / U[j, j]` of the last factorisation.
     pivot_inv: Vec<f64>,
-    /// The forward sweep: `L`'s strictly lower entries, column by column.
-    lower: Vec<Update>,
-    /// The backward sweep: `U`'s strictly upper entries divided by their
-    /// column's pivot, last column first.
-    upper: Vec<Update>,
+    /// `U`'s entries divided by their column's pivot, in the order of
+    /// faer's storage of `U` (its diagonal entries unused).
+    upper: Vec<f64>,
     /// Scratch of [`Self::solve`].
     work: Vec<f64>,
     /// The pattern whose factorisation this holds (none after the dense
@@ -200,8 +199,7 @@ impl Factors {
             row_perm: vec![0; n],
             row_perm_inv: vec![0; n],
             pivot_inv: vec![0.0; n],
-            lower: Vec::with_capacity(n * n.saturating_sub(1) / 2),
-            upper: Vec::with_capacity(n * n.saturating_sub(1) / 2),
+            upper: Vec::with_capacity(n * (n + 1) / 2),
             work: vec![0.0; n],
             owner: None,
         };
@@ -255,10 +253,7 @@ impl Factors {
         let n = self.n;
         assert_eq!(pattern.n, n, "pattern and storage dimensions differ");
         self.owner = None;
-        let matrix = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx),
-            values,
-        );
+        let matrix = SparseColMatRef::new(pattern.structure.as_ref(), values);
         match factorize_simplicial_numeric_lu(
             &mut self.row_perm,
             &mut self.row_perm_inv,
@@ -274,33 +269,18 @@ impl Factors {
             }
             Err(LuError::Generic(e)) => panic!("faer numeric LU failed: {e:?}"),
         }
-        // faer stores each column's unit diagonal of L first and its
-        // diagonal of U last (the contracts of its own triangular solves).
-        let index = |i: usize| u32::try_from(i).expect("dimension fits in u32");
-        let l = self.lu.l_factor_unsorted();
-        let (l_ptr, l_row, l_val) = (l.symbolic().col_ptr(), l.symbolic().row_idx(), l.val());
-        self.lower.clear();
-        for j in 0..n {
-            for p in l_ptr[j] + 1..l_ptr[j + 1] {
-                self.lower.push(Update {
-                    i: index(l_row[p]),
-                    j: index(j),
-                    v: l_val[p],
-                });
-            }
-        }
+        // faer stores each column's diagonal of U last (the contract of its
+        // own triangular solves).
         let u = self.lu.u_factor_unsorted();
-        let (u_ptr, u_row, u_val) = (u.symbolic().col_ptr(), u.symbolic().row_idx(), u.val());
-        self.upper.clear();
-        for j in (0..n).rev() {
-            let pivot_inv = u_val[u_ptr[j + 1] - 1].recip();
+        let (u_ptr, u_val) = (u.symbolic().col_ptr(), u.val());
+        // At most the dense U's entries (see the module docs): no growth.
+        self.upper.resize(u_val.len(), 0.0);
+        for j in 0..n {
+            let (start, diag) = (u_ptr[j], u_ptr[j + 1] - 1);
+            let pivot_inv = u_val[diag].recip();
             self.pivot_inv[j] = pivot_inv;
-            for p in u_ptr[j]..u_ptr[j + 1] - 1 {
-                self.upper.push(Update {
-                    i: index(u_row[p]),
-                    j: index(j),
-                    v: u_val[p] * pivot_inv,
-                });
+            for (s, &v) in self.upper[start..diag].iter_mut().zip(&u_val[start..diag]) {
+                *s = v * pivot_inv;
             }
         }
         self.owner = Some(pattern.id);
@@ -324,15 +304,28 @@ impl Factors {
         for (wi, &p) in w.iter_mut().zip(&self.row_perm) {
             *wi = rhs[p];
         }
-        // L: w[j] is final when column j's updates start (they come from
-        // the columns before it).
-        for u in &self.lower {
-            w[u.i as usize] -= u.v * w[u.j as usize];
+        // L, column by column: w[j] is final when column j's updates start
+        // (they come from the columns before it); faer stores each column's
+        // unit diagonal first.
+        let l = self.lu.l_factor_unsorted();
+        let (l_ptr, l_row, l_val) = (l.symbolic().col_ptr(), l.symbolic().row_idx(), l.val());
+        for j in 0..n {
+            let wj = w[j];
+            let (start, end) = (l_ptr[j] + 1, l_ptr[j + 1]);
+            for (&i, &v) in l_row[start..end].iter().zip(&l_val[start..end]) {
+                w[i] -= v * wj;
+            }
         }
         // U D⁻¹, last column first: w[j] is final (unscaled) when column
-        // j's updates start.
-        for u in &self.upper {
-            w[u.i as usize] -= u.v * w[u.j as usize];
+        // j's updates start; faer stores each column's diagonal last.
+        let u = self.lu.u_factor_unsorted();
+        let (u_ptr, u_row) = (u.symbolic().col_ptr(), u.symbolic().row_idx());
+        for j in (0..n).rev() {
+            let wj = w[j];
+            let (start, end) = (u_ptr[j], u_ptr[j + 1] - 1);
+            for (&i, &v) in u_row[start..end].iter().zip(&self.upper[start..end]) {
+                w[i] -= v * wj;
+            }
         }
         let (col_fwd, _) = pattern.col_perm().arrays();
         for ((&c, &wj), &p) in col_fwd.iter().zip(w.iter()).zip(&self.pivot_inv) {
@@ -375,7 +368,7 @@ mod tests {
             let triplets = matrix(n, seed);
             let mut entries: Vec<(usize, usize)> = triplets.iter().map(|t| (t.0, t.1)).collect();
             let mut pattern = Pattern::build(0, n, &mut entries, 0);
-            let mut values = vec![0.0; pattern.row_idx.len()];
+            let mut values = vec![0.0; pattern.nnz()];
             for &(i, j, v) in &triplets {
                 values[pattern.slot[i * n + j] as usize] += v;
             }
@@ -396,16 +389,7 @@ mod tests {
             factors.solve(&pattern, &mut ours);
 
             let mut numeric = NumericLu::new();
-            let a = SparseColMatRef::new(
-                SymbolicSparseColMatRef::new_checked(
-                    n,
-                    n,
-                    &pattern.col_ptr,
-                    None,
-                    &pattern.row_idx,
-                ),
-                &values[..],
-            );
+            let a = SparseColMatRef::new(pattern.structure.as_ref(), &values[..]);
             let lu = pattern
                 .symbolic
                 .factorize_numeric_lu(

@@ -358,7 +358,7 @@ impl NewtonSolver {
         );
         let index = self.register(sys);
         let pattern = &self.patterns[index].1;
-        set_len(&mut self.ws.values, pattern.row_idx.len());
+        set_len(&mut self.ws.values, pattern.nnz());
         set_len(&mut self.ws.r, n);
         Workspace::eval_with_jacobian(&mut self.ws.values, pattern, sys, x, &mut self.ws.r);
         self.loaded = Some(index);
@@ -420,7 +420,11 @@ fn scaled_norm<S: NewtonSystem>(sys: &S, r: &[f64]) -> Option<f64> {
         if !ri.is_finite() {
             return None;
         }
-        norm = norm.max(ri.abs() * sys.residual_weight(i));
+        // `norm.max(v)` without its NaN handling: `ri` is finite here.
+        let v = ri.abs() * sys.residual_weight(i);
+        if v > norm {
+            norm = v;
+        }
     }
     Some(norm)
 }
@@ -514,7 +518,7 @@ impl Workspace {
         run: &mut usize,
     ) -> Result<NewtonReport, SolverError> {
         let n = pattern.n;
-        let nnz = pattern.row_idx.len();
+        let nnz = pattern.nnz();
         set_len(&mut self.values, nnz);
         set_len(&mut self.r, n);
         set_len(&mut self.dx, n);

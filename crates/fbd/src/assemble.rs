@@ -29,6 +29,7 @@
 
 use crate::body::{BodyStep, cross};
 use crate::mechanism::Mechanism;
+use crate::rows;
 use fbd_contact::{ContactState, Terrain};
 use fbd_kinematics::LimitSide;
 use fbd_kinematics::planar::PlanarData;
@@ -287,13 +288,10 @@ pub fn advance(_mech: &Mechanism, data: &mut FbdData) {
 /// base 3 (the slide direction changes values, not structure), then one
 /// bit per joint limit (free or at an end).
 pub fn pattern_key(data: &FbdData) -> u64 {
-    let k = data
-        .contact
-        .iter()
-        .fold(0u64, |k, c| k * 3 + c.state.code() as u64);
-    data.limit
-        .iter()
-        .fold(k, |k, l| k * 2 + u64::from(l.state.is_at()))
+    rows::pattern_key(
+        data.contact.iter().map(|c| c.state.code()),
+        data.limit.iter().map(|l| l.state.is_at()),
+    )
 }
 
 /// Pushes every structural `(row, col)` of the Jacobian for the current
@@ -375,31 +373,32 @@ pub fn eval<S: JacobianSink>(
         let row = lay.contact_row(ci);
         let (fa, n) = (z[lay.contact_fa(ci)], z[lay.contact_n(ci)]);
         let p = data.kin_next.pos[spec.point];
+        let (force, out) = ([fa, n], &mut r[row..row + 2]);
         match eq.state {
-            ContactState::Free => {
-                r[row] = fa;
-                r[row + 1] = n;
-            }
+            ContactState::Free => rows::free_rows(&force, out),
             ContactState::Stick { anchor } => {
-                let b = eq.regularization;
-                r[row] = k * (p[0] - anchor[0]) + b * (fa * eq.tangent[0] + n * eq.normal[0]);
-                r[row + 1] = k * (p[1] - anchor[1]) + b * (fa * eq.tangent[1] + n * eq.normal[1]);
+                let f = [
+                    fa * eq.tangent[0] + n * eq.normal[0],
+                    fa * eq.tangent[1] + n * eq.normal[1],
+                ];
+                rows::stick_rows(k, &p, &anchor, eq.regularization, &f, out);
             }
-            ContactState::Slide { dir } => {
-                r[row] = fa + dir * eq.mu_dynamic * n;
-                r[row + 1] = k * terrain.clearance(p) + eq.regularization * n;
-            }
+            ContactState::Slide { dir } => rows::slide_rows(
+                &force,
+                &[dir],
+                eq.mu_dynamic,
+                k,
+                terrain.clearance(p),
+                eq.regularization,
+                out,
+            ),
         }
     }
     for (l, &j) in mech.limits.iter().enumerate() {
         let eq = &data.limit[l];
         let lambda = z[lay.limit_moment(l)];
-        r[lay.limit_row(l)] = match eq.state {
-            LimitState::Free => lambda,
-            LimitState::At { angle, .. } => {
-                data.limit_gain * (z[mech.joints[j].q_index] - angle) + eq.regularization * lambda
-            }
-        };
+        r[lay.limit_row(l)] =
+            rows::limit_row(eq, lambda, z[mech.joints[j].q_index], data.limit_gain);
     }
     if S::ACTIVE {
         force_entries(mech, data, jac);
@@ -469,12 +468,11 @@ fn force_entries<S: JacobianSink>(mech: &Mechanism, data: &FbdData, jac: &mut S)
         );
         jac.add(lay.body_row(spec.child) + 2, col, -vc * spec.axis_z);
         jac.add(lay.body_row(spec.parent) + 2, col, vp * spec.axis_z);
-        let eq = &data.limit[l];
-        let d = match eq.state {
-            LimitState::Free => 1.0,
-            LimitState::At { .. } => eq.regularization,
-        };
-        jac.add(lay.limit_row(l), col, d);
+        jac.add(
+            lay.limit_row(l),
+            col,
+            rows::limit_row_diagonal(&data.limit[l]),
+        );
     }
 }
 

@@ -192,60 +192,6 @@ impl JacobianSink for Sink<'_, '_> {
     }
 }
 
-/// What [`step_loop`] ended with.
-pub(crate) struct LoopEnd {
-    /// Wall time inside `step` (s).
-    pub wall: f64,
-    /// The error that stopped the loop.
-    pub error: Option<SimError>,
-    /// `true` when `stop` ended it early.
-    pub interrupted: bool,
-}
-
-/// The stepping loop of every run: `steps` calls of `step` on `data`,
-/// `on_row` with the step's result after every `stride`-th, stopping at the
-/// first error or before the next step once `stop` is set. The wall time
-/// is the loop's minus the observer's: the clock is read around the loop
-/// and around each written row only, not around every step.
-pub(crate) fn step_loop<D, R>(
-    data: &mut D,
-    steps: usize,
-    stride: usize,
-    stop: &std::sync::atomic::AtomicBool,
-    mut step: impl FnMut(&mut D) -> Result<R, SimError>,
-    mut on_row: impl FnMut(&R, &D),
-) -> LoopEnd {
-    let stride = stride.max(1);
-    let mut end = LoopEnd {
-        wall: 0.0,
-        error: None,
-        interrupted: false,
-    };
-    let mut observer = std::time::Duration::ZERO;
-    let start = std::time::Instant::now();
-    for k in 0..steps {
-        if stop.load(std::sync::atomic::Ordering::Relaxed) {
-            end.interrupted = true;
-            break;
-        }
-        match step(data) {
-            Ok(r) => {
-                if k % stride == 0 {
-                    let t = std::time::Instant::now();
-                    on_row(&r, data);
-                    observer += t.elapsed();
-                }
-            }
-            Err(e) => {
-                end.error = Some(e);
-                break;
-            }
-        }
-    }
-    end.wall = start.elapsed().saturating_sub(observer).as_secs_f64();
-    end
-}
-
 /// Why one attempt at a step (whole or in substeps) failed; made into a
 /// [`SimError`] only when every retry has failed (no allocation before).
 #[derive(Clone, Copy, Debug)]

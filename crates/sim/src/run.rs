@@ -1,8 +1,7 @@
 //! The stepping loop of a whole run.
 
 use crate::record::{Event, LimitEvent, RetryEvent, StepRecord};
-use crate::rules::step_loop;
-use crate::{Data, Model, SimError, step};
+use crate::{Data, Model, SimError};
 use std::sync::atomic::AtomicBool;
 
 /// Outcome of [`run`].
@@ -21,7 +20,7 @@ pub struct RunSummary {
     /// Numeric LU factorisations over all steps.
     pub numeric_factorizations: u64,
     /// Wall time of the stepping loop alone (s): the loop's time without
-    /// the observer's (the time inside [`step`]).
+    /// the observer's (the time inside [`crate::step()`]).
     pub wall_seconds: f64,
     /// Symbolic factorisations (one per contact-state pattern met).
     pub symbolic_factorizations: usize,
@@ -59,37 +58,10 @@ pub fn run(model: &Model, on_row: impl FnMut(&StepRecord)) -> RunSummary {
 }
 
 /// [`run`], stopping before the next step once `stop` is set (e.g. by a
-/// signal handler); the summary then says `interrupted`.
-pub fn run_until(
-    model: &Model,
-    stop: &AtomicBool,
-    mut on_row: impl FnMut(&StepRecord),
-) -> RunSummary {
-    let mut data = Data::new(model);
-    let end = step_loop(
-        &mut data,
-        model.steps,
-        model.params.stride,
-        stop,
-        |d| step(model, d),
-        |rec, _| on_row(rec),
-    );
-    let (wall, error, interrupted) = (end.wall, end.error, end.interrupted);
-    RunSummary {
-        steps: data.k,
-        newton_iterations: data.newton_iterations,
-        max_newton_iterations: data.max_step_iterations,
-        chord_iterations: data.chord_iterations,
-        numeric_factorizations: data.solver.numeric_factorizations(),
-        wall_seconds: wall,
-        symbolic_factorizations: data.symbolic_factorizations(),
-        events: data.events,
-        error,
-        limit_events: data.limit_events,
-        retries: data.retries,
-        resolved_cycles: data.resolved_cycles,
-        interrupted,
-    }
+/// signal handler); the summary then says `interrupted`
+/// ([`crate::engine::run::run_until`]).
+pub fn run_until(model: &Model, stop: &AtomicBool, on_row: impl FnMut(&StepRecord)) -> RunSummary {
+    crate::engine::run::run_until(model, Data::new(model), stop, on_row)
 }
 
 /// Runs `model` and keeps every written record in memory (for tests and

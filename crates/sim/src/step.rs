@@ -53,6 +53,8 @@ impl Engine for Model {
             max_substeps: self.max_substeps,
             cycle_tolerance: self.cycle_tolerance,
             qdot0: &self.params.qdot0,
+            steps: self.steps,
+            stride: self.params.stride,
             bodies: self.mech.bodies.len(),
             contacts: self.mech.contacts.len(),
             limits: self.mech.limits.len(),
@@ -114,10 +116,10 @@ impl Engine for Model {
             dt: data.fbd.dt,
         }
     }
-    fn contact_violation(&self, data: &Data, c: usize, t: &Trial) -> f64 {
+    fn contact_violation(&self, data: &Data, state: &ContactState, t: &Trial) -> f64 {
         let k = data.fbd.position_gain;
         let mu = self.params.friction.mu_static;
-        match data.trial[c] {
+        match *state {
             ContactState::Free => k * (-self.params.terrain.clearance(t.p_next)).max(0.0),
             ContactState::Stick { .. } => (-t.n).max(0.0) + (t.fa.abs() - mu * t.n).max(0.0),
             ContactState::Slide { dir } => {

@@ -102,8 +102,15 @@ pub struct RunData<M: Engine> {
     pub(crate) best_z: Vec<f64>,
     pub(crate) best_trial: Vec<M::State>,
     pub(crate) best_limits: Vec<LimitState>,
+    /// The states a solution was solved in, kept while the switching rules
+    /// change the trial ones.
+    pub(crate) checked_trial: Vec<M::State>,
+    pub(crate) checked_limits: Vec<LimitState>,
     /// Set while solving the finest substeps of a retried step.
     pub(crate) last_resort: bool,
+    /// Whether the next step's record is made (`true` unless a run skips
+    /// the rows it does not hand out, [`super::run::run_until`]).
+    pub(crate) want_record: bool,
 }
 
 /// What a model gives [`RunData::build`].
@@ -179,9 +186,12 @@ impl<M: Engine> RunData<M> {
             start_z: vec![0.0; dim],
             best_violation: f64::INFINITY,
             best_z: vec![0.0; dim],
+            checked_trial: initial_states.clone(),
+            checked_limits: free.clone(),
             best_trial: initial_states,
             best_limits: free,
             last_resort: false,
+            want_record: true,
             q: q0,
         }
     }

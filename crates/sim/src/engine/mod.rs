@@ -27,6 +27,7 @@
 //! 6. **accept**: record, events, `q[k+1]` becomes the current state.
 
 pub mod data;
+pub mod run;
 pub mod search;
 pub mod step;
 
@@ -63,6 +64,10 @@ pub struct Settings<'a, G: ?Sized> {
     pub cycle_tolerance: f64,
     /// Initial generalised velocities (one per coordinate of `q`).
     pub qdot0: &'a [f64],
+    /// Steps of a run.
+    pub steps: usize,
+    /// A run hands every `stride`-th step's record to its observer.
+    pub stride: usize,
     /// Rigid bodies.
     pub bodies: usize,
     /// Contact points.
@@ -179,8 +184,14 @@ pub trait Engine: Sized {
     fn evaluate_next(&self, data: &mut RunData<Self>);
     /// Point `c`'s view of the last solution.
     fn trial(&self, data: &RunData<Self>, c: usize) -> Self::Trial;
-    /// How far point `c`'s trial is from the law of its state (N).
-    fn contact_violation(&self, data: &RunData<Self>, c: usize, trial: &Self::Trial) -> f64;
+    /// How far a point's trial is from the law of `state`, the state it
+    /// was solved in (N).
+    fn contact_violation(
+        &self,
+        data: &RunData<Self>,
+        state: &Self::State,
+        trial: &Self::Trial,
+    ) -> f64;
     /// The position gain of the stop rows over the length scale (N/rad),
     /// which turns a joint's overshoot into a force.
     fn limit_gain(&self, data: &RunData<Self>) -> f64;
@@ -209,6 +220,9 @@ pub trait Engine: Sized {
     fn reset_kinematics(&self, data: &mut RunData<Self>);
     /// Fills `data.record` for the solved (sub)step of length `h`.
     fn make_record(&self, data: &mut RunData<Self>, iterations: usize, trials: usize, h: f64);
+    /// Instead of [`Self::make_record`] for a step whose record nobody
+    /// reads: what the record's making computes that the next step needs.
+    fn skip_record(&self, _data: &mut RunData<Self>, _h: f64) {}
     /// Adds a later substep's iterations and solves to the record.
     fn add_to_record(record: &mut Self::Record, iterations: usize, trials: usize);
     /// Stage 6's model part: the assembly's state moves to the next step;

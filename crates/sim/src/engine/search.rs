@@ -79,9 +79,19 @@ pub(crate) fn solve<M: Engine>(
             });
         }
         model.evaluate_next(data);
-        keep_if_best(model, data);
+        data.checked_trial.copy_from_slice(&data.trial);
+        data.checked_limits.copy_from_slice(&data.limit_trial);
         if !check_states(model, data) {
             break;
+        }
+        // An inconsistent solution: kept if it is the least inconsistent
+        // so far (judged in the states it was solved in).
+        let v = violation(model, data, &data.checked_trial, &data.checked_limits);
+        if v < data.best_violation {
+            data.best_violation = v;
+            data.best_z.copy_from_slice(&data.z);
+            data.best_trial.copy_from_slice(&data.checked_trial);
+            data.best_limits.copy_from_slice(&data.checked_limits);
         }
         let mut key = states_key(data);
         if data.visited.contains(&key) && !fallback_used {
@@ -114,10 +124,10 @@ pub(crate) fn solve<M: Engine>(
     Ok((newton_iterations, trials))
 }
 
-/// Keeps the solution in `data.z` as the search's least inconsistent one
-/// when it is; returns its violation.
+/// Keeps the solution in `data.z` (solved in the trial states) as the
+/// search's least inconsistent one when it is; returns its violation.
 fn keep_if_best<M: Engine>(model: &M, data: &mut RunData<M>) -> f64 {
-    let v = violation(model, data);
+    let v = violation(model, data, &data.trial, &data.limit_trial);
     if v < data.best_violation {
         data.best_violation = v;
         data.best_z.copy_from_slice(&data.z);
@@ -382,18 +392,23 @@ fn enumerate_states<M: Engine>(
 /// friction beyond μS·N when sticking, a slide running backwards
 /// ([`Engine::contact_violation`]). The largest over all points and
 /// limits; 0 for a consistent solution.
-pub(crate) fn violation<M: Engine>(model: &M, data: &RunData<M>) -> f64 {
+pub(crate) fn violation<M: Engine>(
+    model: &M,
+    data: &RunData<M>,
+    states: &[M::State],
+    limits: &[LimitState],
+) -> f64 {
     let mut worst: f64 = 0.0;
-    for c in 0..model.contacts() {
+    for (c, state) in states.iter().enumerate() {
         let trial = model.trial(data, c);
-        worst = worst.max(model.contact_violation(data, c, &trial));
+        worst = worst.max(model.contact_violation(data, state, &trial));
     }
     let length = model.length_scale(data);
     let gain = model.limit_gain(data);
-    for l in 0..model.limits() {
+    for (l, state) in limits.iter().enumerate() {
         let info = model.limit(l);
         let angle = data.z[info.q_index];
-        let v = match data.limit_trial[l] {
+        let v = match *state {
             LimitState::Free => {
                 let [lo, hi] = model.joint_limits().range(info.joint);
                 gain / length * (lo - angle).max(angle - hi).max(0.0)

@@ -34,7 +34,7 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
     let first = match solve(model, data) {
         Ok((iterations, trials)) => {
             data.max_step_iterations = data.max_step_iterations.max(iterations);
-            model.make_record(data, iterations, trials, model.dt());
+            record(model, data, iterations, trials, model.dt());
             let same = accept(model, data, t);
             model.accepted_whole(data);
             data.predictor.record(&data.z, same);
@@ -103,6 +103,15 @@ pub fn prepare<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimErr
     }
     start_search(data);
     Ok(())
+}
+
+/// The record of the solved (sub)step of length `h` when it is wanted.
+fn record<M: Engine>(model: &M, data: &mut RunData<M>, iterations: usize, trials: usize, h: f64) {
+    if data.want_record {
+        model.make_record(data, iterations, trials, h);
+    } else {
+        model.skip_record(data, h);
+    }
 }
 
 /// Stage 6: events (at time `t`, attributed to step `data.k`), the trial
@@ -220,7 +229,7 @@ fn substeps<M: Engine>(model: &M, data: &mut RunData<M>, n: usize) -> Result<usi
         let (iterations, trials) = solve(model, data)?;
         total += iterations;
         if i == 0 {
-            model.make_record(data, iterations, trials, h);
+            record(model, data, iterations, trials, h);
         } else {
             M::add_to_record(&mut data.record, iterations, trials);
         }

@@ -89,6 +89,8 @@ impl Engine for SpatialModel {
             max_substeps: self.max_substeps,
             cycle_tolerance: self.cycle_tolerance,
             qdot0: &self.params.qdot0,
+            steps: self.steps,
+            stride: self.params.stride,
             bodies: self.mech.bodies.len(),
             contacts: self.mech.contacts.len(),
             limits: self.mech.limits.len(),
@@ -147,10 +149,10 @@ impl Engine for SpatialModel {
     fn trial(&self, data: &SpatialData, c: usize) -> SpatialTrial {
         trial_of(self, data, c)
     }
-    fn contact_violation(&self, data: &SpatialData, c: usize, t: &SpatialTrial) -> f64 {
+    fn contact_violation(&self, data: &SpatialData, state: &SpatialState, t: &SpatialTrial) -> f64 {
         let k = data.fbd.position_gain;
         let mu = self.params.friction.mu_static;
-        match data.trial[c] {
+        match *state {
             SpatialState::Free => k * (-clearance(&self.params.terrain, t.p_next)).max(0.0),
             SpatialState::Stick { .. } => {
                 (-t.n).max(0.0) + (t.ft[0].hypot(t.ft[1]) - mu * t.n).max(0.0)
@@ -206,6 +208,9 @@ impl Engine for SpatialModel {
     }
     fn make_record(&self, data: &mut SpatialData, iterations: usize, trials: usize, h: f64) {
         make_record(self, data, iterations, trials, h);
+    }
+    fn skip_record(&self, data: &mut SpatialData, h: f64) {
+        carry_momenta(self, data, h);
     }
     fn add_to_record(record: &mut Self::Record, iterations: usize, trials: usize) {
         record.newton_iterations += iterations;
@@ -452,4 +457,16 @@ fn make_record(
     rec.potential = potential;
     rec.momentum = p.into();
     rec.angular_momentum = hmom.into();
+}
+
+/// The bodies' momenta `L[k+½]` over the step, kept for the next step's
+/// `L[k−½]` (as [`make_record`] keeps them), for a step without a record.
+fn carry_momenta(model: &SpatialModel, data: &mut SpatialData, h: f64) {
+    let fbd = &mut data.fbd;
+    for (b, body) in model.mech.bodies.iter().enumerate() {
+        let (l, _) =
+            half_momentum_and_rotation(&fbd.kin.rot[b], &fbd.kin_next.rot[b], &body.inertia, h);
+        fbd.l_carry[b] = l;
+    }
+    fbd.l_carry_dt = h;
 }

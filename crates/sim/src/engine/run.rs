@@ -1,0 +1,76 @@
+//! The stepping loop of a whole run, for every model.
+
+use super::{Engine, RunData};
+use crate::{RunSummary, SimError};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Runs `model` from its initial state to its last step (or the first
+/// error), handing the record of every `stride`-th step to `on_row`, and
+/// stopping before the next step once `stop` is set (e.g. by a signal
+/// handler; the summary then says `interrupted`).
+///
+/// The records of the other steps are not made (a strided run does not pay
+/// for rows it does not write). The wall time is the loop's minus the
+/// observer's: the clock is read around the loop and around each handed
+/// row only, not around every step.
+pub fn run_until<M: Engine>(
+    model: &M,
+    data: RunData<M>,
+    stop: &AtomicBool,
+    mut on_row: impl FnMut(&M::Record),
+) -> RunSummary {
+    let mut data = data;
+    let settings = model.settings();
+    let stride = settings.stride.max(1);
+    let mut error: Option<SimError> = None;
+    let mut interrupted = false;
+    let mut observer = std::time::Duration::ZERO;
+    let start = std::time::Instant::now();
+    for k in 0..settings.steps {
+        if stop.load(Ordering::Relaxed) {
+            interrupted = true;
+            break;
+        }
+        let wanted = k % stride == 0;
+        data.want_record = wanted;
+        match super::step::step(model, &mut data) {
+            Ok(()) if wanted => {
+                let t = std::time::Instant::now();
+                on_row(&data.record);
+                observer += t.elapsed();
+            }
+            Ok(()) => {}
+            Err(e) => {
+                error = Some(e);
+                break;
+            }
+        }
+    }
+    let wall = start.elapsed().saturating_sub(observer).as_secs_f64();
+    data.want_record = true;
+    summary(data, wall, error, interrupted)
+}
+
+/// The summary of a run that ended with `data`.
+fn summary<M: Engine>(
+    data: RunData<M>,
+    wall: f64,
+    error: Option<SimError>,
+    interrupted: bool,
+) -> RunSummary {
+    RunSummary {
+        steps: data.k,
+        newton_iterations: data.newton_iterations,
+        max_newton_iterations: data.max_step_iterations,
+        chord_iterations: data.chord_iterations,
+        numeric_factorizations: data.solver.numeric_factorizations(),
+        wall_seconds: wall,
+        symbolic_factorizations: data.symbolic_factorizations(),
+        events: data.events,
+        error,
+        limit_events: data.limit_events,
+        retries: data.retries,
+        resolved_cycles: data.resolved_cycles,
+        interrupted,
+    }
+}

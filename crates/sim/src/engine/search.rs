@@ -85,14 +85,8 @@ pub(crate) fn solve<M: Engine>(
             break;
         }
         // An inconsistent solution: kept if it is the least inconsistent
-        // so far (judged in the states it was solved in).
-        let v = violation(model, data, &data.checked_trial, &data.checked_limits);
-        if v < data.best_violation {
-            data.best_violation = v;
-            data.best_z.copy_from_slice(&data.z);
-            data.best_trial.copy_from_slice(&data.checked_trial);
-            data.best_limits.copy_from_slice(&data.checked_limits);
-        }
+        // so far.
+        keep_if_best(model, data);
         let mut key = states_key(data);
         if data.visited.contains(&key) && !fallback_used {
             fallback_used = true;
@@ -124,15 +118,17 @@ pub(crate) fn solve<M: Engine>(
     Ok((newton_iterations, trials))
 }
 
-/// Keeps the solution in `data.z` (solved in the trial states) as the
-/// search's least inconsistent one when it is; returns its violation.
+/// Keeps the solution in `data.z`, solved in the states
+/// `data.checked_trial` and `data.checked_limits`, as the search's least
+/// inconsistent one when it is (judged in those states); returns its
+/// violation.
 fn keep_if_best<M: Engine>(model: &M, data: &mut RunData<M>) -> f64 {
-    let v = violation(model, data, &data.trial, &data.limit_trial);
+    let v = violation(model, data, &data.checked_trial, &data.checked_limits);
     if v < data.best_violation {
         data.best_violation = v;
         data.best_z.copy_from_slice(&data.z);
-        data.best_trial.copy_from_slice(&data.trial);
-        data.best_limits.copy_from_slice(&data.limit_trial);
+        data.best_trial.copy_from_slice(&data.checked_trial);
+        data.best_limits.copy_from_slice(&data.checked_limits);
     }
     v
 }
@@ -379,6 +375,8 @@ fn enumerate_states<M: Engine>(
             continue;
         }
         model.evaluate_next(data);
+        data.checked_trial.copy_from_slice(&data.trial);
+        data.checked_limits.copy_from_slice(&data.limit_trial);
         if keep_if_best(model, data) <= model.cycle_tolerance() {
             return true;
         }

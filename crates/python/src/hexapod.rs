@@ -9,12 +9,11 @@ use fbd_cli::hexapod::{HexapodRun, ROW_VALUES, columns, row_values, simulate};
 use fbd_cli::steptime::StepTimes;
 use fbd_scenario::{Config, HexapodConfig};
 use numpy::PyArray1;
-use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::errors::cli_error;
-use crate::run::SignalWatch;
+use crate::run::{SignalWatch, finish};
 
 /// The hexapod's `run` dict: `columns` (names of `trajectory.csv`),
 /// `data` (float64 arrays; `stance{n}` is 1.0 or 0.0), `events` (dicts
@@ -44,7 +43,7 @@ pub fn run<'py>(
             }
             watch.row(&stop);
         })
-        .map(|r| (r, data, watch.signal))
+        .map(|r| (r, data, watch))
     });
     let (sim, data, signal) = outcome.map_err(|e| cli_error(py, &e, from_text))?;
     let HexapodRun {
@@ -55,15 +54,7 @@ pub fn run<'py>(
     if let Some(e) = io_error {
         return Err(cli_error(py, &e, from_text));
     }
-    if let Some(e) = signal {
-        if e.is_instance_of::<PyKeyboardInterrupt>(py) {
-            return Err(PyKeyboardInterrupt::new_err(format!(
-                "{source}: interrupted after {} steps",
-                run.steps
-            )));
-        }
-        return Err(e);
-    }
+    signal.raise(source, run.steps)?;
     let d = PyDict::new(py);
     let arrays = PyDict::new(py);
     for (name, v) in names.iter().zip(data) {
@@ -81,20 +72,13 @@ pub fn run<'py>(
         events.append(ev)?;
     }
     d.set_item("events", events)?;
-    let json = serde_json::to_string(&summary).unwrap_or_else(|_| "{}".into());
-    d.set_item("summary", json)?;
-    d.set_item("source", source)?;
-    let error = match &run.error {
-        Some(e) => {
-            let err = PyDict::new(py);
-            err.set_item("message", format!("{e} ({source})"))?;
-            // The failing step is the one after the last computed.
-            err.set_item("step", run.steps)?;
-            err.set_item("t", run.steps as f64 * h.time.dt)?;
-            Some(err)
-        }
-        None => None,
-    };
-    d.set_item("error", error)?;
-    Ok(d)
+    // The failing step is the one after the last computed.
+    let error = run.error.as_ref().map(|e| {
+        (
+            e.to_string(),
+            Some(run.steps),
+            Some(run.steps as f64 * h.time.dt),
+        )
+    });
+    finish(d, &summary, source, error)
 }

@@ -41,6 +41,77 @@ impl SignalWatch {
     }
 }
 
+impl SignalWatch {
+    /// After the run of `source` that stopped after `steps` steps: the
+    /// signal handler's exception, if one was raised (a KeyboardInterrupt
+    /// for Ctrl-C, with where the run stopped).
+    pub fn raise(self, source: &str, steps: usize) -> PyResult<()> {
+        let Some(e) = self.signal else {
+            return Ok(());
+        };
+        Python::attach(|py| {
+            if e.is_instance_of::<PyKeyboardInterrupt>(py) {
+                Err(PyKeyboardInterrupt::new_err(format!(
+                    "{source}: interrupted after {steps} steps"
+                )))
+            } else {
+                Err(e)
+            }
+        })
+    }
+}
+
+/// Completes a run's dict `d` with its `summary` (JSON text), `source` and
+/// `error` (None, or `{"message", "step", "t"}` for a run that stopped at
+/// `step` (time `t`) with `message`).
+pub fn finish<'py>(
+    d: Bound<'py, PyDict>,
+    summary: &impl serde::Serialize,
+    source: &str,
+    error: Option<(String, Option<usize>, Option<f64>)>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let json = serde_json::to_string(summary).unwrap_or_else(|_| "{}".into());
+    d.set_item("summary", json)?;
+    d.set_item("source", source)?;
+    let error = match error {
+        Some((message, step, t)) => {
+            let err = PyDict::new(d.py());
+            err.set_item("message", format!("{message} ({source})"))?;
+            err.set_item("step", step)?;
+            err.set_item("t", t)?;
+            Some(err)
+        }
+        None => None,
+    };
+    d.set_item("error", error)?;
+    Ok(d)
+}
+
+/// The dict of a dynamics run (planar or 3D) of `source`: its columns,
+/// its events as `events.csv` lists them, then [`finish`].
+pub fn dynamics_result<'py>(
+    py: Python<'py>,
+    cols: Columns,
+    run: &fbd_sim::RunSummary,
+    summary: &impl serde::Serialize,
+    source: &str,
+    dt: f64,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let (names, data) = cols.into_py(py)?;
+    d.set_item("columns", names)?;
+    d.set_item("data", data)?;
+    d.set_item(
+        "events",
+        events(py, &run.events, &run.limit_events, &run.retries, dt)?,
+    )?;
+    let error = run
+        .error
+        .as_ref()
+        .map(|e| (e.to_string(), e.step(), e.step().map(|k| k as f64 * dt)));
+    finish(d, summary, source, error)
+}
+
 /// Every event of a run — contact, joint-limit and retried-step events, as
 /// `events.csv` lists them ([`fbd_cli::output::merge_events`]) — as a list
 /// of dicts (`t`, `step`, `leg` (None for a retried step), `point`, `from`,
@@ -129,7 +200,7 @@ pub fn run<'py>(
                     watch.row(&stop);
                 },
             )
-            .map(|s| (s, cols, dt, watch.signal))
+            .map(|s| (s, cols, dt, watch))
         });
         let (sim, cols, dt, signal) = outcome.map_err(|e| cli_error(py, &e, loaded.from_text))?;
         let Simulated {
@@ -141,39 +212,7 @@ pub fn run<'py>(
         if let Some(e) = io_error {
             return Err(cli_error(py, &e, loaded.from_text));
         }
-        if let Some(e) = signal {
-            // The signal handler's exception (KeyboardInterrupt for Ctrl-C),
-            // with where the run stopped.
-            if e.is_instance_of::<PyKeyboardInterrupt>(py) {
-                return Err(PyKeyboardInterrupt::new_err(format!(
-                    "{}: interrupted after {} steps",
-                    loaded.source, run.steps
-                )));
-            }
-            return Err(e);
-        }
-        let d = PyDict::new(py);
-        let (names, data) = cols.into_py(py)?;
-        d.set_item("columns", names)?;
-        d.set_item("data", data)?;
-        d.set_item(
-            "events",
-            events(py, &run.events, &run.limit_events, &run.retries, dt)?,
-        )?;
-        let json = serde_json::to_string(&summary).unwrap_or_else(|_| "{}".into());
-        d.set_item("summary", json)?;
-        d.set_item("source", &loaded.source)?;
-        let error = match &run.error {
-            Some(e) => {
-                let err = PyDict::new(py);
-                err.set_item("message", format!("{e} ({})", loaded.source))?;
-                err.set_item("step", e.step())?;
-                err.set_item("t", e.step().map(|k| k as f64 * dt))?;
-                Some(err)
-            }
-            None => None,
-        };
-        d.set_item("error", error)?;
-        Ok(d)
+        signal.raise(&loaded.source, run.steps)?;
+        dynamics_result(py, cols, &run, &summary, &loaded.source, dt)
     })
 }

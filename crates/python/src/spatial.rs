@@ -11,13 +11,12 @@ use fbd_cli::spatial::csv::{Slots, row_values};
 use fbd_cli::spatial::{Feet, Layout, SpatialRun, columns, simulate};
 use fbd_scenario::{Config, HexapodConfig};
 use fbd_sim::spatial::SpatialRecord;
-use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::columns::Columns;
 use crate::errors::{cli_error, config_error};
-use crate::run::{SignalWatch, events};
+use crate::run::{SignalWatch, dynamics_result};
 
 /// The dynamic hexapod's `run` dict, as the planar run's: `columns`,
 /// `data` (float64 arrays; `state{n}` and `*point{n}_state` lists of
@@ -62,7 +61,7 @@ pub fn run<'py>(
                 watch.row(&stop);
             },
         )
-        .map(|s| (s, cols, watch.signal))
+        .map(|s| (s, cols, watch))
     });
     let (sim, cols, signal) = outcome.map_err(|e| cli_error(py, &e, from_text))?;
     let SpatialRun {
@@ -74,36 +73,6 @@ pub fn run<'py>(
     if let Some(e) = io_error {
         return Err(cli_error(py, &e, from_text));
     }
-    if let Some(e) = signal {
-        if e.is_instance_of::<PyKeyboardInterrupt>(py) {
-            return Err(PyKeyboardInterrupt::new_err(format!(
-                "{source}: interrupted after {} steps",
-                run.steps
-            )));
-        }
-        return Err(e);
-    }
-    let d = PyDict::new(py);
-    let (names, data) = cols.into_py(py)?;
-    d.set_item("columns", names)?;
-    d.set_item("data", data)?;
-    d.set_item(
-        "events",
-        events(py, &run.events, &run.limit_events, &run.retries, dt)?,
-    )?;
-    let json = serde_json::to_string(&summary).unwrap_or_else(|_| "{}".into());
-    d.set_item("summary", json)?;
-    d.set_item("source", source)?;
-    let error = match &run.error {
-        Some(e) => {
-            let err = PyDict::new(py);
-            err.set_item("message", format!("{e} ({source})"))?;
-            err.set_item("step", e.step())?;
-            err.set_item("t", e.step().map(|k| k as f64 * dt))?;
-            Some(err)
-        }
-        None => None,
-    };
-    d.set_item("error", error)?;
-    Ok(d)
+    signal.raise(source, run.steps)?;
+    dynamics_result(py, cols, &run, &summary, source, dt)
 }

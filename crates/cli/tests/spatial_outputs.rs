@@ -9,8 +9,7 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use fbd_cli::spatial::{self, FILES, Layout, columns};
-use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
-use fbd_kinematics::leg::LegGeometry;
+use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, NQ, forward};
 use fbd_sim::spatial::SpatialParams;
 
 /// A short drop onto flat ground: the body 0.4 m up (the feet 5 mm above
@@ -300,15 +299,7 @@ fn two_runs_are_byte_identical() {
 /// The centres of mass of the body, and of each leg's upper and lower
 /// link, from the row's coordinates by the D-H forward kinematics.
 fn centres(csv: &Csv, p: &SpatialParams, row: usize) -> ([f64; 3], Vec<[[f64; 3]; 2]>) {
-    let model = HexapodModel::new(
-        p.side,
-        LegGeometry {
-            a: p.upper_length,
-            c: p.lower_length,
-        },
-        p.upper_com,
-        p.lower_com,
-    );
+    let model = p.kinematic_model();
     let mut q = [0.0; NQ];
     for (k, name) in ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
         .iter()
@@ -546,15 +537,7 @@ fn the_joint_moments_carry_the_torques_about_the_joint_axes() {
     assert!(r.run.error.is_none(), "{:?}", r.run.error);
     assert!(r.run.limit_events.is_empty(), "a joint reached its limit");
     let csv = Csv::read(&dir.path().join("trajectory.csv"));
-    let model = HexapodModel::new(
-        p.side,
-        LegGeometry {
-            a: p.upper_length,
-            c: p.lower_length,
-        },
-        p.upper_com,
-        p.lower_com,
-    );
+    let model = p.kinematic_model();
     let mut d = HexapodData::new();
     let mut largest = 0.0f64;
     for k in 0..csv.rows.len() {

@@ -14,7 +14,6 @@ use std::sync::atomic::AtomicBool;
 
 use fbd_dynamics::PointKind;
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
-use fbd_kinematics::leg::LegGeometry;
 use fbd_sim::RunSummary;
 use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_until};
 
@@ -107,7 +106,7 @@ impl Feet {
     /// For the geometry and masses of `params`.
     pub fn new(params: &SpatialParams) -> Self {
         Self {
-            model: kinematic_model(params),
+            model: params.kinematic_model(),
             data: HexapodData::new(),
             legs: Layout::of(params).legs,
             q: [0.0; NQ],
@@ -150,19 +149,6 @@ impl Feet {
     pub fn q(&self) -> &[f64; NQ] {
         &self.q
     }
-}
-
-/// The kinematic model (geometry and link centres of mass) of `params`.
-pub fn kinematic_model(params: &SpatialParams) -> HexapodModel {
-    HexapodModel::new(
-        params.side,
-        LegGeometry {
-            a: params.upper_length,
-            c: params.lower_length,
-        },
-        params.upper_com,
-        params.lower_com,
-    )
 }
 
 /// The viewer frame of a record.
@@ -253,7 +239,7 @@ impl Outputs {
             plot: out_dir.map(|_| plots::Recorder::new(&layout, t_end)),
             view: out_dir.map(|dir| {
                 HexapodScene::dynamic(
-                    kinematic_model(params),
+                    params.kinematic_model(),
                     params.terrain.clone(),
                     &layout.legs,
                     &layout.extra_points,

@@ -410,7 +410,7 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
             let params = c.spatial_params(&source)?;
             let frames = spatial_frames(&traj, &params)?;
             let mut scene = HexapodScene::dynamic(
-                crate::spatial::kinematic_model(&params),
+                params.kinematic_model(),
                 params.terrain.clone(),
                 &params.legs,
                 &crate::spatial::Layout::of(&params).extra_points,

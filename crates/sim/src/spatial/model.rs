@@ -7,8 +7,6 @@ use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
 use fbd_dynamics::PointKind;
 use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism, q_joint};
-use fbd_kinematics::hexapod::HexapodModel;
-use fbd_kinematics::leg::LegGeometry;
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
 use fbd_solver::NewtonParams;
 
@@ -198,15 +196,7 @@ impl SpatialModel {
     pub fn new(params: &SpatialParams) -> Result<Self, SimError> {
         let p = params;
         p.validate()?;
-        let geometry = HexapodModel::new(
-            p.side,
-            LegGeometry {
-                a: p.upper_length,
-                c: p.lower_length,
-            },
-            p.upper_com,
-            p.lower_com,
-        );
+        let geometry = p.kinematic_model();
         let inertia = SpatialInertia {
             body_mass: p.body_mass,
             body_inertia: inertia_matrix(&p.body_inertia),

@@ -182,6 +182,21 @@ pub fn default_q0() -> Vec<f64> {
 }
 
 impl SpatialParams {
+    /// The kinematic model (D-H geometry and link centres of mass) of
+    /// these parameters: the one source of the hexapod's geometry for the
+    /// dynamics, the outputs and the tests.
+    pub fn kinematic_model(&self) -> fbd_kinematics::hexapod::HexapodModel {
+        fbd_kinematics::hexapod::HexapodModel::new(
+            self.side,
+            fbd_kinematics::leg::LegGeometry {
+                a: self.upper_length,
+                c: self.lower_length,
+            },
+            self.upper_com,
+            self.lower_com,
+        )
+    }
+
     /// The spatial twin of a planar run: legs 3 and 4 only, θ1 = 0, the
     /// planar initial state in the X–Y plane, the same masses (the body's
     /// inertia isotropic with the planar value about Z, each link's

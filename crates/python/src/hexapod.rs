@@ -51,10 +51,7 @@ pub fn run<'py>(
         summary,
         io_error,
     } = sim;
-    if let Some(e) = io_error {
-        return Err(cli_error(py, &e, from_text));
-    }
-    signal.raise(source, run.steps)?;
+    signal.raise(io_error, from_text, source, run.steps)?;
     let d = PyDict::new(py);
     let arrays = PyDict::new(py);
     for (name, v) in names.iter().zip(data) {

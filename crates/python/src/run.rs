@@ -42,10 +42,20 @@ impl SignalWatch {
 }
 
 impl SignalWatch {
-    /// After the run of `source` that stopped after `steps` steps: the
-    /// signal handler's exception, if one was raised (a KeyboardInterrupt
-    /// for Ctrl-C, with where the run stopped).
-    pub fn raise(self, source: &str, steps: usize) -> PyResult<()> {
+    /// After the run of `source` that stopped after `steps` steps: an
+    /// output file that could not be written (`io_error`, as the CLI's
+    /// error), else the signal handler's exception, if one was raised (a
+    /// KeyboardInterrupt for Ctrl-C, with where the run stopped).
+    pub fn raise(
+        self,
+        io_error: Option<fbd_cli::CliError>,
+        from_text: bool,
+        source: &str,
+        steps: usize,
+    ) -> PyResult<()> {
+        if let Some(e) = io_error {
+            return Python::attach(|py| Err(cli_error(py, &e, from_text)));
+        }
         let Some(e) = self.signal else {
             return Ok(());
         };
@@ -209,10 +219,7 @@ pub fn run<'py>(
             io_error,
             ..
         } = sim;
-        if let Some(e) = io_error {
-            return Err(cli_error(py, &e, loaded.from_text));
-        }
-        signal.raise(&loaded.source, run.steps)?;
+        signal.raise(io_error, loaded.from_text, &loaded.source, run.steps)?;
         dynamics_result(py, cols, &run, &summary, &loaded.source, dt)
     })
 }

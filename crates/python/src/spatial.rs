@@ -70,9 +70,6 @@ pub fn run<'py>(
         io_error,
         ..
     } = sim;
-    if let Some(e) = io_error {
-        return Err(cli_error(py, &e, from_text));
-    }
-    signal.raise(source, run.steps)?;
+    signal.raise(io_error, from_text, source, run.steps)?;
     dynamics_result(py, cols, &run, &summary, source, dt)
 }

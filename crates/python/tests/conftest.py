@@ -59,3 +59,24 @@ def sigint_raises():
     old = signal.signal(signal.SIGINT, signal.default_int_handler)
     yield
     signal.signal(signal.SIGINT, old)
+
+
+@pytest.fixture
+def ctrl_c(sigint_raises):
+    """`with ctrl_c():` — Ctrl-C (a KeyboardInterrupt in the main thread)
+    `seconds` (default 0.3) after entering the block."""
+    import _thread
+    import contextlib
+    import threading
+
+    @contextlib.contextmanager
+    def after(seconds: float = 0.3):
+        timer = threading.Timer(seconds, _thread.interrupt_main)
+        timer.start()
+        try:
+            yield
+        finally:
+            timer.cancel()
+            timer.join()
+
+    return after

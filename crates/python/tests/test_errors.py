@@ -173,10 +173,7 @@ def test_unwritable_out_is_an_os_error(tmp):
         fbd.run("[time]\nduration = 0.05\n", out=f)
 
 
-def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call(sigint_raises):
-    import _thread
-    import threading
-
+def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call(ctrl_c):
     # Long enough to outlast the timer at any speed (3e6 steps of a free
     # fall, a row every 10 steps: the signals are looked at every 4096
     # rows).
@@ -185,17 +182,11 @@ def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call(sigint_raises):
         "terrain": {"kind": "none"},
         "output": {"stride": 10},
     }
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    timer.start()
-    with pytest.raises(KeyboardInterrupt, match="interrupted after"):
+    with ctrl_c(), pytest.raises(KeyboardInterrupt, match="interrupted after"):
         fbd.run(long)
-    timer.join()
     sim = fbd.Simulator(long)
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    timer.start()
-    with pytest.raises(KeyboardInterrupt):
+    with ctrl_c(), pytest.raises(KeyboardInterrupt):
         sim.step(steps=sim.steps)
-    timer.join()
     # Stopped between steps: the state is a solved one, and stepping goes on.
     k = sim.k
     assert 0 < k < sim.steps

@@ -146,10 +146,7 @@ def test_a_two_legged_dynamic_hexapod(tmp):
     assert np.allclose(r["ry"][free], 0.6 - 0.5 * G * t[free] ** 2, atol=1e-9)
 
 
-def test_ctrl_c_interrupts_a_dynamic_run(sigint_raises):
-    import _thread
-    import threading
-
+def test_ctrl_c_interrupts_a_dynamic_run(ctrl_c):
     # Long enough to outlast the timer at any speed (a robot at rest
     # steps fastest: 2e5 steps, a row every 10; the signals are looked at
     # every 4096 rows).
@@ -158,11 +155,8 @@ def test_ctrl_c_interrupts_a_dynamic_run(sigint_raises):
         "time": {"dt": 0.001, "duration": 200.0},
         "output": {"stride": 10},
     }
-    timer = threading.Timer(0.3, _thread.interrupt_main)
-    timer.start()
-    with pytest.raises(KeyboardInterrupt, match="interrupted after"):
+    with ctrl_c(), pytest.raises(KeyboardInterrupt, match="interrupted after"):
         fbd.run(long)
-    timer.join()
 
 
 def test_dynamic_runs_in_threads_equal_the_same_runs_in_turn(examples):

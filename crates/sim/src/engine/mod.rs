@@ -225,8 +225,8 @@ pub trait Engine: Sized {
     fn skip_record(&self, _data: &mut RunData<Self>, _h: f64) {}
     /// Adds a later substep's iterations and solves to the record.
     fn add_to_record(record: &mut Self::Record, iterations: usize, trials: usize);
-    /// Stage 6's model part: the assembly's state moves to the next step;
-    /// `whole` when the step was solved whole (not in substeps).
+    /// Stage 6's model part: the assembly's state moves to the next
+    /// (sub)step.
     fn advance(&self, data: &mut RunData<Self>);
     /// After a step solved whole has been accepted.
     fn accepted_whole(&self, _data: &mut RunData<Self>) {}

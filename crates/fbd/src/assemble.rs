@@ -23,13 +23,16 @@
 //! stops at the end within one step — a plastic stop. Whether the stop
 //! pushes (`λ` away from the end) is the state search's business.
 //!
-//! The Jacobian is written entry by entry through a [`JacobianSink`]; the
-//! same code path with [`pattern`] declares the structure, so the two cannot
-//! drift apart.
+//! The equations are assembled by the one assembly of the plane and space,
+//! [`crate::assembly`]; this module supplies the planar model's part of it
+//! ([`FbdModel`] for [`Mechanism`]): its kinematics, and the rotation row's
+//! central difference of the body angle.
 
-use crate::body::{BodyStep, cross};
+use crate::assembly::{self, At, ContactView, Dims, FbdModel, Reaction, RowState, Slip, StopView};
+use crate::body::{BodyStep, Wrench};
 use crate::mechanism::Mechanism;
 use crate::rows;
+use crate::space::Plane;
 use fbd_contact::{ContactState, Terrain};
 use fbd_kinematics::LimitSide;
 use fbd_kinematics::planar::PlanarData;
@@ -49,16 +52,6 @@ impl JacobianSink for NoJacobian {
     const ACTIVE: bool = false;
     #[inline]
     fn add(&mut self, _: usize, _: usize, _: f64) {}
-}
-
-struct PatternSink<'a>(&'a mut Vec<(usize, usize)>);
-
-impl JacobianSink for PatternSink<'_> {
-    const ACTIVE: bool = true;
-    #[inline]
-    fn add(&mut self, row: usize, col: usize, _: f64) {
-        self.0.push((row, col));
-    }
 }
 
 /// The equations a contact point contributes in this step.
@@ -185,7 +178,7 @@ pub struct FbdData {
     /// The `q[k+1]` at which `kin_next`'s positions were last evaluated
     /// (NaN before the first evaluation).
     next_q: Vec<f64>,
-    acc: Vec<[f64; 3]>,
+    wrench: Vec<Wrench<Plane>>,
 }
 
 impl FbdData {
@@ -207,7 +200,7 @@ impl FbdData {
             length_scale: mech.length_scale(),
             next_is_candidate: false,
             next_q: vec![f64::NAN; mech.layout().nq],
-            acc: vec![[0.0; 3]; mech.bodies.len()],
+            wrench: vec![Wrench::default(); mech.bodies.len()],
         }
     }
 
@@ -297,12 +290,11 @@ pub fn pattern_key(data: &FbdData) -> u64 {
 /// Pushes every structural `(row, col)` of the Jacobian for the current
 /// contact states.
 pub fn pattern(mech: &Mechanism, data: &FbdData, entries: &mut Vec<(usize, usize)>) {
-    let mut sink = PatternSink(entries);
-    force_entries(mech, data, &mut sink);
-    position_entries(mech, &Terrain::None, data, &mut sink);
+    assembly::pattern(mech, &Terrain::None, data, entries);
 }
 
-/// Residual `r(z)` and, through `jac`, the analytic Jacobian.
+/// Residual `r(z)` and, through `jac`, the analytic Jacobian
+/// ([`crate::assembly::eval`]).
 pub fn eval<S: JacobianSink>(
     mech: &Mechanism,
     terrain: &Terrain,
@@ -311,221 +303,194 @@ pub fn eval<S: JacobianSink>(
     r: &mut [f64],
     jac: &mut S,
 ) {
-    let lay = mech.layout();
-    assert_eq!(z.len(), lay.dim(), "unknown vector has the wrong length");
-    assert_eq!(r.len(), lay.dim(), "residual vector has the wrong length");
-    let nq = lay.nq;
-    mech.chains.eval_positions(&z[..nq], &mut data.kin_next);
-    data.next_q.copy_from_slice(&z[..nq]);
-    data.next_is_candidate = false;
-    if S::ACTIVE {
-        mech.chains.eval_jacobians(&mut data.kin_next);
+    assembly::eval(mech, terrain, data, z, r, jac);
+}
+
+/// The planar model's part of the assembly.
+impl FbdModel for Mechanism {
+    type S = Plane;
+    type Data = FbdData;
+    type Ground = Terrain;
+    const IMPLICIT_SLIP: bool = false;
+
+    fn dims(&self) -> Dims {
+        self.layout().dims()
     }
-    let inv_dt2 = 1.0 / (data.dt * data.dt);
-    // Sum of applied forces and moments per body, at configuration k.
-    for (b, acc) in data.acc.iter_mut().enumerate() {
-        *acc = [0.0, -mech.bodies[b].mass * mech.gravity, 0.0];
+
+    #[inline]
+    fn gravity(&self) -> f64 {
+        self.gravity
     }
-    for (j, spec) in mech.joints.iter().enumerate() {
-        let f = [z[lay.joint_force(j, 0)], z[lay.joint_force(j, 1)]];
-        let p = data.kin.pos[spec.point];
-        let tz = spec.axis_z * data.torque[j];
-        for (b, sgn) in [(spec.child, 1.0), (spec.parent, -1.0)] {
-            let c = data.body[b].com_k;
-            let a = &mut data.acc[b];
-            a[0] += sgn * f[0];
-            a[1] += sgn * f[1];
-            a[2] += sgn * (cross([p[0] - c[0], p[1] - c[1]], f) + tz);
+
+    #[inline]
+    fn mass(&self, b: usize) -> f64 {
+        self.bodies[b].mass
+    }
+
+    #[inline]
+    fn rotation_projection(&self, b: usize) -> f64 {
+        self.bodies[b].versor_z
+    }
+
+    #[inline]
+    fn gains(&self, data: &FbdData) -> (f64, f64, f64) {
+        (data.dt, data.position_gain, data.limit_gain)
+    }
+
+    fn kinematics_next(&self, data: &mut FbdData, q: &[f64], jacobians: bool) {
+        self.chains.eval_positions(q, &mut data.kin_next);
+        data.next_q.copy_from_slice(q);
+        data.next_is_candidate = false;
+        if jacobians {
+            self.chains.eval_jacobians(&mut data.kin_next);
         }
     }
-    for (ci, spec) in mech.contacts.iter().enumerate() {
-        let eq = &data.contact[ci];
-        let (fa, n) = (z[lay.contact_fa(ci)], z[lay.contact_n(ci)]);
-        let f = [
-            fa * eq.tangent[0] + n * eq.normal[0],
-            fa * eq.tangent[1] + n * eq.normal[1],
-        ];
-        let p = data.kin.pos[spec.point];
-        let c = data.body[spec.body].com_k;
-        let a = &mut data.acc[spec.body];
-        a[0] += f[0];
-        a[1] += f[1];
-        a[2] += cross([p[0] - c[0], p[1] - c[1]], f);
+
+    #[inline]
+    fn body_step<'a>(&self, data: &'a FbdData, b: usize) -> &'a BodyStep<Plane> {
+        &data.body[b]
     }
-    for (l, &j) in mech.limits.iter().enumerate() {
-        let spec = &mech.joints[j];
-        let m = spec.axis_z * z[lay.limit_moment(l)];
-        data.acc[spec.child][2] += m;
-        data.acc[spec.parent][2] -= m;
+
+    #[inline]
+    fn wrenches<'a>(&self, data: &'a mut FbdData) -> &'a mut [Wrench<Plane>] {
+        &mut data.wrench
     }
-    for (b, spec) in mech.bodies.iter().enumerate() {
-        let x = FbdData::body_coords(mech, &data.kin_next, b);
-        let bs = &data.body[b];
-        let row = lay.body_row(b);
-        let a = data.acc[b];
-        r[row] = spec.mass * bs.acceleration(0, x[0], inv_dt2) - a[0];
-        r[row + 1] = spec.mass * bs.acceleration(1, x[1], inv_dt2) - a[1];
-        r[row + 2] = spec.versor_z * (spec.inertia * bs.acceleration(2, x[2], inv_dt2) - a[2]);
+
+    #[inline]
+    fn com_next(&self, data: &FbdData, b: usize) -> [f64; 2] {
+        data.kin_next.pos[self.bodies[b].com]
     }
-    let k = data.position_gain;
-    for (ci, spec) in mech.contacts.iter().enumerate() {
-        let eq = &data.contact[ci];
-        let row = lay.contact_row(ci);
-        let (fa, n) = (z[lay.contact_fa(ci)], z[lay.contact_n(ci)]);
-        let p = data.kin_next.pos[spec.point];
-        let (force, out) = ([fa, n], &mut r[row..row + 2]);
-        match eq.state {
-            ContactState::Free => rows::free_rows(&force, out),
-            ContactState::Stick { anchor } => {
-                let f = [
-                    fa * eq.tangent[0] + n * eq.normal[0],
-                    fa * eq.tangent[1] + n * eq.normal[1],
-                ];
-                rows::stick_rows(k, &p, &anchor, eq.regularization, &f, out);
-            }
-            ContactState::Slide { dir } => rows::slide_rows(
-                &force,
-                &[dir],
-                eq.mu_dynamic,
-                k,
-                terrain.clearance(p),
-                eq.regularization,
-                out,
-            ),
+
+    /// `I·(c·ψ[k+1] + b_ψ)/Δt²`, the paper's central difference.
+    #[inline]
+    fn angular_rate(&self, data: &mut FbdData, b: usize, _: bool) -> [f64; 1] {
+        let spec = &self.bodies[b];
+        let inv_dt2 = 1.0 / (data.dt * data.dt);
+        let psi = data.kin_next.angle[spec.angle];
+        [spec.inertia * data.body[b].angular_acceleration(psi, inv_dt2)]
+    }
+
+    #[inline]
+    fn reactions(&self) -> usize {
+        self.joints.len()
+    }
+
+    #[inline]
+    fn reaction(&self, data: &FbdData, j: usize) -> Reaction<Plane> {
+        let spec = &self.joints[j];
+        Reaction {
+            child: spec.child,
+            parent: spec.parent,
+            point: data.kin.pos[spec.point],
+            force_col: self.layout().joint_force(j, 0),
+            torque: [spec.axis_z * data.torque[j]],
+            moments: [(0, [0.0]); 2],
+            n_moments: 0,
         }
     }
-    for (l, &j) in mech.limits.iter().enumerate() {
-        let eq = &data.limit[l];
-        let lambda = z[lay.limit_moment(l)];
-        r[lay.limit_row(l)] =
-            rows::limit_row(eq, lambda, z[mech.joints[j].q_index], data.limit_gain);
+
+    #[inline]
+    fn contact<'a>(&self, data: &'a FbdData, c: usize) -> ContactView<'a, Plane> {
+        let eq = &data.contact[c];
+        ContactView {
+            body: self.contacts[c].body,
+            frame: [eq.tangent, eq.normal],
+            state: match &eq.state {
+                ContactState::Free => RowState::Free,
+                ContactState::Stick { anchor } => RowState::Stick(anchor),
+                ContactState::Slide { dir } => RowState::Slide(std::slice::from_ref(dir)),
+            },
+            mu_dynamic: eq.mu_dynamic,
+            regularization: eq.regularization,
+        }
     }
-    if S::ACTIVE {
-        force_entries(mech, data, jac);
-        position_entries(mech, terrain, data, jac);
+
+    #[inline]
+    fn contact_point(&self, data: &FbdData, c: usize, at: At) -> [f64; 2] {
+        let kin = match at {
+            At::Now => &data.kin,
+            At::Next => &data.kin_next,
+        };
+        kin.pos[self.contacts[c].point]
+    }
+
+    #[inline]
+    fn stop<'a>(&self, data: &'a FbdData, l: usize) -> StopView<'a, Plane> {
+        let spec = &self.joints[self.limits[l]];
+        StopView {
+            child: spec.child,
+            parent: spec.parent,
+            axis: [spec.axis_z],
+            q_index: spec.q_index,
+            equation: &data.limit[l],
+        }
+    }
+
+    /// A planar slide keeps its direction (±1) for the step.
+    #[inline]
+    fn slide_direction(
+        &self,
+        _: &mut FbdData,
+        _: usize,
+        _: &[f64; 2],
+        dir: &[f64],
+        _: f64,
+    ) -> [f64; 2] {
+        [dir[0], 0.0]
+    }
+
+    fn slip(&self, data: &FbdData, c: usize) -> Slip {
+        let dir = match data.contact[c].state {
+            ContactState::Slide { dir } => dir,
+            _ => 0.0,
+        };
+        Slip {
+            dir: [dir, 0.0],
+            len: f64::INFINITY,
+            normal: 0.0,
+            bias: 0.0,
+        }
+    }
+
+    #[inline]
+    fn clearance(&self, terrain: &Terrain, p: &[f64; 2]) -> f64 {
+        terrain.clearance(*p)
+    }
+
+    #[inline]
+    fn slope(&self, terrain: &Terrain, p: &[f64; 2]) -> [f64; 2] {
+        [terrain.slope(p[0]), 0.0]
+    }
+
+    #[inline]
+    fn com_columns(&self, data: &FbdData, b: usize, f: impl FnMut(usize, &[f64; 2])) {
+        point_columns(self, &data.kin_next, self.bodies[b].com, f);
+    }
+
+    #[inline]
+    fn contact_columns(&self, data: &FbdData, c: usize, f: impl FnMut(usize, &[f64; 2])) {
+        point_columns(self, &data.kin_next, self.contacts[c].point, f);
+    }
+
+    /// `v·I·c/Δt²·∂ψ/∂q_i`: the angle is linear in `q`.
+    fn rotation_entries<J: JacobianSink>(&self, data: &FbdData, b: usize, row: usize, jac: &mut J) {
+        let spec = &self.bodies[b];
+        let gi = spec.versor_z * spec.inertia * data.body[b].c_next / (data.dt * data.dt);
+        for &(i, coef) in &self.chains.angles[spec.angle].terms {
+            jac.add(row, i, gi * coef);
+        }
     }
 }
 
-/// Entries in the force columns (they do not depend on the iterate).
-fn force_entries<S: JacobianSink>(mech: &Mechanism, data: &FbdData, jac: &mut S) {
-    let lay = mech.layout();
-    for (j, spec) in mech.joints.iter().enumerate() {
-        let (cx, cy) = (lay.joint_force(j, 0), lay.joint_force(j, 1));
-        let p = data.kin.pos[spec.point];
-        for (b, sgn) in [(spec.child, 1.0), (spec.parent, -1.0)] {
-            let c = data.body[b].com_k;
-            let v = mech.bodies[b].versor_z;
-            let row = lay.body_row(b);
-            let (rx, ry) = (p[0] - c[0], p[1] - c[1]);
-            jac.add(row, cx, -sgn);
-            jac.add(row + 1, cy, -sgn);
-            // −v·∂(r × F)/∂F = −v·(−ry, rx)
-            jac.add(row + 2, cx, v * sgn * ry);
-            jac.add(row + 2, cy, -v * sgn * rx);
-        }
-    }
-    for (ci, spec) in mech.contacts.iter().enumerate() {
-        let eq = &data.contact[ci];
-        let (ca, cn) = (lay.contact_fa(ci), lay.contact_n(ci));
-        let p = data.kin.pos[spec.point];
-        let c = data.body[spec.body].com_k;
-        let rr = [p[0] - c[0], p[1] - c[1]];
-        let v = mech.bodies[spec.body].versor_z;
-        let row = lay.body_row(spec.body);
-        jac.add(row, ca, -eq.tangent[0]);
-        jac.add(row, cn, -eq.normal[0]);
-        jac.add(row + 1, ca, -eq.tangent[1]);
-        jac.add(row + 1, cn, -eq.normal[1]);
-        jac.add(row + 2, ca, -v * cross(rr, eq.tangent));
-        jac.add(row + 2, cn, -v * cross(rr, eq.normal));
-        let crow = lay.contact_row(ci);
-        match eq.state {
-            ContactState::Free => {
-                jac.add(crow, ca, 1.0);
-                jac.add(crow + 1, cn, 1.0);
-            }
-            ContactState::Stick { .. } => {
-                let b = eq.regularization;
-                jac.add(crow, ca, b * eq.tangent[0]);
-                jac.add(crow, cn, b * eq.normal[0]);
-                jac.add(crow + 1, ca, b * eq.tangent[1]);
-                jac.add(crow + 1, cn, b * eq.normal[1]);
-            }
-            ContactState::Slide { dir } => {
-                jac.add(crow, ca, 1.0);
-                jac.add(crow, cn, dir * eq.mu_dynamic);
-                jac.add(crow + 1, cn, eq.regularization);
-            }
-        }
-    }
-    for (l, &j) in mech.limits.iter().enumerate() {
-        let spec = &mech.joints[j];
-        let col = lay.limit_moment(l);
-        // r[rot] = v·(I·ψ̈ − Σ moments), the stop adds ±axis·λ.
-        let (vc, vp) = (
-            mech.bodies[spec.child].versor_z,
-            mech.bodies[spec.parent].versor_z,
-        );
-        jac.add(lay.body_row(spec.child) + 2, col, -vc * spec.axis_z);
-        jac.add(lay.body_row(spec.parent) + 2, col, vp * spec.axis_z);
-        jac.add(
-            lay.limit_row(l),
-            col,
-            rows::limit_row_diagonal(&data.limit[l]),
-        );
-    }
-}
-
-/// Entries in the `q[k+1]` columns: `∂(second difference)/∂q` of every body
-/// and the contact position rows, at the iterate `data.kin_next`.
-fn position_entries<S: JacobianSink>(
+/// Visits `(i, ∂p/∂q_i)` of planar point `p` in `kin`.
+#[inline]
+fn point_columns(
     mech: &Mechanism,
-    terrain: &Terrain,
-    data: &FbdData,
-    jac: &mut S,
+    kin: &PlanarData,
+    p: usize,
+    mut f: impl FnMut(usize, &[f64; 2]),
 ) {
-    let lay = mech.layout();
-    let kin_next = &data.kin_next;
-    let dt2 = data.dt * data.dt;
-    for (b, spec) in mech.bodies.iter().enumerate() {
-        let row = lay.body_row(b);
-        let g = spec.mass * data.body[b].c_next / dt2;
-        for &i in mech.point_columns(spec.com) {
-            jac.add(row, i, g * kin_next.jac_at(spec.com, 0, i));
-            jac.add(row + 1, i, g * kin_next.jac_at(spec.com, 1, i));
-        }
-        let gi = spec.versor_z * spec.inertia * data.body[b].c_next / dt2;
-        for &(i, coef) in &mech.chains.angles[spec.angle].terms {
-            jac.add(row + 2, i, gi * coef);
-        }
-    }
-    let k = data.position_gain;
-    for (ci, spec) in mech.contacts.iter().enumerate() {
-        let row = lay.contact_row(ci);
-        match data.contact[ci].state {
-            ContactState::Free => {}
-            ContactState::Stick { .. } => {
-                for &i in mech.point_columns(spec.point) {
-                    jac.add(row, i, k * kin_next.jac_at(spec.point, 0, i));
-                    jac.add(row + 1, i, k * kin_next.jac_at(spec.point, 1, i));
-                }
-            }
-            ContactState::Slide { .. } => {
-                let s = terrain.slope(kin_next.pos[spec.point][0]);
-                for &i in mech.point_columns(spec.point) {
-                    jac.add(
-                        row + 1,
-                        i,
-                        k * (kin_next.jac_at(spec.point, 1, i)
-                            - s * kin_next.jac_at(spec.point, 0, i)),
-                    );
-                }
-            }
-        }
-    }
-    for (l, &j) in mech.limits.iter().enumerate() {
-        if data.limit[l].state.is_at() {
-            jac.add(lay.limit_row(l), mech.joints[j].q_index, data.limit_gain);
-        }
+    for &i in mech.point_columns(p) {
+        f(i, &[kin.jac_at(p, 0, i), kin.jac_at(p, 1, i)]);
     }
 }

@@ -36,11 +36,21 @@
 //! `x_b[−1] = x_b(q[1]) − 2Δt ẋ_b(0)`. The residual is nonlinear in `q[k+1]`
 //! only, linear in the forces; its Jacobian is assembled analytically,
 //! directly into a sparse pattern (see [`assemble`]).
+//!
+//! ## One assembly, two models
+//! The residual and its Jacobian are written once, in [`assembly`], over a
+//! [`space::Space`] (the plane or space) and a model ([`assembly::FbdModel`]):
+//! the planar mechanism ([`assemble`]) and the spatial hexapod ([`spatial`])
+//! supply their kinematics, joint reactions and rotation rows; loads,
+//! Newton–Euler rows, contact and stop rows ([`rows`]) and every force
+//! column of the Jacobian are shared.
 
 pub mod assemble;
+pub mod assembly;
 pub mod body;
 pub mod mechanism;
 pub mod rows;
+pub mod space;
 pub mod spatial;
 
 pub use assemble::{

@@ -1,6 +1,9 @@
 //! The mechanism description: rigid bodies, revolute joints and contact
 //! points over a planar kinematic tree (immutable, the "Model").
 
+use crate::assembly::Dims;
+use crate::rows::NORMAL;
+use crate::space::{Plane, Space};
 use fbd_kinematics::planar::{PlanarChains, PlanarGeometry, TwoLegIndex};
 
 /// One rigid body.
@@ -118,38 +121,51 @@ pub struct Layout {
 }
 
 impl Layout {
+    /// The generic layout of the assembly ([`crate::assembly::Dims`]): the
+    /// one source of where each block of unknowns and equations sits.
+    pub fn dims(&self) -> Dims {
+        Dims {
+            nq: self.nq,
+            reaction_unknowns: 2 * self.joints,
+            bodies: self.bodies,
+            contacts: self.contacts,
+            limits: self.limits,
+            lin: Plane::LIN,
+            ang: Plane::ANG,
+        }
+    }
     /// Unknowns = equations.
     pub fn dim(&self) -> usize {
-        self.nq + 2 * self.joints + 2 * self.contacts + self.limits
+        self.dims().dim()
     }
     /// Column of joint limit `l`'s stop moment (N·m, positive towards
     /// larger joint angles).
     pub fn limit_moment(&self, l: usize) -> usize {
-        self.nq + 2 * self.joints + 2 * self.contacts + l
+        self.dims().limit_moment(l)
     }
     /// Row of joint limit `l`'s equation.
     pub fn limit_row(&self, l: usize) -> usize {
-        3 * self.bodies + 2 * self.contacts + l
+        self.dims().limit_row(l)
     }
     /// Column of joint `j`'s force component `axis` (0 = x, 1 = y).
     pub fn joint_force(&self, j: usize, axis: usize) -> usize {
-        self.nq + 2 * j + axis
+        self.dims().reaction() + 2 * j + axis
     }
     /// Column of contact `c`'s tangential force `Fa`.
     pub fn contact_fa(&self, c: usize) -> usize {
-        self.nq + 2 * self.joints + 2 * c
+        self.dims().contact_force(c, 0)
     }
     /// Column of contact `c`'s normal force `N`.
     pub fn contact_n(&self, c: usize) -> usize {
-        self.contact_fa(c) + 1
+        self.dims().contact_force(c, NORMAL)
     }
     /// First row of body `b`'s equations (x, y, rotation).
     pub fn body_row(&self, b: usize) -> usize {
-        3 * b
+        self.dims().body_row(b)
     }
     /// First row of contact `c`'s two equations.
     pub fn contact_row(&self, c: usize) -> usize {
-        3 * self.bodies + 2 * c
+        self.dims().contact_row(c)
     }
 }
 

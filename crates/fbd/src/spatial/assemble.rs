@@ -1,27 +1,23 @@
 //! Residual and analytic Jacobian of one spatial time step (see the module
 //! docs of [`crate::spatial`] for the unknowns, equations and the rotation
-//! scheme). Written entry by entry through a [`JacobianSink`]; the same
-//! code path declares the pattern ([`pattern`]), so the two cannot drift.
+//! scheme). The equations are assembled by the one assembly of the plane
+//! and space, [`crate::assembly`]; this module supplies the hexapod's part
+//! ([`FbdModel`] for [`SpatialMechanism`]): its kinematics, the joint
+//! reactions with their constraint moments, the Lie-group discretisation of
+//! Euler's equations and the implicit slip direction of a sliding foot.
 
 use super::kin::{Columns, SpatialKin};
 use super::mechanism::{SpatialMechanism, lower_body, upper_body};
 use super::so3;
 use crate::assemble::{History, JacobianSink, LimitEquation};
+use crate::assembly::{self, At, ContactView, Dims, FbdModel, Reaction, RowState, Slip, StopView};
+use crate::body::{BodyStep, Wrench};
 use crate::mechanism::PointKind;
 use crate::rows;
+use crate::space::Space3;
 use fbd_contact::spatial::clearance;
 use fbd_contact::{SpatialState, Surface};
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
-
-struct PatternSink<'a>(&'a mut Vec<(usize, usize)>);
-
-impl JacobianSink for PatternSink<'_> {
-    const ACTIVE: bool = true;
-    #[inline]
-    fn add(&mut self, row: usize, col: usize, _: f64) {
-        self.0.push((row, col));
-    }
-}
 
 /// The equations a contact point contributes in this step.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,30 +43,10 @@ impl Default for SpatialContactEquation {
     }
 }
 
-/// Per-step constants of one body's six equations.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BodyStep3 {
-    /// Coefficient of the `k+1` term (1, or 2 at k = 0).
-    pub c_next: f64,
-    /// Constant of the centre of mass's second difference:
-    /// `−2c[k] + c[k−1]`, or `−2c[0] − 2Δt·ċ(0)` at k = 0.
-    pub x_const: Vector3<f64>,
-    /// Constant of the momentum difference: `L[k−½]`, or `2·L(0)` at k = 0.
-    pub l_const: Vector3<f64>,
-    /// Centre of mass at `q[k]` (the moment reference).
-    pub com_k: Vector3<f64>,
-}
-
-impl Default for BodyStep3 {
-    fn default() -> Self {
-        Self {
-            c_next: 1.0,
-            x_const: Vector3::zeros(),
-            l_const: Vector3::zeros(),
-            com_k: Vector3::zeros(),
-        }
-    }
-}
+/// Per-step constants of one body's six equations: `b` the centre of
+/// mass's constant (`−2c[k] + c[k−1]`, or `−2c[0] − 2Δt·ċ(0)` at k = 0),
+/// `ang` the momentum's (`L[k−½]`, or `2·L(0)` at k = 0).
+pub type BodyStep3 = BodyStep<Space3>;
 
 /// The discrete angular momentum of a body over a step (inertial frame):
 /// `L = R[k]·exp(ψ/2)·I·ψ/Δt` with `ψ = log(R[k]ᵀ·R[k+1])`, and its
@@ -147,10 +123,9 @@ pub struct SpatialFbdData {
     pub knee_dir: Vec<[Vector3<f64>; 2]>,
     /// Per body, `L[k+½]` at the last evaluated iterate.
     pub l_next: Vec<Vector3<f64>>,
-    /// Per body, the sum of applied forces at k of the last evaluation (N).
-    pub force: Vec<Vector3<f64>>,
-    /// Per body, the sum of applied moments about its CoM at k (N·m).
-    pub moment: Vec<Vector3<f64>>,
+    /// Per body, the sum of applied forces and moments (about its CoM) at
+    /// k of the last evaluation (N, N·m).
+    pub wrench: Vec<Wrench<Space3>>,
     /// `L[k+½]` of every body at the accepted `q[k+1]` over a step of
     /// `l_carry_dt`, handed to the next step's [`prepare_step`] as its
     /// `L[k−½]` (the same function of the same rotations, so the same
@@ -231,8 +206,7 @@ impl SpatialFbdData {
             slip_len: vec![1.0; mech.contacts.len()],
             fixed_direction: vec![false; mech.contacts.len()],
             slip_n: vec![0.0; mech.contacts.len()],
-            force: vec![Vector3::zeros(); nb],
-            moment: vec![Vector3::zeros(); nb],
+            wrench: vec![Wrench::default(); nb],
             rot_d: vec![Matrix3::zeros(); nb],
             kin_next_q: vec![f64::NAN; mech.layout().nq],
             next_is_candidate: false,
@@ -281,8 +255,8 @@ pub fn prepare_step(
         data.body[b] = match history {
             History::Previous => BodyStep3 {
                 c_next: 1.0,
-                x_const: -2.0 * com_k + data.kin_prev.com[b],
-                l_const: if carried && data.l_carry_dt == dt {
+                b: (-2.0 * com_k + data.kin_prev.com[b]).into(),
+                ang: if carried && data.l_carry_dt == dt {
                     data.l_carry[b]
                 } else {
                     half_momentum_value(
@@ -291,17 +265,18 @@ pub fn prepare_step(
                         &mech.bodies[b].inertia,
                         dt,
                     )
-                },
-                com_k,
+                }
+                .into(),
+                com_k: com_k.into(),
             },
             History::Initial { qdot } => {
                 let v = data.kin.com_jacobian(mech, b).apply(qdot);
                 let w = data.kin.angular_jacobian(mech, b).apply(qdot);
                 BodyStep3 {
                     c_next: 2.0,
-                    x_const: -2.0 * com_k - 2.0 * dt * v,
-                    l_const: 2.0 * momentum(mech, &data.kin, b, &w),
-                    com_k,
+                    b: (-2.0 * com_k - 2.0 * dt * v).into(),
+                    ang: (2.0 * momentum(mech, &data.kin, b, &w)).into(),
+                    com_k: com_k.into(),
                 }
             }
         };
@@ -353,24 +328,7 @@ pub fn pattern_key(data: &SpatialFbdData) -> u64 {
 /// Pushes every structural `(row, col)` of the Jacobian for the current
 /// states.
 pub fn pattern(mech: &SpatialMechanism, data: &SpatialFbdData, entries: &mut Vec<(usize, usize)>) {
-    let mut sink = PatternSink(entries);
-    force_entries(mech, data, &mut sink);
-    position_entries(mech, &Surface::default(), data, &mut sink);
-}
-
-#[inline]
-fn v3(z: &[f64], i: usize) -> Vector3<f64> {
-    Vector3::new(z[i], z[i + 1], z[i + 2])
-}
-
-#[inline]
-fn frame_force(eq: &SpatialContactEquation, f: Vector3<f64>) -> Vector3<f64> {
-    let [t1, n, t2] = eq.frame;
-    Vector3::new(
-        f[0] * t1[0] + f[1] * n[0] + f[2] * t2[0],
-        f[0] * t1[1] + f[1] * n[1] + f[2] * t2[1],
-        f[0] * t1[2] + f[1] * n[2] + f[2] * t2[2],
-    )
+    assembly::pattern(mech, &Surface::default(), data, entries);
 }
 
 /// The child and parent bodies of joint `j` (0–2) of slot `s`.
@@ -389,7 +347,8 @@ fn slot_of(point: usize) -> usize {
     point / 3
 }
 
-/// Residual `r(z)` and, through `jac`, the analytic Jacobian.
+/// Residual `r(z)` and, through `jac`, the analytic Jacobian
+/// ([`crate::assembly::eval`]).
 pub fn eval<S: JacobianSink>(
     mech: &SpatialMechanism,
     surface: &Surface,
@@ -398,314 +357,244 @@ pub fn eval<S: JacobianSink>(
     r: &mut [f64],
     jac: &mut S,
 ) {
-    let lay = mech.layout();
-    assert_eq!(z.len(), lay.dim(), "unknown vector has the wrong length");
-    assert_eq!(r.len(), lay.dim(), "residual vector has the wrong length");
-    if data.kin_next_q[..] != z[..lay.nq] {
-        data.kin_next.eval(mech, &z[..lay.nq]);
-        data.kin_next_q.copy_from_slice(&z[..lay.nq]);
+    assembly::eval(mech, surface, data, z, r, jac);
+}
+
+#[inline]
+fn columns(cols: &Columns, mut f: impl FnMut(usize, &[f64; 3])) {
+    for (i, v) in cols.iter() {
+        f(*i, &[v.x, v.y, v.z]);
     }
-    data.next_is_candidate = false;
-    let dt = data.dt;
-    for (b, body) in mech.bodies.iter().enumerate() {
-        data.force[b] = Vector3::new(0.0, -body.mass * mech.gravity, 0.0);
-        data.moment[b] = Vector3::zeros();
+}
+
+/// The hexapod's part of the assembly.
+impl FbdModel for SpatialMechanism {
+    type S = Space3;
+    type Data = SpatialFbdData;
+    type Ground = Surface;
+    const IMPLICIT_SLIP: bool = true;
+
+    fn dims(&self) -> Dims {
+        self.layout().dims()
     }
-    let kin = &data.kin;
-    for s in 0..lay.legs {
-        let (u, l) = (upper_body(s), lower_body(s));
-        let [z0, z1, z2] = data.axes[s];
-        let tau = data.torque[s];
-        // Hip: body on upper link.
-        let p = kin.point(mech, s, PointKind::Hip);
-        let f = v3(z, lay.hip_force(s, 0));
-        let m = z[lay.hip_moment(s)] * data.hip_dir[s] + tau[0] * z0 + tau[1] * z1;
-        for (b, sgn) in [(u, 1.0), (0, -1.0)] {
-            data.force[b] += sgn * f;
-            data.moment[b] += sgn * ((p - data.body[b].com_k).cross(&f) + m);
+
+    #[inline]
+    fn gravity(&self) -> f64 {
+        self.gravity
+    }
+
+    #[inline]
+    fn mass(&self, b: usize) -> f64 {
+        self.bodies[b].mass
+    }
+
+    #[inline]
+    fn rotation_projection(&self, _: usize) -> f64 {
+        1.0
+    }
+
+    #[inline]
+    fn gains(&self, data: &SpatialFbdData) -> (f64, f64, f64) {
+        (data.dt, data.position_gain, data.limit_gain)
+    }
+
+    fn kinematics_next(&self, data: &mut SpatialFbdData, q: &[f64], _: bool) {
+        if data.kin_next_q[..] != q[..] {
+            data.kin_next.eval(self, q);
+            data.kin_next_q.copy_from_slice(q);
         }
-        // Knee: upper link on lower link.
-        let p = kin.point(mech, s, PointKind::Knee);
-        let f = v3(z, lay.knee_force(s, 0));
-        let [b1, b2] = data.knee_dir[s];
-        let m = z[lay.knee_moment(s, 0)] * b1 + z[lay.knee_moment(s, 1)] * b2 + tau[2] * z2;
-        for (b, sgn) in [(l, 1.0), (u, -1.0)] {
-            data.force[b] += sgn * f;
-            data.moment[b] += sgn * ((p - data.body[b].com_k).cross(&f) + m);
-        }
+        data.next_is_candidate = false;
     }
-    for (li, lim) in mech.limits.iter().enumerate() {
-        let j = lim.joint.index();
-        let m = z[lay.limit_moment(li)] * data.axes[lim.slot][j];
-        let (child, parent) = joint_bodies(lim.slot, j);
-        data.moment[child] += m;
-        data.moment[parent] -= m;
+
+    #[inline]
+    fn body_step<'a>(&self, data: &'a SpatialFbdData, b: usize) -> &'a BodyStep3 {
+        &data.body[b]
     }
-    for (c, spec) in mech.contacts.iter().enumerate() {
-        let eq = &data.contact[c];
-        let f = frame_force(eq, v3(z, lay.contact_force(c, 0)));
-        let p = kin.point(mech, slot_of(spec.point), spec.kind);
-        data.force[spec.body] += f;
-        data.moment[spec.body] += (p - data.body[spec.body].com_k).cross(&f);
+
+    #[inline]
+    fn wrenches<'a>(&self, data: &'a mut SpatialFbdData) -> &'a mut [Wrench<Space3>] {
+        &mut data.wrench
     }
-    for (b, body) in mech.bodies.iter().enumerate() {
-        let bs = &data.body[b];
-        let row = lay.body_row(b);
-        let acc = (bs.c_next * data.kin_next.com[b] + bs.x_const) / (dt * dt);
-        let l_next = if S::ACTIVE {
-            let (l, d) = half_momentum(&data.kin.rot[b], &data.kin_next.rot[b], &body.inertia, dt);
+
+    #[inline]
+    fn com_next(&self, data: &SpatialFbdData, b: usize) -> [f64; 3] {
+        data.kin_next.com[b].into()
+    }
+
+    /// `(c·L[k+½] − L[k−½])/Δt` ([`half_momentum`]); with `jacobian`, its
+    /// derivative for [`FbdModel::rotation_entries`].
+    fn angular_rate(&self, data: &mut SpatialFbdData, b: usize, jacobian: bool) -> [f64; 3] {
+        let bs = data.body[b];
+        let (dt, inertia) = (data.dt, &self.bodies[b].inertia);
+        let (r_k, r_next) = (&data.kin.rot[b], &data.kin_next.rot[b]);
+        let l_next = if jacobian {
+            let (l, d) = half_momentum(r_k, r_next, inertia, dt);
             data.rot_d[b] = d * (bs.c_next / dt);
             l
         } else {
-            half_momentum_value(&data.kin.rot[b], &data.kin_next.rot[b], &body.inertia, dt)
+            half_momentum_value(r_k, r_next, inertia, dt)
         };
         data.l_next[b] = l_next;
-        let dl = (bs.c_next * l_next - bs.l_const) / dt;
-        for i in 0..3 {
-            r[row + i] = body.mass * acc[i] - data.force[b][i];
-            r[row + 3 + i] = dl[i] - data.moment[b][i];
-        }
+        ((bs.c_next * l_next - Vector3::from(bs.ang)) / dt).into()
     }
-    let k = data.position_gain;
-    for (c, spec) in mech.contacts.iter().enumerate() {
-        let eq = &data.contact[c];
-        let row = lay.contact_row(c);
-        let fl = v3(z, lay.contact_force(c, 0));
-        let p = data.kin_next.point(mech, slot_of(spec.point), spec.kind);
-        let out = &mut r[row..row + 3];
-        match eq.state {
-            SpatialState::Free => rows::free_rows(fl.as_slice(), out),
-            SpatialState::Stick { anchor } => {
-                let f = frame_force(eq, fl);
-                rows::stick_rows(
-                    k,
-                    p.as_slice(),
-                    &anchor,
-                    eq.regularization,
-                    f.as_slice(),
-                    out,
-                );
-            }
-            SpatialState::Slide { dir } => {
-                let d = p - data.kin.point(mech, slot_of(spec.point), spec.kind);
-                let [t1, _, t2] = eq.frame;
-                let s = [
-                    d.x * t1[0] + d.y * t1[1] + d.z * t1[2],
-                    d.x * t2[0] + d.y * t2[1] + d.z * t2[2],
-                ];
-                let (u, len) = if data.fixed_direction[c] {
-                    (dir, f64::INFINITY)
-                } else {
-                    slip_direction(s, dir, data.slip_bias)
-                };
-                data.slip_hat[c] = u;
-                data.slip_len[c] = len;
-                data.slip_n[c] = fl[1];
-                rows::slide_rows(
-                    fl.as_slice(),
-                    &u,
-                    eq.mu_dynamic,
-                    k,
-                    clearance(surface, [p.x, p.y, p.z]),
-                    eq.regularization,
-                    out,
-                );
-            }
-        }
-    }
-    for (li, lim) in mech.limits.iter().enumerate() {
-        let lambda = z[lay.limit_moment(li)];
-        let eq = &data.limit[li];
-        r[lay.limit_row(li)] = rows::limit_row(eq, lambda, z[lim.q_index], data.limit_gain);
-    }
-    if S::ACTIVE {
-        force_entries(mech, data, jac);
-        position_entries(mech, surface, data, jac);
-    }
-}
 
-/// `−∂(r × f)/∂f = −[r]×` into the rotation rows of body `b` for the three
-/// force columns starting at `col` (times `sgn`).
-#[inline]
-fn arm_entries<S: JacobianSink>(jac: &mut S, row: usize, col: usize, r: &Vector3<f64>, sgn: f64) {
-    let h = so3::hat(r);
-    for i in 0..3 {
-        for j in 0..3 {
-            if i != j {
-                jac.add(row + 3 + i, col + j, -sgn * h[(i, j)]);
-            }
-        }
-        jac.add(row + i, col + i, -sgn);
+    #[inline]
+    fn reactions(&self) -> usize {
+        2 * self.legs.len()
     }
-}
 
-/// Entries in the force columns (constant within a step).
-fn force_entries<S: JacobianSink>(mech: &SpatialMechanism, data: &SpatialFbdData, jac: &mut S) {
-    let lay = mech.layout();
-    let kin = &data.kin;
-    for s in 0..lay.legs {
-        let (u, l) = (upper_body(s), lower_body(s));
-        let p = kin.point(mech, s, PointKind::Hip);
-        for (b, sgn) in [(u, 1.0), (0, -1.0)] {
-            let row = lay.body_row(b);
-            arm_entries(
-                jac,
-                row,
-                lay.hip_force(s, 0),
-                &(p - data.body[b].com_k),
-                sgn,
-            );
-            for i in 0..3 {
-                jac.add(row + 3 + i, lay.hip_moment(s), -sgn * data.hip_dir[s][i]);
+    /// Reaction `2s` is slot `s`'s hip (body on upper link: force, the
+    /// constraint moment along `z0 × z1`, torques `τ1·z0 + τ2·z1`), `2s + 1`
+    /// its knee (upper on lower link: force, constraint moments along `b1`
+    /// and `b2`, torque `τ3·z2`).
+    fn reaction(&self, data: &SpatialFbdData, i: usize) -> Reaction<Space3> {
+        let lay = self.layout();
+        let s = i / 2;
+        let [z0, z1, z2] = data.axes[s];
+        let tau = data.torque[s];
+        if i.is_multiple_of(2) {
+            Reaction {
+                child: upper_body(s),
+                parent: 0,
+                point: data.kin.point(self, s, PointKind::Hip).into(),
+                force_col: lay.hip_force(s, 0),
+                torque: (tau[0] * z0 + tau[1] * z1).into(),
+                moments: [(lay.hip_moment(s), data.hip_dir[s].into()), (0, [0.0; 3])],
+                n_moments: 1,
             }
-        }
-        let p = kin.point(mech, s, PointKind::Knee);
-        for (b, sgn) in [(l, 1.0), (u, -1.0)] {
-            let row = lay.body_row(b);
-            arm_entries(
-                jac,
-                row,
-                lay.knee_force(s, 0),
-                &(p - data.body[b].com_k),
-                sgn,
-            );
-            for m in 0..2 {
-                for i in 0..3 {
-                    jac.add(
-                        row + 3 + i,
-                        lay.knee_moment(s, m),
-                        -sgn * data.knee_dir[s][m][i],
-                    );
-                }
+        } else {
+            let [b1, b2] = data.knee_dir[s];
+            Reaction {
+                child: lower_body(s),
+                parent: upper_body(s),
+                point: data.kin.point(self, s, PointKind::Knee).into(),
+                force_col: lay.knee_force(s, 0),
+                torque: (tau[2] * z2).into(),
+                moments: [
+                    (lay.knee_moment(s, 0), b1.into()),
+                    (lay.knee_moment(s, 1), b2.into()),
+                ],
+                n_moments: 2,
             }
         }
     }
-    for (c, spec) in mech.contacts.iter().enumerate() {
+
+    #[inline]
+    fn contact<'a>(&self, data: &'a SpatialFbdData, c: usize) -> ContactView<'a, Space3> {
         let eq = &data.contact[c];
-        let p = kin.point(mech, slot_of(spec.point), spec.kind);
-        let arm = p - data.body[spec.body].com_k;
-        let row = lay.body_row(spec.body);
-        let crow = lay.contact_row(c);
-        for (m, e) in eq.frame.iter().enumerate() {
-            let e = Vector3::new(e[0], e[1], e[2]);
-            let col = lay.contact_force(c, m);
-            let me = arm.cross(&e);
-            for i in 0..3 {
-                jac.add(row + i, col, -e[i]);
-                jac.add(row + 3 + i, col, -me[i]);
-            }
-            match eq.state {
-                SpatialState::Free => jac.add(crow + m, col, 1.0),
-                SpatialState::Stick { .. } => {
-                    for i in 0..3 {
-                        jac.add(crow + i, col, eq.regularization * e[i]);
-                    }
-                }
-                SpatialState::Slide { .. } => match m {
-                    0 => jac.add(crow, col, 1.0),
-                    2 => jac.add(crow + 2, col, 1.0),
-                    _ => {
-                        let u = data.slip_hat[c];
-                        jac.add(crow, col, u[0] * eq.mu_dynamic);
-                        jac.add(crow + 1, col, eq.regularization);
-                        jac.add(crow + 2, col, u[1] * eq.mu_dynamic);
-                    }
-                },
-            }
+        ContactView {
+            body: self.contacts[c].body,
+            frame: eq.frame,
+            state: match &eq.state {
+                SpatialState::Free => RowState::Free,
+                SpatialState::Stick { anchor } => RowState::Stick(anchor),
+                SpatialState::Slide { dir } => RowState::Slide(dir),
+            },
+            mu_dynamic: eq.mu_dynamic,
+            regularization: eq.regularization,
         }
     }
-    for (li, lim) in mech.limits.iter().enumerate() {
+
+    #[inline]
+    fn contact_point(&self, data: &SpatialFbdData, c: usize, at: At) -> [f64; 3] {
+        let kin = match at {
+            At::Now => &data.kin,
+            At::Next => &data.kin_next,
+        };
+        let spec = &self.contacts[c];
+        kin.point(self, slot_of(spec.point), spec.kind).into()
+    }
+
+    #[inline]
+    fn stop<'a>(&self, data: &'a SpatialFbdData, l: usize) -> StopView<'a, Space3> {
+        let lim = &self.limits[l];
         let j = lim.joint.index();
-        let axis = data.axes[lim.slot][j];
-        let col = lay.limit_moment(li);
         let (child, parent) = joint_bodies(lim.slot, j);
-        for i in 0..3 {
-            jac.add(lay.body_row(child) + 3 + i, col, -axis[i]);
-            jac.add(lay.body_row(parent) + 3 + i, col, axis[i]);
+        StopView {
+            child,
+            parent,
+            axis: data.axes[lim.slot][j].into(),
+            q_index: lim.q_index,
+            equation: &data.limit[l],
         }
-        jac.add(
-            lay.limit_row(li),
-            col,
-            rows::limit_row_diagonal(&data.limit[li]),
-        );
     }
-}
 
-/// Entries in the `q[k+1]` columns at the iterate `kin_next`.
-fn position_entries<S: JacobianSink>(
-    mech: &SpatialMechanism,
-    surface: &Surface,
-    data: &SpatialFbdData,
-    jac: &mut S,
-) {
-    let lay = mech.layout();
-    let kin = &data.kin_next;
-    let dt2 = data.dt * data.dt;
-    for (b, body) in mech.bodies.iter().enumerate() {
-        let row = lay.body_row(b);
-        let g = body.mass * data.body[b].c_next / dt2;
-        let jc: Columns = kin.com_jacobian(mech, b);
-        for (i, v) in jc.iter() {
-            for a in 0..3 {
-                jac.add(row + a, *i, g * v[a]);
-            }
+    /// The step's own slip ([`slip_direction`]), or the reference direction
+    /// of a slide that keeps it ([`SpatialFbdData::fixed_direction`]).
+    fn slide_direction(
+        &self,
+        data: &mut SpatialFbdData,
+        c: usize,
+        p: &[f64; 3],
+        dir: &[f64],
+        normal: f64,
+    ) -> [f64; 2] {
+        let spec = &self.contacts[c];
+        let d = Vector3::from(*p) - data.kin.point(self, slot_of(spec.point), spec.kind);
+        let [t1, _, t2] = data.contact[c].frame;
+        let s = [
+            d.x * t1[0] + d.y * t1[1] + d.z * t1[2],
+            d.x * t2[0] + d.y * t2[1] + d.z * t2[2],
+        ];
+        let dir = [dir[0], dir[1]];
+        let (u, len) = if data.fixed_direction[c] {
+            (dir, f64::INFINITY)
+        } else {
+            slip_direction(s, dir, data.slip_bias)
+        };
+        data.slip_hat[c] = u;
+        data.slip_len[c] = len;
+        data.slip_n[c] = normal;
+        u
+    }
+
+    #[inline]
+    fn slip(&self, data: &SpatialFbdData, c: usize) -> Slip {
+        Slip {
+            dir: data.slip_hat[c],
+            len: data.slip_len[c],
+            normal: data.slip_n[c],
+            bias: data.slip_bias,
         }
-        let jw = kin.angular_jacobian(mech, b);
+    }
+
+    #[inline]
+    fn clearance(&self, surface: &Surface, p: &[f64; 3]) -> f64 {
+        clearance(surface, *p)
+    }
+
+    #[inline]
+    fn slope(&self, surface: &Surface, p: &[f64; 3]) -> [f64; 2] {
+        surface.gradient(p[0], p[2])
+    }
+
+    #[inline]
+    fn com_columns(&self, data: &SpatialFbdData, b: usize, f: impl FnMut(usize, &[f64; 3])) {
+        columns(&data.kin_next.com_jacobian(self, b), f);
+    }
+
+    #[inline]
+    fn contact_columns(&self, data: &SpatialFbdData, c: usize, f: impl FnMut(usize, &[f64; 3])) {
+        let spec = &self.contacts[c];
+        let slot = slot_of(spec.point);
+        columns(&data.kin_next.contact_jacobian(self, slot, spec.kind), f);
+    }
+
+    /// `∂(c·L[k+½]/Δt)/∂q_i = D·ω_i`, `ω_i` the body's angular Jacobian
+    /// column.
+    fn rotation_entries<J: JacobianSink>(
+        &self,
+        data: &SpatialFbdData,
+        b: usize,
+        row: usize,
+        jac: &mut J,
+    ) {
         let d = &data.rot_d[b];
-        for (i, w) in jw.iter() {
+        for (i, w) in data.kin_next.angular_jacobian(self, b).iter() {
             let col = d * w;
             for a in 0..3 {
-                jac.add(row + 3 + a, *i, col[a]);
+                jac.add(row + a, *i, col[a]);
             }
-        }
-    }
-    let k = data.position_gain;
-    for (c, spec) in mech.contacts.iter().enumerate() {
-        let row = lay.contact_row(c);
-        match data.contact[c].state {
-            SpatialState::Free => {}
-            SpatialState::Stick { .. } => {
-                let jp = kin.contact_jacobian(mech, slot_of(spec.point), spec.kind);
-                for (i, v) in jp.iter() {
-                    for a in 0..3 {
-                        jac.add(row + a, *i, k * v[a]);
-                    }
-                }
-            }
-            SpatialState::Slide { .. } => {
-                let p = kin.point(mech, slot_of(spec.point), spec.kind);
-                let [gx, gz] = surface.gradient(p.x, p.z);
-                let jp = kin.contact_jacobian(mech, slot_of(spec.point), spec.kind);
-                // Friction rows: μ·N·∂ŝ/∂s·∂s/∂q, ∂ŝ/∂s = (I − ŝŝᵀ)/|w|
-                // (Coulomb) or I/ε (regularised, |w| < ε).
-                let eq = &data.contact[c];
-                let [t1, _, t2] = eq.frame;
-                let u = data.slip_hat[c];
-                let len = data.slip_len[c];
-                let g = eq.mu_dynamic * data.slip_n[c] / len;
-                let p2 = if len > data.slip_bias {
-                    [
-                        [1.0 - u[0] * u[0], -u[0] * u[1]],
-                        [-u[1] * u[0], 1.0 - u[1] * u[1]],
-                    ]
-                } else {
-                    [[1.0, 0.0], [0.0, 1.0]]
-                };
-                for (i, v) in jp.iter() {
-                    jac.add(row + 1, *i, k * (v[1] - gx * v[0] - gz * v[2]));
-                    let ds = [
-                        v[0] * t1[0] + v[1] * t1[1] + v[2] * t1[2],
-                        v[0] * t2[0] + v[1] * t2[1] + v[2] * t2[2],
-                    ];
-                    jac.add(row, *i, g * (p2[0][0] * ds[0] + p2[0][1] * ds[1]));
-                    jac.add(row + 2, *i, g * (p2[1][0] * ds[0] + p2[1][1] * ds[1]));
-                }
-            }
-        }
-    }
-    for (li, lim) in mech.limits.iter().enumerate() {
-        if data.limit[li].state.is_at() {
-            jac.add(lay.limit_row(li), lim.q_index, data.limit_gain);
         }
     }
 }

@@ -2,7 +2,9 @@
 //! leg, its upper and lower link; hips, knees, contact points and joint
 //! limits; the index layout of one step's unknowns and equations.
 
+use crate::assembly::Dims;
 use crate::mechanism::{ContactPoints, ContactSpec, PointKind};
+use crate::space::{Space, Space3};
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::nalgebra::Matrix3;
 use fbd_kinematics::{Joint, JointLimits};
@@ -83,45 +85,58 @@ pub struct SpatialLayout {
 }
 
 impl SpatialLayout {
+    /// The generic layout of the assembly ([`crate::assembly::Dims`]): the
+    /// one source of where each block of unknowns and equations sits.
+    pub fn dims(&self) -> Dims {
+        Dims {
+            nq: self.nq,
+            reaction_unknowns: 9 * self.legs,
+            bodies: self.bodies,
+            contacts: self.contacts,
+            limits: self.limits,
+            lin: Space3::LIN,
+            ang: Space3::ANG,
+        }
+    }
     /// Unknowns = equations: `nq + 9·legs + 3·contacts + limits`.
     pub fn dim(&self) -> usize {
-        self.nq + 9 * self.legs + 3 * self.contacts + self.limits
+        self.dims().dim()
     }
     /// Column of the hip force of slot `s`, component `axis` (x, y, z).
     pub fn hip_force(&self, s: usize, axis: usize) -> usize {
-        self.nq + 9 * s + axis
+        self.dims().reaction() + 9 * s + axis
     }
     /// Column of the hip's constraint moment (along `z0 × z1`).
     pub fn hip_moment(&self, s: usize) -> usize {
-        self.nq + 9 * s + 3
+        self.dims().reaction() + 9 * s + 3
     }
     /// Column of the knee force of slot `s`, component `axis`.
     pub fn knee_force(&self, s: usize, axis: usize) -> usize {
-        self.nq + 9 * s + 4 + axis
+        self.dims().reaction() + 9 * s + 4 + axis
     }
     /// Column of the knee's constraint moment `i` (0: along `b1`, 1: `b2`).
     pub fn knee_moment(&self, s: usize, i: usize) -> usize {
-        self.nq + 9 * s + 7 + i
+        self.dims().reaction() + 9 * s + 7 + i
     }
     /// Column of contact `c`'s force component `i` (0: `t1`, 1: `n`, 2: `t2`).
     pub fn contact_force(&self, c: usize, i: usize) -> usize {
-        self.nq + 9 * self.legs + 3 * c + i
+        self.dims().contact_force(c, i)
     }
     /// Column of limit `l`'s stop moment (N·m, towards larger angles).
     pub fn limit_moment(&self, l: usize) -> usize {
-        self.nq + 9 * self.legs + 3 * self.contacts + l
+        self.dims().limit_moment(l)
     }
     /// First row of body `b` (3 translation rows, then 3 rotation rows).
     pub fn body_row(&self, b: usize) -> usize {
-        6 * b
+        self.dims().body_row(b)
     }
     /// First row of contact `c`'s three equations.
     pub fn contact_row(&self, c: usize) -> usize {
-        6 * self.bodies + 3 * c
+        self.dims().contact_row(c)
     }
     /// Row of limit `l`.
     pub fn limit_row(&self, l: usize) -> usize {
-        6 * self.bodies + 3 * self.contacts + l
+        self.dims().limit_row(l)
     }
 }
 

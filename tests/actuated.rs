@@ -167,7 +167,7 @@ fn torque_limit_saturates() {
     let (model, rows, _) = run_ok(&p);
     let peak = rows
         .iter()
-        .flat_map(|r| r.torque)
+        .flat_map(|r| r.torque.iter().copied())
         .fold(0.0f64, |m, t| m.max(t.abs()));
     assert!((peak - 15.0).abs() < 1e-12, "peak torque {peak}");
     let (worst, at) = worst_body_imbalance(&model, &rows);

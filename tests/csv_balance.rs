@@ -53,7 +53,9 @@ fn read_rows(path: &Path, model: &Model) -> Vec<StepRecord> {
         .enumerate()
         .map(|(k, rec)| {
             let rec = rec.unwrap();
-            let mut r = StepRecord::zeroed(k, f(&rec, "t"), model.mech.contacts.len());
+            let lay = model.mech.layout();
+            let mut r = StepRecord::new(lay.nq, lay.contacts, lay.joints);
+            (r.step, r.t) = (k, f(&rec, "t"));
             for (i, c) in q_cols.iter().enumerate() {
                 r.q[i] = f(&rec, c);
             }
@@ -142,7 +144,7 @@ rate_deg = [140.0, -60.0]
     // Joint forces are far from zero in a tumbling flight.
     let peak = rows
         .iter()
-        .flat_map(|r| r.joint_force)
+        .flat_map(|r| r.joint_force.iter().copied())
         .map(|f| f[0].hypot(f[1]))
         .fold(0.0, f64::max);
     assert!(peak > 1.0, "peak joint force {peak} N");

@@ -46,7 +46,7 @@ fn centre_of_mass_falls_exactly_g_t2_over_2_from_rest() {
             c[0]
         );
         // From rest, a uniform field exerts no internal forces.
-        for f in r.joint_force {
+        for f in &r.joint_force {
             assert!(
                 f[0].abs() < 1e-6 && f[1].abs() < 1e-6,
                 "t = {}: joint force {f:?} in free fall",
@@ -113,13 +113,13 @@ fn trajectory_error_is_second_order() {
         assert!(summary.error.is_none(), "{:?}", summary.error);
         let last = rows.last().unwrap();
         assert!((last.t - t_end).abs() < 1e-9);
-        last.q
+        last.q.clone()
     };
     let reference = final_q(0.004 / 64.0);
     let err = |dt: f64| {
         let q = final_q(dt);
         q.iter()
-            .zip(reference)
+            .zip(&reference)
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max)
     };

@@ -16,7 +16,7 @@ fn check_rows(p: &PlanarParams) -> (Vec<usize>, Vec<usize>) {
     let nc = model.mech.contacts.len();
     let (mut stick, mut slide) = (vec![0; nc], vec![0; nc]);
     for (k, r) in rows.iter().enumerate() {
-        for c in 0..r.contacts {
+        for c in 0..r.contacts() {
             let (fa, n, name) = (r.fa[c], r.n[c], &model.mech.contacts[c].name);
             let tol = 1e-6 * (1.0 + n.abs());
             // Feet are rigid; knees and hips are bumpers of documented

@@ -34,7 +34,11 @@ fn a_sliding_foot_whose_knee_leaves_its_stop_does_not_chatter() {
     let mut data = Data::new(&model);
     let mut rows = Vec::with_capacity(model.steps);
     for _ in 0..model.steps {
-        rows.push(step(&model, &mut data).expect("the landing completes"));
+        rows.push(
+            step(&model, &mut data)
+                .expect("the landing completes")
+                .clone(),
+        );
     }
 
     let events = data.events.len() + data.limit_events.len();
@@ -61,7 +65,7 @@ fn a_sliding_foot_whose_knee_leaves_its_stop_does_not_chatter() {
     // Coulomb's law on every row (forces of the step's first (sub)step).
     let (mus, mud) = (p.friction.mu_static, p.friction.mu_dynamic);
     for r in &rows {
-        for c in 0..r.contacts {
+        for c in 0..r.contacts() {
             let (fa, n, name) = (r.fa[c], r.n[c], &model.mech.contacts[c].name);
             let tol = 1e-6 * (1.0 + n.abs());
             match r.state[c] {

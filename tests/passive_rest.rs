@@ -18,7 +18,7 @@ fn the_passive_experiment_runs_to_rest() {
     assert!((last.t - p.duration).abs() < 1e-9);
     // At rest on the ground: every point in contact sticks and pushes, the
     // others are clear of it, and together they carry the weight.
-    assert_eq!(last.contacts, 6);
+    assert_eq!(last.contacts(), 6);
     for c in 0..6 {
         match last.state[c] {
             StateCode::St2 => assert!(last.n[c] > 0.0, "point {c}: n = {}", last.n[c]),

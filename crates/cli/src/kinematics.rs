@@ -45,7 +45,7 @@ pub fn planar_geometry(c: &PlanarConfig) -> PlanarGeometry {
 }
 
 /// Hip, knee and tip of legs 3 and 4 for planar coordinates `q` (z = 0).
-pub fn planar_points(geometry: &PlanarGeometry, q: &[f64; 7]) -> Vec<LegPoints> {
+pub fn planar_points(geometry: &PlanarGeometry, q: &[f64]) -> Vec<LegPoints> {
     let (chains, ix) = PlanarChains::two_leg(geometry);
     let mut data = chains.new_data();
     chains.eval_positions(q, &mut data);

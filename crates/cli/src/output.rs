@@ -528,7 +528,7 @@ impl EventJson {
         Self {
             t: times.value(e.step, e.t),
             leg: Some(e.leg),
-            point: e.point.to_owned(),
+            point: e.point.as_str().to_owned(),
             from: e.from.as_str().to_owned(),
             to: e.to.as_str().to_owned(),
         }
@@ -816,7 +816,8 @@ mod tests {
         ];
         for contacts in &layouts {
             let slots = ContactSlots::of(contacts);
-            let mut r = StepRecord::zeroed(3, 0.03, contacts.len());
+            let mut r = StepRecord::new(7, contacts.len(), 4);
+            (r.step, r.t) = (3, 0.03);
             for c in 0..contacts.len() {
                 r.point[c] = [10.0 + c as f64, 20.0 + c as f64];
                 r.state[c] = StateCode::St2;

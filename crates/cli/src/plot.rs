@@ -228,7 +228,7 @@ impl PlotRecorder {
             self.tip[2 * leg].push(t, p[0]);
             self.tip[2 * leg + 1].push(t, p[1]);
         }
-        for c in 0..self.names.len().min(r.contacts) {
+        for c in 0..self.names.len().min(r.contacts()) {
             self.touched[c] |= r.state[c] != StateCode::St1;
             self.normal[c].push(t, r.n[c]);
             self.tangential[c].push(t, r.fa[c]);
@@ -1063,7 +1063,7 @@ mod tests {
         let steps = 600_000;
         let dt = 1e-5;
         let mut rec = PlotRecorder::new(&tips, (steps - 1) as f64 * dt);
-        let mut r = StepRecord::zeroed(0, 0.0, 2);
+        let mut r = StepRecord::new(7, 2, 4);
         for k in 0..steps {
             let t = k as f64 * dt;
             r.step = k;

@@ -23,10 +23,10 @@ const STANCE_INTERVALS: usize = 10;
 struct Collector {
     snapshot_steps: Vec<usize>,
     plot: PlotRecorder,
-    snapshots: Vec<(f64, [f64; 7])>,
+    snapshots: Vec<(f64, Vec<f64>)>,
     last: Option<StepRecord>,
     peak_contact: Vec<PeakForce>,
-    peak_joint: [f64; 4],
+    peak_joint: Vec<f64>,
 }
 
 impl Collector {
@@ -45,23 +45,26 @@ impl Collector {
             plot,
             last: None,
             peak_contact: vec![PeakForce::default(); contacts.len()],
-            peak_joint: [0.0; 4],
+            peak_joint: vec![0.0; model.mech.joints.len()],
         }
     }
 
     fn push(&mut self, r: &StepRecord) {
         self.plot.push(r);
         if self.snapshot_steps.binary_search(&r.step).is_ok() {
-            self.snapshots.push((r.t, r.q));
+            self.snapshots.push((r.t, r.q.clone()));
         }
-        for (c, p) in self.peak_contact.iter_mut().enumerate().take(r.contacts) {
+        for (c, p) in self.peak_contact.iter_mut().enumerate() {
             p.n = p.n.max(r.n[c].abs());
             p.fa = p.fa.max(r.fa[c].abs());
         }
         for (p, f) in self.peak_joint.iter_mut().zip(&r.joint_force) {
             *p = p.max(f[0].hypot(f[1]));
         }
-        self.last = Some(*r);
+        match &mut self.last {
+            Some(last) => last.clone_from(r),
+            None => self.last = Some(r.clone()),
+        }
     }
 
     /// Completes the plot data after the run.
@@ -69,11 +72,11 @@ impl Collector {
         mut self,
         model: &Model,
         run: &RunSummary,
-    ) -> (PlotData, Option<StepRecord>, Vec<PeakForce>, [f64; 4]) {
-        if let Some(r) = self.last
+    ) -> (PlotData, Option<StepRecord>, Vec<PeakForce>, Vec<f64>) {
+        if let Some(r) = &self.last
             && self.snapshots.last().map(|s| s.0) != Some(r.t)
         {
-            self.snapshots.push((r.t, r.q));
+            self.snapshots.push((r.t, r.q.clone()));
         }
         let chains: &PlanarChains = &model.mech.chains;
         let ix = &model.index;
@@ -122,7 +125,7 @@ fn summary(
     rows: usize,
     last: Option<StepRecord>,
     peaks: Vec<PeakForce>,
-    joints: [f64; 4],
+    joints: Vec<f64>,
 ) -> Summary {
     use fbd_contact::StateCode;
     let times = StepTimes::new(model.params.dt);
@@ -184,7 +187,7 @@ fn summary(
             .joints
             .iter()
             .map(|j| j.name.clone())
-            .zip(joints)
+            .zip(joints.iter().copied())
             .collect(),
         peak_joint_force_max: joints.iter().copied().fold(0.0, f64::max),
         final_energy: last.map(|r| Energy {

@@ -73,6 +73,12 @@ impl PointKind {
     }
 }
 
+impl std::fmt::Display for PointKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
 /// A point of a body that can touch the terrain.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactSpec {

@@ -10,9 +10,6 @@ use pyo3::types::PyList;
 
 use crate::errors::{config_error, guard, simulation_error};
 
-/// Joints of the planar model: hip3, knee3, hip4, knee4.
-const JOINTS: usize = fbd_sim::record::MAX_JOINTS;
-
 /// The planar model stepped one Δt at a time, for controllers written in
 /// Python. `config` is a configuration as for `fbd.run` (None, a path, TOML
 /// text or a dict).
@@ -29,24 +26,30 @@ pub struct Simulator {
     data: Data,
     source: String,
     contacts: Vec<String>,
-    /// The record of the step solved last.
+    /// The record of the step solved last (a copy: a failed step's retries
+    /// overwrite `data.record`), `None` before the first or after `reset()`.
     last: Option<StepRecord>,
     /// The error that stopped the simulation (steps refuse until reset).
     failed: Option<SimError>,
 }
 
 impl Simulator {
-    fn torques_from(&self, torques: &Bound<'_, PyAny>) -> PyResult<[f64; JOINTS]> {
-        let mut tau = [0.0; JOINTS];
+    /// The record of the step solved last.
+    fn last(&self) -> Option<&StepRecord> {
+        self.last.as_ref()
+    }
+
+    fn torques_from(&self, torques: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
         let n = self.data.fbd.torque.len();
-        let fill = |tau: &mut [f64; JOINTS], v: &[f64]| -> PyResult<()> {
+        let mut tau = vec![0.0; n];
+        let fill = |tau: &mut [f64], v: &[f64]| -> PyResult<()> {
             if v.len() != n {
                 return Err(PyValueError::new_err(format!(
                     "torques: expected {n} joint torques (hip3, knee3, hip4, knee4), got {}",
                     v.len()
                 )));
             }
-            tau[..n].copy_from_slice(v);
+            tau.copy_from_slice(v);
             Ok(())
         };
         if let Ok(a) = torques.cast::<PyArray1<f64>>() {
@@ -128,7 +131,11 @@ impl Simulator {
         let result = py.detach(|| {
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
                 for i in 1..=steps {
-                    *last = Some(fbd_sim::step(model, data)?);
+                    let r = fbd_sim::step(model, data)?;
+                    match last {
+                        Some(l) => l.clone_from(r),
+                        None => *last = Some(r.clone()),
+                    }
                     // Ctrl-C between steps of a long call.
                     if i.is_multiple_of(crate::run::SIGNAL_CHECK)
                         && i < steps
@@ -254,7 +261,7 @@ impl Simulator {
     fn contact_forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let n = self.contacts.len();
         let a = Array2::from_shape_fn((n, 2), |(c, j)| {
-            self.last
+            self.last()
                 .map_or(0.0, |r| if j == 0 { r.fa[c] } else { r.n[c] })
         });
         PyArray2::from_owned_array(py, a)
@@ -265,7 +272,7 @@ impl Simulator {
     #[getter]
     fn contact_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         let n = self.contacts.len();
-        let a = Array2::from_shape_fn((n, 2), |(c, j)| match self.last {
+        let a = Array2::from_shape_fn((n, 2), |(c, j)| match self.last() {
             Some(r) => r.point[c][j],
             None => self.data.fbd.kin.pos[self.model.mech.contacts[c].point][j],
         });
@@ -276,8 +283,9 @@ impl Simulator {
     /// solved step (N, parent on child, inertial frame), shape `(4, 2)`.
     #[getter]
     fn joint_forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let a = Array2::from_shape_fn((JOINTS, 2), |(j, i)| {
-            self.last.map_or(0.0, |r| r.joint_force[j][i])
+        let joints = self.data.fbd.torque.len();
+        let a = Array2::from_shape_fn((joints, 2), |(j, i)| {
+            self.last().map_or(0.0, |r| r.joint_force[j][i])
         });
         PyArray2::from_owned_array(py, a)
     }
@@ -286,13 +294,16 @@ impl Simulator {
     /// hip4, knee4.
     #[getter]
     fn joint_torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.last.map_or([0.0; JOINTS], |r| r.torque))
+        match self.last() {
+            Some(r) => PyArray1::from_slice(py, &r.torque),
+            None => PyArray1::from_vec(py, vec![0.0; self.data.fbd.torque.len()]),
+        }
     }
 
     /// Kinetic and potential energy at the last solved step (J).
     #[getter]
     fn energy(&self) -> Option<(f64, f64)> {
-        self.last.map(|r| (r.kinetic, r.potential))
+        self.last().map(|r| (r.kinetic, r.potential))
     }
 
     /// Events so far, as `fbd.run` lists them: contact, joint-limit and

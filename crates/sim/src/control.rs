@@ -178,7 +178,7 @@ impl Control {
 /// torques [`Data::external_torque`] as given when set (no saturation),
 /// else the configured controller's. No allocation.
 pub fn joint_torques(model: &Model, data: &mut Data) {
-    if let Some(tau) = data.external_torque {
+    if let Some(tau) = &data.external_torque {
         let n = data.fbd.torque.len();
         assert!(
             n <= tau.len(),
@@ -251,7 +251,7 @@ mod tests {
         let mut moved = false;
         for _ in 0..controlled.steps {
             let ra = step(&passive, &mut a).unwrap();
-            b.external_torque = Some([0.0; 4]);
+            b.external_torque = Some(vec![0.0; 4]);
             let rb = step(&controlled, &mut b).unwrap();
             assert_eq!(ra.q, rb.q, "zero external torques = passive joints");
             // The controller's own torques, computed outside and fed back.
@@ -260,9 +260,8 @@ mod tests {
             probe.q.copy_from_slice(&c.q);
             probe.q_prev.copy_from_slice(&c.q_prev);
             super::joint_torques(&controlled, &mut probe);
-            let mut tau = [0.0; 4];
-            tau.copy_from_slice(&probe.fbd.torque);
-            c.external_torque = Some(tau);
+            let tau = probe.fbd.torque.clone();
+            c.external_torque = Some(tau.clone());
             let rc = step(&controlled, &mut c).unwrap();
             assert_eq!(rc.torque, tau);
             moved |= rc.q != ra.q;

@@ -20,7 +20,6 @@ impl RunData<Model> {
         let lay = mech.layout();
         let mut fbd = FbdData::new(mech);
         fbd_dynamics::set_configuration(mech, &mut fbd, &model.params.q0);
-        let nc = mech.contacts.len().min(crate::record::MAX_CONTACTS);
         RunData::build(Parts {
             q0: model.params.q0.to_vec(),
             dim: lay.dim(),
@@ -28,7 +27,7 @@ impl RunData<Model> {
             initial_states: model.initial_states.clone(),
             fbd,
             solver: NewtonSolver::new(model.newton),
-            record: StepRecord::zeroed(0, 0.0, nc),
+            record: StepRecord::new(lay.nq, lay.contacts, lay.joints),
             control: (),
         })
     }

@@ -25,10 +25,6 @@ pub struct Model {
     pub newton: NewtonParams,
     /// Steps to solve: `round(duration/dt) + 1`.
     pub steps: usize,
-    /// Hexapod leg number (3 or 4) of each contact point.
-    pub contact_leg: Vec<usize>,
-    /// Kind of each contact point: `"tip"`, `"knee"` or `"hip"`.
-    pub contact_point: Vec<&'static str>,
     /// Compliance of each contact point's anchor at the model's Δt (m/N):
     /// 0 for the feet (rigid, as the paper's), `β_b·Δt²/M` for knees and
     /// hips ([`ContactParams::bumper_regularization`]).
@@ -239,9 +235,6 @@ impl Model {
         let mech = mech.with_limits(limited);
         pd_stability(p, &mech, &index)?;
         let contact = ContactParams::default();
-        let contact_leg: Vec<usize> = mech.contacts.iter().map(|c| c.leg).collect();
-        let contact_point: Vec<&'static str> =
-            mech.contacts.iter().map(|c| c.kind.as_str()).collect();
         let contact_bumper: Vec<f64> = mech
             .contacts
             .iter()
@@ -254,10 +247,10 @@ impl Model {
         let mut kin = mech.chains.new_data();
         mech.chains.eval_positions(&p.q0, &mut kin);
         let mut initial_states = Vec::with_capacity(mech.contacts.len());
-        for (ci, c) in mech.contacts.iter().enumerate() {
+        for c in &mech.contacts {
             let state = ContactState::initial(kin.pos[c.point], &p.terrain, contact.initial_tol)
                 .map_err(|depth| SimError::InitialPenetration {
-                    leg: format!("leg{}", contact_leg[ci]),
+                    leg: format!("leg{}", c.leg),
                     point: c.name.clone(),
                     depth,
                 })?;
@@ -277,13 +270,11 @@ impl Model {
                 ..NewtonParams::default()
             },
             steps: steps_f as usize + 1,
-            contact_leg,
             contact_compliance: contact_bumper
                 .iter()
                 .map(|b| b * p.dt * p.dt / total_mass)
                 .collect(),
             contact_bumper,
-            contact_point,
             initial_states,
             limit_joint,
             limit_leg,

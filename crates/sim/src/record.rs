@@ -1,7 +1,8 @@
-//! What one step produces: a fixed-size, allocation-free record, and
-//! contact events.
+//! What one step produces: a record sized from the model's layout
+//! (allocated once, refilled every step), and contact events.
 
 use fbd_contact::StateCode;
+use fbd_dynamics::PointKind;
 use fbd_kinematics::Joint;
 
 /// The state of a joint limit as written to the output files.
@@ -36,41 +37,38 @@ impl LimitCode {
     }
 }
 
-/// Most contact points a planar record holds (tips, knees, hips of 2 legs).
-pub const MAX_CONTACTS: usize = 6;
-/// Joints of the planar model (hip3, knee3, hip4, knee4).
-pub const MAX_JOINTS: usize = 4;
-
-/// Everything known about step `k` once it is solved. Row `k` of
-/// `trajectory.csv` (docs/reference.md).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Everything known about step `k` once it is solved: row `k` of
+/// `trajectory.csv` (docs/reference.md). Sized from the model's layout
+/// ([`StepRecord::new`]) once per run and refilled every step.
+#[derive(Clone, Debug, PartialEq)]
 pub struct StepRecord {
     /// Step index k.
     pub step: usize,
     /// Time k·Δt (s).
     pub t: f64,
-    /// `q[k] = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)` (m, rad).
-    pub q: [f64; 7],
-    /// Number of contact points in use (`contacts` entries below are valid).
-    pub contacts: usize,
-    /// Inertial position of each contact point at `q[k]` (m).
-    pub point: [[f64; 2]; MAX_CONTACTS],
+    /// `q[k]`: body `(Rx, Ry, φz)` then the joint angles in the model's
+    /// joint order (m, rad).
+    pub q: Vec<f64>,
+    /// Inertial position of each contact point at `q[k]` (m), in the
+    /// model's contact order.
+    pub point: Vec<[f64; 2]>,
     /// State each contact point was solved in at step k.
-    pub state: [StateCode; MAX_CONTACTS],
+    pub state: Vec<StateCode>,
     /// Tangential contact force along the terrain tangent (N).
-    pub fa: [f64; MAX_CONTACTS],
+    pub fa: Vec<f64>,
     /// Normal contact force along the terrain normal (N).
-    pub n: [f64; MAX_CONTACTS],
-    /// Joint forces, parent on child, inertial frame (N):
-    /// `[hip3, knee3, hip4, knee4]`.
-    pub joint_force: [[f64; 2]; MAX_JOINTS],
+    pub n: Vec<f64>,
+    /// Joint forces, parent on child, inertial frame (N), in the model's
+    /// joint order (the two-leg model: hip3, knee3, hip4, knee4).
+    pub joint_force: Vec<[f64; 2]>,
     /// Joint torques (N·m), same order.
-    pub torque: [f64; MAX_JOINTS],
-    /// State of each joint's limit at step k, same order.
-    pub limit: [LimitCode; MAX_JOINTS],
+    pub torque: Vec<f64>,
+    /// State of each joint's limit at step k, same order (free for a joint
+    /// without one).
+    pub limit: Vec<LimitCode>,
     /// Moment of each joint's limit stop (N·m, positive towards larger
     /// joint angles; 0 when free), same order.
-    pub limit_moment: [f64; MAX_JOINTS],
+    pub limit_moment: Vec<f64>,
     /// Kinetic energy at k, from central-difference velocities (J).
     pub kinetic: f64,
     /// Gravitational potential energy at k (J).
@@ -82,27 +80,31 @@ pub struct StepRecord {
 }
 
 impl StepRecord {
-    /// A record of step `step` at time `t` with `contacts` points in use and
-    /// every other field zero (states ST1).
-    pub fn zeroed(step: usize, t: f64, contacts: usize) -> Self {
+    /// A record for a model of `nq` coordinates, `contacts` contact points
+    /// and `joints` joints, every value zero (states ST1, limits free).
+    pub fn new(nq: usize, contacts: usize, joints: usize) -> Self {
         Self {
-            step,
-            t,
-            q: [0.0; 7],
-            contacts,
-            point: [[0.0; 2]; MAX_CONTACTS],
-            state: [StateCode::St1; MAX_CONTACTS],
-            fa: [0.0; MAX_CONTACTS],
-            n: [0.0; MAX_CONTACTS],
-            joint_force: [[0.0; 2]; MAX_JOINTS],
-            torque: [0.0; MAX_JOINTS],
-            limit: [LimitCode::Free; MAX_JOINTS],
-            limit_moment: [0.0; MAX_JOINTS],
+            step: 0,
+            t: 0.0,
+            q: vec![0.0; nq],
+            point: vec![[0.0; 2]; contacts],
+            state: vec![StateCode::St1; contacts],
+            fa: vec![0.0; contacts],
+            n: vec![0.0; contacts],
+            joint_force: vec![[0.0; 2]; joints],
+            torque: vec![0.0; joints],
+            limit: vec![LimitCode::Free; joints],
+            limit_moment: vec![0.0; joints],
             kinetic: 0.0,
             potential: 0.0,
             newton_iterations: 0,
             state_trials: 0,
         }
+    }
+
+    /// Contact points of the record.
+    pub fn contacts(&self) -> usize {
+        self.state.len()
     }
 }
 
@@ -115,9 +117,9 @@ pub struct Event {
     pub step: usize,
     /// Index of the contact point in the mechanism.
     pub contact: usize,
-    /// Kind of contact point: `"tip"`, `"knee"` or `"hip"` (with `leg`, the
-    /// mechanism's contact name, e.g. `tip4`).
-    pub point: &'static str,
+    /// Kind of contact point: tip, knee or hip (with `leg`, the point's
+    /// identity; [`PointKind::as_str`] names it in `events.csv`).
+    pub point: PointKind,
     /// Hexapod leg number (3 or 4).
     pub leg: usize,
     /// Previous state.

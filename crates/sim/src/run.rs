@@ -68,6 +68,6 @@ pub fn run_until(model: &Model, stop: &AtomicBool, on_row: impl FnMut(&StepRecor
 /// small runs).
 pub fn run_collect(model: &Model) -> (Vec<StepRecord>, RunSummary) {
     let mut rows = Vec::with_capacity(model.steps / model.params.stride.max(1) + 1);
-    let summary = run(model, |r| rows.push(*r));
+    let summary = run(model, |r| rows.push(r.clone()));
     (rows, summary)
 }

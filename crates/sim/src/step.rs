@@ -16,14 +16,15 @@
 
 use crate::energy;
 use crate::engine::{Engine, LimitInfo, Settings};
-use crate::record::{LimitCode, MAX_CONTACTS, MAX_JOINTS, StepRecord};
+use crate::record::{LimitCode, StepRecord};
 use crate::rules::regularization;
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
 use fbd_contact::{ContactState, Terrain, Trial};
 use fbd_dynamics::{
-    ContactEquation, FbdData, History, LimitEquation, advance, evaluate_next, prepare_step,
+    ContactEquation, FbdData, History, LimitEquation, PointKind, advance, evaluate_next,
+    prepare_step,
 };
 use fbd_solver::{NewtonReport, NewtonSolver, SolverError};
 
@@ -33,9 +34,9 @@ use fbd_solver::{NewtonReport, NewtonSolver, SolverError};
 ///
 /// # Errors
 /// A [`SimError`] naming the step and time.
-pub fn step(model: &Model, data: &mut Data) -> Result<StepRecord, SimError> {
+pub fn step<'a>(model: &Model, data: &'a mut Data) -> Result<&'a StepRecord, SimError> {
     crate::engine::step::step(model, data)?;
-    Ok(data.record)
+    Ok(&data.record)
 }
 
 impl Engine for Model {
@@ -44,7 +45,7 @@ impl Engine for Model {
     type Ground = Terrain;
     type Fbd = FbdData;
     type Record = StepRecord;
-    type Torques = [f64; MAX_JOINTS];
+    type Torques = Vec<f64>;
     type ControlData = ();
 
     fn settings(&self) -> Settings<'_, Terrain> {
@@ -67,8 +68,9 @@ impl Engine for Model {
     fn contact_body(&self, c: usize) -> usize {
         self.mech.contacts[c].body
     }
-    fn contact_identity(&self, c: usize) -> (usize, &'static str) {
-        (self.contact_leg[c], self.contact_point[c])
+    fn contact_identity(&self, c: usize) -> (usize, PointKind) {
+        let spec = &self.mech.contacts[c];
+        (spec.leg, spec.kind)
     }
     fn contact_name(&self, c: usize) -> &str {
         &self.mech.contacts[c].name
@@ -162,7 +164,7 @@ impl Engine for Model {
         chains.eval_positions(&data.grid_q_prev, &mut data.fbd.kin_prev);
     }
     fn make_record(&self, data: &mut Data, iterations: usize, trials: usize, h: f64) {
-        data.record = make_record(self, data, iterations, trials, h);
+        make_record(self, data, iterations, trials, h);
     }
     fn add_to_record(record: &mut StepRecord, iterations: usize, trials: usize) {
         record.newton_iterations += iterations;
@@ -233,41 +235,43 @@ fn beta(model: &Model, h: f64) -> f64 {
     regularization(model.contact.regularization, h)
 }
 
+/// Fills `data.record` (sized from the layout by [`Data::new`]) for the
+/// solved step.
 fn make_record(
     model: &Model,
-    data: &Data,
+    data: &mut Data,
     newton_iterations: usize,
     state_trials: usize,
     h: f64,
-) -> StepRecord {
+) {
     let mech = &model.mech;
     let lay = mech.layout();
-    let nc = mech.contacts.len().min(MAX_CONTACTS);
-    let mut r = StepRecord::zeroed(data.k, data.k as f64 * model.dt(), nc);
+    let r = &mut data.record;
+    r.step = data.k;
+    r.t = data.k as f64 * model.dt();
     r.potential = energy::potential(mech, &data.fbd.kin);
     r.newton_iterations = newton_iterations;
     r.state_trials = state_trials;
-    r.q.copy_from_slice(&data.q[..7]);
-    for c in 0..nc {
-        r.point[c] = data.fbd.kin.pos[mech.contacts[c].point];
+    r.q.copy_from_slice(&data.q[..lay.nq]);
+    for (c, spec) in mech.contacts.iter().enumerate() {
+        r.point[c] = data.fbd.kin.pos[spec.point];
         r.state[c] = data.trial[c].code();
         r.fa[c] = data.z[lay.contact_fa(c)];
         r.n[c] = data.z[lay.contact_n(c)];
     }
-    for j in 0..lay.joints.min(MAX_JOINTS) {
+    for j in 0..lay.joints {
         r.joint_force[j] = [data.z[lay.joint_force(j, 0)], data.z[lay.joint_force(j, 1)]];
         r.torque[j] = data.fbd.torque[j];
+        r.limit[j] = LimitCode::Free;
+        r.limit_moment[j] = 0.0;
     }
     for (l, &j) in mech.limits.iter().enumerate() {
-        if j < MAX_JOINTS {
-            r.limit[j] = LimitCode::of(&data.limit_trial[l]);
-            r.limit_moment[j] = data.z[lay.limit_moment(l)];
-        }
+        r.limit[j] = LimitCode::of(&data.limit_trial[l]);
+        r.limit_moment[j] = data.z[lay.limit_moment(l)];
     }
     r.kinetic = if data.k == 0 {
         energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)
     } else {
         energy::kinetic_central(mech, &data.fbd.kin_prev, &data.fbd.kin_next, h)
     };
-    r
 }

@@ -7,9 +7,9 @@
 //! counters. (The wrapper lives in a dev-dependency because the workspace
 //! forbids `unsafe_code`, and implementing `GlobalAlloc` needs `unsafe impl`.)
 //!
-//! The counters are process-global, so this file holds a single `#[test]`:
-//! no other test thread of this binary can allocate inside the measured
-//! region. Anything counted there is a real allocation (never hidden).
+//! The counters are process-global, so this file runs as a plain `main`
+//! without libtest's harness: no other thread of this binary can allocate
+//! inside the measured region. Anything counted there is a real allocation (never hidden).
 
 mod common;
 
@@ -29,7 +29,6 @@ fn assert_no_heap(what: &str, stats: Stats) {
     );
 }
 
-#[test]
 fn second_solve_of_a_pattern_does_not_allocate() {
     let root_a: Vec<f64> = (0..10)
         .map(|i| 0.8 * ((i as f64) * 0.7 + 0.3).sin())
@@ -152,4 +151,21 @@ fn second_solve_of_a_pattern_does_not_allocate() {
     assert!(ok);
     assert!(chords > 100, "chord steps taken: {chords}");
     assert_no_heap("chord steps and refactorisations", stats);
+}
+
+/// The test runs without libtest's harness (`harness = false` in
+/// `Cargo.toml`): the allocation counters are process-global, and the
+/// harness's main thread allocates while it waits for a test to finish, at
+/// a moment no test controls (a rare false failure). Here nothing but the
+/// test runs. `--list` answers as libtest does, for cargo-nextest.
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.iter().any(|a| a == "--list") {
+        if !args.iter().any(|a| a == "--ignored") {
+            println!("second_solve_of_a_pattern_does_not_allocate: test");
+        }
+        return;
+    }
+    second_solve_of_a_pattern_does_not_allocate();
+    println!("test second_solve_of_a_pattern_does_not_allocate ... ok");
 }

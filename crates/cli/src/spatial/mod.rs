@@ -524,7 +524,7 @@ mod tests {
                 t: 0.005,
                 step: 5,
                 contact: 3,
-                point: "tip",
+                point: PointKind::Tip,
                 leg: 4,
                 from: StateCode::St1,
                 to: StateCode::St2,

@@ -218,7 +218,7 @@ impl Collector {
                     let t = run
                         .events
                         .iter()
-                        .find(|e| e.leg == n && e.point == PointKind::Tip.as_str() && pred(e))
+                        .find(|e| e.leg == n && e.point == PointKind::Tip && pred(e))
                         .map(|e| times.value(e.step, e.t));
                     (format!("leg{n}"), t)
                 })

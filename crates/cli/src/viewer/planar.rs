@@ -31,10 +31,13 @@ pub struct PlanarScene<'a> {
     decimator: Decimator,
     rows_planned: usize,
     rows: usize,
-    /// Contact states of the previous row (no allocation per row).
-    last_state: Option<[StateCode; fbd_sim::record::MAX_CONTACTS]>,
+    /// Contact states of the previous row (empty before the first; no
+    /// allocation per row).
+    last_state: Vec<StateCode>,
     /// The last row pushed, when it is not a frame (kept by `finish`).
-    pending: Option<(usize, StepRecord)>,
+    pending: Option<usize>,
+    /// The record of that row (a buffer reused from row to row).
+    pending_record: Option<StepRecord>,
     /// Indices into the chains' points of the drawn points, in order.
     drawn: Vec<usize>,
     touched: Vec<bool>,
@@ -142,8 +145,9 @@ impl<'a> PlanarScene<'a> {
             decimator: Decimator::new(rows_planned),
             rows_planned,
             rows: 0,
-            last_state: None,
+            last_state: Vec::with_capacity(ncontacts),
             pending: None,
+            pending_record: None,
             drawn,
             touched: vec![false; ncontacts],
             torques_used: false,
@@ -164,15 +168,20 @@ impl<'a> PlanarScene<'a> {
             self.touched[c] |= *s != StateCode::St1;
         }
         self.torques_used |= r.torque.iter().any(|t| *t != 0.0);
-        let changed = self.last_state.is_some_and(|s| s[..nc] != r.state[..nc]);
+        let changed = !self.last_state.is_empty() && self.last_state[..] != r.state[..nc];
         let last = row + 1 >= self.rows_planned;
         let keep = self.decimator.keep(row, changed, last);
-        self.last_state = Some(r.state);
+        self.last_state.clear();
+        self.last_state.extend_from_slice(&r.state[..nc]);
         if keep {
             self.frame(row, r);
             self.pending = None;
         } else {
-            self.pending = Some((row, *r));
+            self.pending = Some(row);
+            match &mut self.pending_record {
+                Some(p) => p.clone_from(r),
+                None => self.pending_record = Some(r.clone()),
+            }
         }
     }
 
@@ -236,7 +245,7 @@ impl<'a> PlanarScene<'a> {
 
     /// Completes the scene: terrain, events, panels.
     pub fn finish(mut self, events: &[Event]) -> Scene {
-        if let Some((row, r)) = self.pending.take() {
+        if let (Some(row), Some(r)) = (self.pending.take(), self.pending_record.take()) {
             self.frame(row, &r);
         }
         let mut s = std::mem::take(&mut self.scene);

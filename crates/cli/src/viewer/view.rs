@@ -114,7 +114,8 @@ fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliEr
     let mut out = Vec::with_capacity(table.rows.len());
     for (r, row) in table.rows.iter().enumerate() {
         let t = table.number(row, r, t_col)?;
-        let mut rec = StepRecord::zeroed(r, t, contacts.len());
+        let mut rec = StepRecord::new(q_cols.len(), contacts.len(), joints.len());
+        (rec.step, rec.t) = (r, t);
         for (k, &c) in q_cols.iter().enumerate() {
             rec.q[k] = table.number(row, r, c)?;
         }
@@ -186,8 +187,8 @@ fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, CliError> {
             t: table.number(row, r, t)?,
             step: 0,
             contact,
-            point: model.contact_point[contact],
-            leg: model.contact_leg[contact],
+            point: model.mech.contacts[contact].kind,
+            leg: model.mech.contacts[contact].leg,
             from: state(cell(row, from)).ok_or_else(|| bad("from"))?,
             to: state(cell(row, to)).ok_or_else(|| bad("to"))?,
         });

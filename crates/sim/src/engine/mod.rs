@@ -35,7 +35,7 @@ pub use data::RunData;
 
 use crate::SimError;
 use fbd_contact::{ContactMode, ContactParams, ContactTrial, Friction};
-use fbd_dynamics::History;
+use fbd_dynamics::{History, PointKind};
 use fbd_kinematics::{Joint, JointLimits};
 use fbd_solver::{NewtonReport, SolverError};
 
@@ -155,8 +155,8 @@ pub trait Engine: Sized {
     }
     /// The body contact point `c` belongs to.
     fn contact_body(&self, c: usize) -> usize;
-    /// Hexapod leg number and kind (`"tip"`, `"knee"`, `"hip"`) of point `c`.
-    fn contact_identity(&self, c: usize) -> (usize, &'static str);
+    /// Hexapod leg number and kind (tip, knee, hip) of point `c`.
+    fn contact_identity(&self, c: usize) -> (usize, PointKind);
     /// Name of point `c` in messages.
     fn contact_name(&self, c: usize) -> &str;
     /// Joint limit `l`.

@@ -31,7 +31,7 @@ use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
     half_momentum_and_rotation, pattern, pattern_key, prepare_step, set_previous,
 };
-use fbd_dynamics::{History, LimitEquation, NoJacobian};
+use fbd_dynamics::{History, LimitEquation, NoJacobian, PointKind};
 use fbd_kinematics::nalgebra::Vector3;
 use fbd_solver::{NewtonReport, NewtonSolver, NewtonSystem, SolverError};
 
@@ -103,9 +103,9 @@ impl Engine for SpatialModel {
     fn contact_body(&self, c: usize) -> usize {
         self.mech.contacts[c].body
     }
-    fn contact_identity(&self, c: usize) -> (usize, &'static str) {
+    fn contact_identity(&self, c: usize) -> (usize, PointKind) {
         let spec = &self.mech.contacts[c];
-        (spec.leg, spec.kind.as_str())
+        (spec.leg, spec.kind)
     }
     fn contact_name(&self, c: usize) -> &str {
         &self.mech.contacts[c].name

@@ -19,12 +19,22 @@ use crate::viewer::{self, planar::PlanarScene};
 /// Snapshot intervals of `stance.svg` (one more snapshot than this).
 const STANCE_INTERVALS: usize = 10;
 
+/// What the summary and the last stance need of the last row (copied row by
+/// row into one buffer).
+struct LastRow {
+    step: usize,
+    t: f64,
+    kinetic: f64,
+    potential: f64,
+    q: Vec<f64>,
+}
+
 /// What the plots and the summary need, gathered step by step.
 struct Collector {
     snapshot_steps: Vec<usize>,
     plot: PlotRecorder,
     snapshots: Vec<(f64, Vec<f64>)>,
-    last: Option<StepRecord>,
+    last: Option<LastRow>,
     peak_contact: Vec<PeakForce>,
     peak_joint: Vec<f64>,
 }
@@ -62,8 +72,20 @@ impl Collector {
             *p = p.max(f[0].hypot(f[1]));
         }
         match &mut self.last {
-            Some(last) => last.clone_from(r),
-            None => self.last = Some(r.clone()),
+            Some(last) => {
+                (last.step, last.t) = (r.step, r.t);
+                (last.kinetic, last.potential) = (r.kinetic, r.potential);
+                last.q.copy_from_slice(&r.q);
+            }
+            None => {
+                self.last = Some(LastRow {
+                    step: r.step,
+                    t: r.t,
+                    kinetic: r.kinetic,
+                    potential: r.potential,
+                    q: r.q.clone(),
+                })
+            }
         }
     }
 
@@ -72,7 +94,7 @@ impl Collector {
         mut self,
         model: &Model,
         run: &RunSummary,
-    ) -> (PlotData, Option<StepRecord>, Vec<PeakForce>, Vec<f64>) {
+    ) -> (PlotData, Option<LastRow>, Vec<PeakForce>, Vec<f64>) {
         if let Some(r) = &self.last
             && self.snapshots.last().map(|s| s.0) != Some(r.t)
         {
@@ -123,7 +145,7 @@ fn summary(
     names: &[String],
     run: &RunSummary,
     rows: usize,
-    last: Option<StepRecord>,
+    last: Option<LastRow>,
     peaks: Vec<PeakForce>,
     joints: Vec<f64>,
 ) -> Summary {

@@ -101,13 +101,43 @@ pub struct PlotData {
 /// than the plot's width in pixels).
 pub const COLUMNS: usize = 1000;
 
+/// The time columns of a run from `t0` to `t1`: [`COLUMNS`] equal spans.
+/// A recorder of several curves finds a step's column once
+/// ([`Self::of`]) and hands it to each curve ([`MinMax::push_at`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Columns {
+    t0: f64,
+    per_second: f64,
+}
+
+impl Columns {
+    /// For times from `t0` to `t1`.
+    pub fn new(t0: f64, t1: f64) -> Self {
+        let span = if t1 > t0 { t1 - t0 } else { 1.0 };
+        Self {
+            t0,
+            per_second: COLUMNS as f64 / span,
+        }
+    }
+
+    /// The column of time `t`: `⌊(t − t0)·COLUMNS / span⌋`. The floor is
+    /// taken by truncation and a correction below zero (exactly
+    /// `f64::floor` for every value in `i64`'s range) rather than by a
+    /// libm call: it runs for every recorded step.
+    #[inline]
+    pub fn of(&self, t: f64) -> i64 {
+        let x = (t - self.t0) * self.per_second;
+        let c = x as i64;
+        if (c as f64) > x { c - 1 } else { c }
+    }
+}
+
 /// Reduces a curve on the fly to at most four points per time column: the
 /// first, the smallest, the largest and the last value, in time order. A
 /// non-finite value breaks the line.
 #[derive(Clone, Debug)]
 pub struct MinMax {
-    t0: f64,
-    per_second: f64,
+    columns: Columns,
     column: Option<i64>,
     first: (f64, f64),
     lo: (f64, f64),
@@ -119,10 +149,8 @@ pub struct MinMax {
 impl MinMax {
     /// For times from `t0` to `t1`.
     pub fn new(t0: f64, t1: f64) -> Self {
-        let span = if t1 > t0 { t1 - t0 } else { 1.0 };
         Self {
-            t0,
-            per_second: COLUMNS as f64 / span,
+            columns: Columns::new(t0, t1),
             column: None,
             first: (0.0, 0.0),
             lo: (0.0, 0.0),
@@ -134,15 +162,22 @@ impl MinMax {
 
     /// Adds the value `v` at time `t` (times increasing).
     pub fn push(&mut self, t: f64, v: f64) {
+        self.push_at(self.columns.of(t), t, v);
+    }
+
+    /// [`Self::push`] with `t`'s column `c` already found
+    /// ([`Columns::of`] of the same `t0`, `t1`). The common case, a finite
+    /// value in the current column, is two compares whose branches are seldom
+    /// taken (a new extreme); the branches cost half what selects of the
+    /// `(t, v)` pairs did.
+    #[inline]
+    pub fn push_at(&mut self, c: i64, t: f64, v: f64) {
         if !v.is_finite() {
-            self.flush();
-            if self.out.last().is_some_and(|p| p.1.is_finite()) {
-                self.out.push((t, f64::NAN));
-            }
+            self.missing(t);
             return;
         }
-        let c = ((t - self.t0) * self.per_second).floor() as i64;
         if self.column == Some(c) {
+            // Strict comparisons: the earliest extreme is kept.
             if v < self.lo.1 {
                 self.lo = (t, v);
             }
@@ -157,6 +192,15 @@ impl MinMax {
             self.lo = (t, v);
             self.hi = (t, v);
             self.last = (t, v);
+        }
+    }
+
+    /// A non-finite value at `t`: the line breaks.
+    #[cold]
+    fn missing(&mut self, t: f64) {
+        self.flush();
+        if self.out.last().is_some_and(|p| p.1.is_finite()) {
+            self.out.push((t, f64::NAN));
         }
     }
 
@@ -186,6 +230,8 @@ impl MinMax {
 /// Gathers the curves of a planar run step by step (every step, not only
 /// the rows of `trajectory.csv`).
 pub struct PlotRecorder {
+    /// The time columns of every curve below.
+    columns: Columns,
     names: Vec<String>,
     points: Vec<(usize, PointKind)>,
     tips: [Option<usize>; 2],
@@ -206,6 +252,7 @@ impl PlotRecorder {
     pub fn new(contacts: &[ContactSpec], t_end: f64) -> Self {
         let m = || MinMax::new(0.0, t_end);
         Self {
+            columns: Columns::new(0.0, t_end),
             names: contacts.iter().map(|c| c.name.clone()).collect(),
             points: contacts.iter().map(|c| (c.leg, c.kind)).collect(),
             tips: ContactSlots::of(contacts).tips,
@@ -221,28 +268,38 @@ impl PlotRecorder {
     }
 
     /// Adds one step.
+    ///
+    /// Runs for every step of the run, inside the stepping loop: the step's
+    /// time column is found once for all the curves ([`Columns::of`]), and
+    /// nothing is looked up by name or allocated.
     pub fn push(&mut self, r: &StepRecord) {
         let t = r.t;
+        let col = self.columns.of(t);
         for (leg, c) in self.tips.iter().enumerate() {
             let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
-            self.tip[2 * leg].push(t, p[0]);
-            self.tip[2 * leg + 1].push(t, p[1]);
+            self.tip[2 * leg].push_at(col, t, p[0]);
+            self.tip[2 * leg + 1].push_at(col, t, p[1]);
         }
-        for c in 0..self.names.len().min(r.contacts()) {
-            self.touched[c] |= r.state[c] != StateCode::St1;
-            self.normal[c].push(t, r.n[c]);
-            self.tangential[c].push(t, r.fa[c]);
+        let used = self.touched.len().min(r.contacts());
+        let rows = self.touched[..used]
+            .iter_mut()
+            .zip(&mut self.normal[..used])
+            .zip(&mut self.tangential[..used]);
+        for (c, ((touched, normal), tangential)) in rows.enumerate() {
+            *touched |= r.state[c] != StateCode::St1;
+            normal.push_at(col, t, r.n[c]);
+            tangential.push_at(col, t, r.fa[c]);
         }
-        for (k, m) in self.joints.iter_mut().enumerate() {
-            m.push(t, r.q[3 + k].to_degrees());
+        for (m, q) in self.joints.iter_mut().zip(&r.q[3..]) {
+            m.push_at(col, t, q.to_degrees());
         }
-        for (k, m) in self.torques.iter_mut().enumerate() {
-            m.push(t, r.torque[k]);
+        for (m, &tau) in self.torques.iter_mut().zip(&r.torque) {
+            m.push_at(col, t, tau);
+            self.torque_used |= tau != 0.0;
         }
-        self.torque_used |= r.torque.iter().any(|x| *x != 0.0);
-        self.energy[0].push(t, r.kinetic);
-        self.energy[1].push(t, r.potential);
-        self.energy[2].push(t, r.kinetic + r.potential);
+        self.energy[0].push_at(col, t, r.kinetic);
+        self.energy[1].push_at(col, t, r.potential);
+        self.energy[2].push_at(col, t, r.kinetic + r.potential);
     }
 
     /// The plot data; `stances` and `terrain` come from the caller.

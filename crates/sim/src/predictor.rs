@@ -143,8 +143,19 @@ fn differences_of<const N: usize>(v: f64) -> [f64; N] {
 /// differences `d` at the newest step: Newton's form `d[0] + Σ_{1≤j≤p}
 /// d[j]`, in which the differences of close values are exact and their
 /// small sum is added to `d[0]` last, so that it rounds about once.
-fn extrapolate(d: &[f64], p: usize) -> f64 {
-    let sum: f64 = d[1..=p].iter().sum();
+///
+/// The sum runs over every order with a test against `p` (the same for
+/// every unknown of a prediction, so the branch is always predicted), from
+/// the empty sum and in order, the additions of `d[1..=p].iter().sum()`:
+/// a fixed-length loop the compiler unrolls.
+#[inline]
+fn extrapolate<const N: usize>(d: &[f64; N], p: usize) -> f64 {
+    let mut sum: f64 = std::iter::empty::<f64>().sum();
+    for (j, &dj) in d.iter().enumerate().skip(1) {
+        if j <= p {
+            sum += dj;
+        }
+    }
     d[0] + sum
 }
 

@@ -8,7 +8,8 @@
 //!   evaluation of residual and Jacobian values.
 //! * [`NewtonSolver`] keeps, per pattern key, the CSC structure, a dense
 //!   `(row, col) → slot` map and faer's symbolic LU (computed once per
-//!   pattern), and, per dimension, the numeric LU storage; a full Newton
+//!   pattern; singleton rows are taken out of the LU and solved apart, see
+//!   the `lu` module), and, per dimension, the numeric LU storage; a full Newton
 //!   step refactors numerically into it, a chord step
 //!   ([`NewtonParams::chord_steps`]) reuses the kept factorisation. After
 //!   the first solve of a pattern, solving does not allocate.

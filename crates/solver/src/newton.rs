@@ -317,15 +317,16 @@ impl NewtonSolver {
                 self.entries.clear();
                 sys.pattern(&mut self.entries);
                 self.ws.prepare(n, self.entries.len());
-                let factors = match self.factors.iter().position(|f| f.dim() == n) {
+                let id = self.patterns.len();
+                let mut pattern = Pattern::build(id, n, &mut self.entries);
+                let m = pattern.m;
+                pattern.factors = match self.factors.iter().position(|f| f.dim() == m) {
                     Some(f) => f,
                     None => {
-                        self.factors.push(Factors::new(n, &mut self.ws.mem));
+                        self.factors.push(Factors::new(m, &mut self.ws.mem));
                         self.factors.len() - 1
                     }
                 };
-                let id = self.patterns.len();
-                let pattern = Pattern::build(id, n, &mut self.entries, factors);
                 self.symbolic_factorizations += 1;
                 self.patterns.push((key, pattern));
                 id
@@ -400,7 +401,7 @@ impl NewtonSolver {
     /// not have the system's dimension.
     pub fn solve_loaded(&mut self, dx: &mut [f64]) {
         let index = self.loaded.expect("solve_loaded: call load_jacobian first");
-        let pattern = &self.patterns[index].1;
+        let pattern = &mut self.patterns[index].1;
         let factors = &mut self.factors[pattern.factors];
         assert!(
             factors.holds(pattern),

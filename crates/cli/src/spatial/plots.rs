@@ -16,7 +16,8 @@ use plotters::style::RGBColor;
 use super::Layout;
 use super::csv::Slots;
 use crate::plot::{
-    self, EventMark, MinMax, PALETTE, PlotData, PlotResult, Style, Trace, stacked_time_chart,
+    self, Columns, EventMark, MinMax, PALETTE, PlotData, PlotResult, Style, Trace,
+    stacked_time_chart,
 };
 
 /// The colour of leg `n` (1–6): the palette's `n`-th colour, as in every
@@ -27,6 +28,8 @@ fn leg_color(n: usize) -> RGBColor {
 
 /// Gathers the curves of a run step by step.
 pub struct Recorder {
+    /// The time columns of every curve below.
+    columns: Columns,
     legs: Vec<usize>,
     normal: Vec<MinMax>,
     torque: Vec<[MinMax; 3]>,
@@ -39,6 +42,7 @@ impl Recorder {
     pub fn new(layout: &Layout, t_end: f64) -> Self {
         let m = || MinMax::new(0.0, t_end);
         Self {
+            columns: Columns::new(0.0, t_end),
             legs: layout.legs.clone(),
             normal: layout.legs.iter().map(|_| m()).collect(),
             torque: layout
@@ -52,24 +56,28 @@ impl Recorder {
     }
 
     /// Adds one step; `s` matches the record's rows to the layout.
+    ///
+    /// Runs for every step: the step's time column is found once for all
+    /// the curves ([`Columns::of`]).
     pub fn push(&mut self, r: &SpatialRecord, s: &Slots) {
         let t = r.t;
+        let col = self.columns.of(t);
         for (i, m) in self.normal.iter_mut().enumerate() {
-            m.push(t, s.tips[i].map_or(0.0, |c| r.contacts[c].normal));
+            m.push_at(col, t, s.tips[i].map_or(0.0, |c| r.contacts[c].normal));
         }
         for (i, ms) in self.torque.iter_mut().enumerate() {
             let tau = s.legs[i].map_or([0.0; 3], |l| r.legs[l].torque);
             for (m, v) in ms.iter_mut().zip(tau) {
-                m.push(t, v);
+                m.push_at(col, t, v);
             }
         }
-        self.body[0].push(t, r.q[1]);
+        self.body[0].push_at(col, t, r.q[1]);
         for k in 0..3 {
-            self.body[1 + k].push(t, r.q[3 + k].to_degrees());
+            self.body[1 + k].push_at(col, t, r.q[3 + k].to_degrees());
         }
-        self.energy[0].push(t, r.kinetic);
-        self.energy[1].push(t, r.potential);
-        self.energy[2].push(t, r.kinetic + r.potential);
+        self.energy[0].push_at(col, t, r.kinetic);
+        self.energy[1].push_at(col, t, r.potential);
+        self.energy[2].push_at(col, t, r.kinetic + r.potential);
     }
 
     /// The curves, with the contact events of `run`.

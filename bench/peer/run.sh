@@ -2,7 +2,7 @@
 # fbd vs MuJoCo on the same models, one core, dt = 1 ms (issues 5, 11, 14).
 #
 #   bench/peer/run.sh            # from anywhere; needs cargo and python3
-#   REPEAT=5 bench/peer/run.sh   # best of 5 runs per case (default 3)
+#   REPEAT=5 bench/peer/run.sh   # best of 5 rounds per case (default 3)
 #   CASES="moving_flight hexapod_stand" bench/peer/run.sh   # some cases
 #
 # fbd: `fbd run` on bench/peer/<case>.toml, steps_per_second from
@@ -16,7 +16,9 @@
 # number of steps). Prints one table: case, steps, fbd steps/s, MuJoCo
 # steps/s, ratio fbd/MuJoCo, Newton iterations per step, chord/full; then
 # the standing hexapod's normal forces in both and the walk's distance.
-# Pins both to one core with taskset if present. The binary is built in
+# The two alternate, one run each per round, and each reports its best
+# round (both meet the same machine as its speed drifts). Pins both to
+# one core with taskset if present. The binary is built in
 # CARGO_TARGET_DIR (default: the tree's target/).
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -61,18 +63,17 @@ all=(
 )
 wanted="${CASES:-}"
 
-# Best steps/s of $repeat fbd runs of $1 into $2, then the last run's
-# "steps sps iterations" (iterations: "mean max chord/full").
-fbd_best() {
-    local config=$1 dir=$2 best=0 line
-    for _ in $(seq "$repeat"); do
-        if ! "${pin[@]}" "$fbd" run "$config" --out "$dir" > "$dir.log" 2>&1; then
-            if [ ! -f "$dir/summary.json" ]; then
-                echo "FAILED $(tail -n 1 "$dir.log")"
-                return
-            fi
+# One fbd run of $1 into $2: "steps sps mean max chord/full" (iterations
+# per step, mean and max; chord/full Newton iterations), or "FAILED ...".
+fbd_once() {
+    local config=$1 dir=$2
+    if ! "${pin[@]}" "$fbd" run "$config" --out "$dir" > "$dir.log" 2>&1; then
+        if [ ! -f "$dir/summary.json" ]; then
+            echo "FAILED $(tail -n 1 "$dir.log")"
+            return
         fi
-        line=$(python3 - "$dir/summary.json" << 'EOF'
+    fi
+    python3 - "$dir/summary.json" << 'EOF'
 import json, sys
 d = json.load(open(sys.argv[1]))
 if d["status"] != "ok":
@@ -87,13 +88,10 @@ mx = per["max"] if per else "-"
 split = f'{d["chord_iterations"]}/{d["full_newton_iterations"]}' if "chord_iterations" in d else "-"
 print(d["steps"], d["steps_per_second"], f"{mean:.2f}", mx, split)
 EOF
-        )
-        case $line in FAILED*) echo "$line"; return ;; esac
-        read -r steps sps rest <<< "$line"
-        best=$(python3 -c "print(max($best, $sps))")
-    done
-    echo "$steps $best $rest"
 }
+
+# The larger of two numbers.
+larger() { python3 -c "print(max($1, $2))"; }
 
 printf '%-14s %7s %12s %12s %7s %9s %7s %16s\n' \
     case steps "fbd steps/s" "MuJoCo st/s" ratio "it/step" "it max" "chord/full"
@@ -102,16 +100,8 @@ for row in "${all[@]}"; do
     read -r name model mj <<< "$row"
     if [ -n "$wanted" ] && [[ " $wanted " != *" $name "* ]]; then continue; fi
     config="$here/$name.toml"
-    result=$(fbd_best "$config" "$out/$name")
-    case $result in
-        FAILED*)
-            printf '%-14s fbd failed: %s\n' "$name" "${result#FAILED }"
-            continue
-            ;;
-    esac
-    read -r steps best mean mx split <<< "$result"
     if [ "$model" = planar ]; then
-        mujoco=$("${pin[@]}" "$py" "$here/mujoco_planar.py" "$mj" --steps "$steps" --repeat "$repeat")
+        mujoco_cmd=("$py" "$here/mujoco_planar.py" "$mj")
     else
         "$fbd" export mjcf "$config" --out "$out/$name.xml"
         extra=()
@@ -120,11 +110,28 @@ for row in "${all[@]}"; do
             "$fbd" run "$out/${name}_kinematic.toml" --out "$out/${name}_kinematic" > /dev/null
             extra=(--targets "$out/${name}_kinematic/trajectory.csv")
         fi
-        mujoco=$("${pin[@]}" "$py" "$here/mujoco_hexapod.py" "$mj" "$out/$name.xml" \
-            --steps "$steps" --repeat "$repeat" "${extra[@]}")
-        notes+=("$name|$mj|$mujoco")
+        mujoco_cmd=("$py" "$here/mujoco_hexapod.py" "$mj" "$out/$name.xml" "${extra[@]}")
     fi
-    msps=$(python3 -c 'import json, sys; print(json.loads(sys.argv[1])["steps_per_second"])' "$mujoco")
+    # fbd and MuJoCo alternate, one run each per round, so that both meet
+    # the same machine (a VM's speed drifts over minutes); the best of
+    # $repeat rounds of each is reported.
+    best=0
+    msps=0
+    failed=""
+    for _ in $(seq "$repeat"); do
+        result=$(fbd_once "$config" "$out/$name")
+        case $result in FAILED*) failed=${result#FAILED }; break ;; esac
+        read -r steps sps mean mx split <<< "$result"
+        best=$(larger "$best" "$sps")
+        mujoco=$("${pin[@]}" "${mujoco_cmd[@]}" --steps "$steps" --repeat 1)
+        m=$(python3 -c 'import json, sys; print(json.loads(sys.argv[1])["steps_per_second"])' "$mujoco")
+        msps=$(larger "$msps" "$m")
+    done
+    if [ -n "$failed" ]; then
+        printf '%-14s fbd failed: %s\n' "$name" "$failed"
+        continue
+    fi
+    if [ "$model" != planar ]; then notes+=("$name|$mj|$mujoco"); fi
     printf '%-14s %7d %12.0f %12.0f %7.2f %9s %7s %16s\n' "$name" "$steps" "$best" "$msps" \
         "$(python3 -c "print($best / $msps)")" "$mean" "$mx" "$split"
 done

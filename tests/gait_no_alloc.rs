@@ -53,19 +53,7 @@ fn gait_steps_do_not_allocate() {
     assert_eq!(counts, (0, 0, 0), "{} steps: {stats:?}", m.steps + 1);
 }
 
-/// The test runs without libtest's harness (`harness = false` in
-/// `Cargo.toml`): the allocation counters are process-global, and the
-/// harness's main thread allocates while it waits for a test to finish, at
-/// a moment no test controls (a rare false failure). Here nothing but the
-/// test runs. `--list` answers as libtest does, for cargo-nextest.
+/// Without libtest's harness (see [`common::harness`]).
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    if args.iter().any(|a| a == "--list") {
-        if !args.iter().any(|a| a == "--ignored") {
-            println!("gait_steps_do_not_allocate: test");
-        }
-        return;
-    }
-    gait_steps_do_not_allocate();
-    println!("test gait_steps_do_not_allocate ... ok");
+    common::harness::run_alone("gait_steps_do_not_allocate", gait_steps_do_not_allocate);
 }

@@ -187,19 +187,10 @@ fn retried_run_does_not_allocate(what: &str, p: &fbd_sim::PlanarParams) -> usize
     data.resolved_cycles
 }
 
-/// The test runs without libtest's harness (`harness = false` in
-/// `Cargo.toml`): the allocation counters are process-global, and the
-/// harness's main thread allocates while it waits for a test to finish, at
-/// a moment no test controls (a rare false failure). Here nothing but the
-/// test runs. `--list` answers as libtest does, for cargo-nextest.
+/// Without libtest's harness (see [`common::harness`]).
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    if args.iter().any(|a| a == "--list") {
-        if !args.iter().any(|a| a == "--ignored") {
-            println!("steady_stepping_does_not_allocate: test");
-        }
-        return;
-    }
-    steady_stepping_does_not_allocate();
-    println!("test steady_stepping_does_not_allocate ... ok");
+    common::harness::run_alone(
+        "steady_stepping_does_not_allocate",
+        steady_stepping_does_not_allocate,
+    );
 }

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod gait;
+pub mod harness;
 pub mod physics;
 pub mod spatial;
 pub mod strategies;

@@ -7,7 +7,7 @@
 //! assembly of [`fbd_dynamics`] as a Newton system (contact equations in
 //! the terrain frame at the anchor or under the point), a contact point's
 //! trial and its violation, the rigid placement of anchors on one body,
-//! and the fixed-size [`StepRecord`].
+//! and the [`StepRecord`] (sized from the layout).
 //!
 //! **Joint limits** are one-sided, plastic stops (`fbd_dynamics::assemble`):
 //! a free joint whose trial angle crosses an end of its range is held at

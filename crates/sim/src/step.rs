@@ -23,8 +23,7 @@ use crate::system::row_scales;
 use crate::{Data, Model, SimError};
 use fbd_contact::{ContactState, Terrain, Trial};
 use fbd_dynamics::{
-    ContactEquation, FbdData, History, LimitEquation, PointKind, advance, evaluate_next,
-    prepare_step,
+    ContactEquation, FbdData, History, LimitEquation, advance, evaluate_next, prepare_step,
 };
 use fbd_solver::{NewtonReport, NewtonSolver, SolverError};
 
@@ -57,23 +56,13 @@ impl Engine for Model {
             steps: self.steps,
             stride: self.params.stride,
             bodies: self.mech.bodies.len(),
-            contacts: self.mech.contacts.len(),
+            contacts: &self.mech.contacts,
             limits: self.mech.limits.len(),
             ground: &self.params.terrain,
             friction: &self.params.friction,
             contact: &self.contact,
             joint_limits: &self.params.joint_limits,
         }
-    }
-    fn contact_body(&self, c: usize) -> usize {
-        self.mech.contacts[c].body
-    }
-    fn contact_identity(&self, c: usize) -> (usize, PointKind) {
-        let spec = &self.mech.contacts[c];
-        (spec.leg, spec.kind)
-    }
-    fn contact_name(&self, c: usize) -> &str {
-        &self.mech.contacts[c].name
     }
     fn limit(&self, l: usize) -> LimitInfo {
         let j = self.mech.limits[l];

@@ -35,7 +35,7 @@ pub use data::RunData;
 
 use crate::SimError;
 use fbd_contact::{ContactMode, ContactParams, ContactTrial, Friction};
-use fbd_dynamics::{History, PointKind};
+use fbd_dynamics::{ContactSpec, History, PointKind};
 use fbd_kinematics::{Joint, JointLimits};
 use fbd_solver::{NewtonReport, SolverError};
 
@@ -70,8 +70,8 @@ pub struct Settings<'a, G: ?Sized> {
     pub stride: usize,
     /// Rigid bodies.
     pub bodies: usize,
-    /// Contact points.
-    pub contacts: usize,
+    /// Contact points, with their body and identity `{leg, kind}`.
+    pub contacts: &'a [ContactSpec],
     /// Joint limits.
     pub limits: usize,
     /// The ground.
@@ -143,7 +143,7 @@ pub trait Engine: Sized {
     }
     /// Contact points.
     fn contacts(&self) -> usize {
-        self.settings().contacts
+        self.settings().contacts.len()
     }
     /// Bodies.
     fn bodies(&self) -> usize {
@@ -154,11 +154,18 @@ pub trait Engine: Sized {
         self.settings().limits
     }
     /// The body contact point `c` belongs to.
-    fn contact_body(&self, c: usize) -> usize;
+    fn contact_body(&self, c: usize) -> usize {
+        self.settings().contacts[c].body
+    }
     /// Hexapod leg number and kind (tip, knee, hip) of point `c`.
-    fn contact_identity(&self, c: usize) -> (usize, PointKind);
+    fn contact_identity(&self, c: usize) -> (usize, PointKind) {
+        let spec = &self.settings().contacts[c];
+        (spec.leg, spec.kind)
+    }
     /// Name of point `c` in messages.
-    fn contact_name(&self, c: usize) -> &str;
+    fn contact_name(&self, c: usize) -> &str {
+        &self.settings().contacts[c].name
+    }
     /// Joint limit `l`.
     fn limit(&self, l: usize) -> LimitInfo;
     /// Name of limit `l`'s joint in messages.

@@ -31,7 +31,7 @@ use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
     half_momentum_and_rotation, pattern, pattern_key, prepare_step, set_previous,
 };
-use fbd_dynamics::{History, LimitEquation, NoJacobian, PointKind};
+use fbd_dynamics::{History, LimitEquation, NoJacobian};
 use fbd_kinematics::nalgebra::Vector3;
 use fbd_solver::{NewtonReport, NewtonSolver, NewtonSystem, SolverError};
 
@@ -92,23 +92,13 @@ impl Engine for SpatialModel {
             steps: self.steps,
             stride: self.params.stride,
             bodies: self.mech.bodies.len(),
-            contacts: self.mech.contacts.len(),
+            contacts: &self.mech.contacts,
             limits: self.mech.limits.len(),
             ground: &self.params.terrain,
             friction: &self.params.friction,
             contact: &self.params.contact,
             joint_limits: &self.params.joint_limits,
         }
-    }
-    fn contact_body(&self, c: usize) -> usize {
-        self.mech.contacts[c].body
-    }
-    fn contact_identity(&self, c: usize) -> (usize, PointKind) {
-        let spec = &self.mech.contacts[c];
-        (spec.leg, spec.kind)
-    }
-    fn contact_name(&self, c: usize) -> &str {
-        &self.mech.contacts[c].name
     }
     fn limit(&self, l: usize) -> LimitInfo {
         let lim = &self.mech.limits[l];

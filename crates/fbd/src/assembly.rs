@@ -394,14 +394,10 @@ fn loads<M: FbdModel>(model: &M, dims: &Dims, data: &mut M::Data, z: &[f64]) {
             &model.contact_point(data, c, At::Now),
             &model.body_step(data, body).com_k,
         );
-        let w = &mut model.wrenches(data)[body];
-        for i in 0..M::S::LIN {
-            w.force.as_mut()[i] += f.as_ref()[i];
-        }
-        let rf = M::S::cross(&r, &f);
-        for i in 0..M::S::ANG {
-            w.moment.as_mut()[i] += rf.as_ref()[i];
-        }
+        // No moment of its own: adding 0 leaves every sum as it was (an
+        // accumulator that starts at +0 is never −0).
+        let none = <M::S as Space>::Ang::default();
+        apply(&mut model.wrenches(data)[body], 1.0, &r, &f, &none);
     }
     for l in 0..dims.limits {
         let stop = model.stop(data, l);

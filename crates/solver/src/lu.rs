@@ -206,8 +206,8 @@ impl Pattern {
         let mut couplings = Vec::new();
         let mut k = 0;
         for &(row, col) in entries.iter() {
-            let s = if let Some(t) = Some(single_of_row[row]).filter(|&t| t != NONE) {
-                reduced_nnz + t
+            let s = if single_of_row[row] != NONE {
+                reduced_nnz + single_of_row[row]
             } else if single_of_col[col] != NONE {
                 couplings.push((row, single_of_col[col]));
                 reduced_nnz + singles.len() + couplings.len() - 1

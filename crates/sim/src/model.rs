@@ -267,6 +267,13 @@ impl Model {
                 // step that does not contract falls back to full Newton, so
                 // the tolerances are unchanged.
                 chord_steps: 6,
+                // A refactorisation (the Jacobian, faer's numeric LU of the
+                // 15–31 unknowns) costs about eight chord steps here;
+                // renewing the kept one at that cost cut the instructions
+                // per step of the `bench/peer` cases by 2–4 % (callgrind;
+                // 4 and 12 did less). Not for the 3D hexapod, whose larger
+                // LU made every renewal a loss.
+                refactor_cost: 8.0,
                 ..NewtonParams::default()
             },
             steps: steps_f as usize + 1,

@@ -111,59 +111,66 @@ pub struct PlanarChains {
 /// from the base).
 #[derive(Clone, Debug, PartialEq)]
 struct Plan {
-    /// Per angle: its offset, its terms `terms[start..end]`, and the
-    /// earlier angle it equals (offset and terms alike), if one does.
+    /// Every distinct angle: its index, offset and terms `terms[start..end]`
+    /// (an angle equal to an earlier one, offset and terms alike, is in
+    /// `copies` instead).
     angles: Vec<PlanAngle>,
-    /// `(index into q, coefficient)` of every angle, angle after angle.
+    /// `(index into q, coefficient)` of every distinct angle, angle after
+    /// angle.
     terms: Vec<(usize, f64)>,
-    /// Per point: the earlier point its segments extend (itself when none
-    /// does: the base position) and its own segments
-    /// `segments[start..end]`.
-    points: Vec<PlanPoint>,
-    /// `(angle, length)` of every point's own segments, point after point.
-    segments: Vec<(usize, f64)>,
     /// `(angle, earlier angle it equals)`: the values copied.
     copies: Vec<(usize, usize)>,
+    /// The points' updates in order, one per segment: point `dst` is point
+    /// `src` (or the base) plus the segment; a point's first update starts
+    /// from the earlier point its segments extend, its further ones from
+    /// itself. A point without segments of its own is one copy.
+    points: Vec<PlanStep>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct PlanAngle {
+    index: usize,
     offset: f64,
     start: usize,
     end: usize,
-    same_as: Option<usize>,
 }
 
+/// One update of [`Plan::points`]: `pos[dst] = pos[src] + length·(cos, sin)
+/// of angle`, with `src ==` [`BASE`] for the base position and `angle ==`
+/// [`NO_SEGMENT`] for a copy.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct PlanPoint {
-    /// The earlier point its segments extend; itself when none does (the
-    /// base position).
-    parent: usize,
-    start: usize,
-    end: usize,
+struct PlanStep {
+    dst: usize,
+    src: usize,
+    angle: usize,
+    length: f64,
 }
+
+/// [`PlanStep::src`] of a point that starts from the base position.
+const BASE: usize = usize::MAX;
+/// [`PlanStep::angle`] of a copy.
+const NO_SEGMENT: usize = usize::MAX;
 
 impl Plan {
     fn new(angles: &[LinearAngle], points: &[PointDef]) -> Self {
         let mut plan = Plan {
             angles: Vec::with_capacity(angles.len()),
             terms: Vec::new(),
-            points: Vec::with_capacity(points.len()),
-            segments: Vec::new(),
             copies: Vec::new(),
+            points: Vec::with_capacity(points.len()),
         };
         for (k, a) in angles.iter().enumerate() {
+            if let Some(e) = angles[..k].iter().position(|b| b == a) {
+                plan.copies.push((k, e));
+                continue;
+            }
             let start = plan.terms.len();
             plan.terms.extend_from_slice(&a.terms);
-            let same_as = angles[..k].iter().position(|b| b == a);
-            if let Some(e) = same_as {
-                plan.copies.push((k, e));
-            }
             plan.angles.push(PlanAngle {
+                index: k,
                 offset: a.offset,
                 start,
                 end: plan.terms.len(),
-                same_as,
             });
         }
         for (p, def) in points.iter().enumerate() {
@@ -174,13 +181,25 @@ impl Plan {
                 .max_by_key(|&e| points[e].segments.len())
                 .filter(|&e| !points[e].segments.is_empty());
             let skip = parent.map_or(0, |e| points[e].segments.len());
-            let start = plan.segments.len();
-            plan.segments.extend_from_slice(&def.segments[skip..]);
-            plan.points.push(PlanPoint {
-                parent: parent.unwrap_or(p),
-                start,
-                end: plan.segments.len(),
-            });
+            let mut src = parent.unwrap_or(BASE);
+            let own = &def.segments[skip..];
+            if own.is_empty() {
+                plan.points.push(PlanStep {
+                    dst: p,
+                    src,
+                    angle: NO_SEGMENT,
+                    length: 0.0,
+                });
+            }
+            for &(angle, length) in own {
+                plan.points.push(PlanStep {
+                    dst: p,
+                    src,
+                    angle,
+                    length,
+                });
+                src = p;
+            }
         }
         plan
     }
@@ -364,56 +383,48 @@ impl PlanarChains {
     pub fn eval_positions(&self, q: &[f64], data: &mut PlanarData) {
         assert_eq!(q.len(), self.nq, "q has the wrong length");
         let plan = &self.plan;
-        let n = plan.angles.len();
-        let values = data.angle[..n]
-            .iter_mut()
-            .zip(&mut data.sin[..n])
-            .zip(&mut data.cos[..n])
-            .zip(&mut data.base[..n]);
-        for (a, (((angle, sin), cos), base)) in plan.angles.iter().zip(values) {
-            if a.same_as.is_some() {
-                continue;
-            }
+        for a in &plan.angles {
+            let k = a.index;
             let terms = &plan.terms[a.start..a.end];
             let v = a.offset + terms.iter().map(|&(i, c)| c * q[i]).sum::<f64>();
-            let [b, bs, bc] = *base;
+            let [b, bs, bc] = data.base[k];
             let d = v - b;
-            if d.abs() <= SERIES_MAX {
+            let (sin, cos) = if d.abs() <= SERIES_MAX {
                 let d2 = d * d;
                 // sin δ and cos δ − 1, Horner in δ².
                 let sd = d
                     * (1.0
                         - d2 * (1.0 / 6.0) * (1.0 - d2 * (1.0 / 20.0) * (1.0 - d2 * (1.0 / 42.0))));
                 let cd = -d2 * 0.5 * (1.0 - d2 * (1.0 / 12.0) * (1.0 - d2 * (1.0 / 30.0)));
-                *sin = bs + (bs * cd + bc * sd);
-                *cos = bc + (bc * cd - bs * sd);
+                (bs + (bs * cd + bc * sd), bc + (bc * cd - bs * sd))
             } else {
                 let (s, c) = v.sin_cos();
-                *base = [v, s, c];
-                *sin = s;
-                *cos = c;
-            }
-            *angle = v;
+                data.base[k] = [v, s, c];
+                (s, c)
+            };
+            data.angle[k] = v;
+            data.sin[k] = sin;
+            data.cos[k] = cos;
         }
         for &(k, e) in &plan.copies {
             data.angle[k] = data.angle[e];
             data.sin[k] = data.sin[e];
             data.cos[k] = data.cos[e];
         }
-        let (sin, cos) = (&data.sin[..n], &data.cos[..n]);
-        let np = plan.points.len();
-        let pos = &mut data.pos[..np];
-        for (p, pt) in plan.points.iter().enumerate() {
-            let [mut x, mut y] = if pt.parent < p {
-                pos[pt.parent]
+        let (sin, cos, pos) = (&data.sin, &data.cos, &mut data.pos);
+        let base = [q[RX], q[RY]];
+        for step in &plan.points {
+            let [x, y] = if step.src == BASE {
+                base
             } else {
-                [q[RX], q[RY]]
+                pos[step.src]
             };
-            for &(a, l) in &plan.segments[pt.start..pt.end] {
-                x += l * cos[a];
-                y += l * sin[a];
-            }
-            pos[p] = [x, y];
+            pos[step.dst] = if step.angle == NO_SEGMENT {
+                [x, y]
+            } else {
+                let (a, l) = (step.angle, step.length);
+                [x + l * cos[a], y + l * sin[a]]
+            };
         }
     }
 

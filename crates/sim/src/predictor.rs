@@ -27,6 +27,12 @@
 //! order wherever the higher one predicted worse. The result of a step does not depend on the
 //! predictor beyond the solver's tolerance.
 //!
+//! An unknown pinned to zero — a free contact point's force, a free
+//! joint stop's moment: singleton rows whose solution is exactly `+0` —
+//! has a history of zeros, which records to zeros: [`Predictor::record`]
+//! skips such an unknown (its differences, all `+0`, stay as they are),
+//! with the same result bit for bit.
+//!
 //! No allocation after [`Predictor::new`].
 
 /// Highest order of the extrapolation of `q` (it uses `q[k−7..k]`).
@@ -48,6 +54,9 @@ pub struct Predictor {
     /// Per force (the unknowns after `q`), the backward differences of its
     /// solutions at the newest step.
     f: Vec<[f64; MAX_FORCE_ORDER + 1]>,
+    /// Per force, `true` when its differences are all `+0` (a history of
+    /// zeros, skipped by `record`: see the module docs).
+    f_zero: Vec<bool>,
     /// Accepted steps recorded (`k`).
     steps: usize,
     /// How many recorded steps before the newest were solved in the
@@ -68,6 +77,7 @@ impl Predictor {
             nq,
             q: q0.iter().map(|&v| differences_of(v)).collect(),
             f: z0[nq..].iter().map(|&v| differences_of(v)).collect(),
+            f_zero: z0[nq..].iter().map(|v| v.to_bits() == 0).collect(),
             steps: 0,
             smooth: 0,
             orders: [1, 0],
@@ -121,7 +131,7 @@ impl Predictor {
         let (zq, zf) = z.split_at(self.nq);
         self.orders = [
             argmin(&record_history(&mut self.q, zq)[1..]) + 1,
-            argmin(&record_history(&mut self.f, zf)),
+            argmin(&record_forces(&mut self.f, &mut self.f_zero, zf)),
         ];
         self.smooth = if same_states {
             (self.smooth + 1).min(MAX_Q_ORDER - 1)
@@ -167,18 +177,46 @@ fn extrapolate<const N: usize>(d: &[f64; N], p: usize) -> f64 {
 fn record_history<const N: usize>(hist: &mut [[f64; N]], values: &[f64]) -> [f64; N] {
     let mut err = [0.0f64; N];
     for (d, &v) in hist.iter_mut().zip(values) {
-        let mut new = v;
-        for (dj, e) in d.iter_mut().zip(err.iter_mut()) {
-            let old = *dj;
-            *dj = new;
-            new -= old;
-            // `e.max(|new|)` without its NaN handling (`e` is never NaN;
-            // a NaN `new` leaves it, as `max` would).
-            let a = new.abs();
-            if a > *e {
-                *e = a;
-            }
+        record_one(d, v, &mut err);
+    }
+    err
+}
+
+/// Records `v` as the newest value of the history with backward
+/// differences `d`, raising each `err[p]` to `|∇ᵖ⁺¹v[k+1]|`.
+#[inline]
+fn record_one<const N: usize>(d: &mut [f64; N], v: f64, err: &mut [f64; N]) {
+    let mut new = v;
+    for (dj, e) in d.iter_mut().zip(err.iter_mut()) {
+        let old = *dj;
+        *dj = new;
+        new -= old;
+        // `e.max(|new|)` without its NaN handling (`e` is never NaN;
+        // a NaN `new` leaves it, as `max` would).
+        let a = new.abs();
+        if a > *e {
+            *e = a;
         }
+    }
+}
+
+/// [`record_history`] for the forces, skipping every force whose history
+/// and new value are `+0` (recording it would leave its differences `+0`
+/// and add no error), and keeping `zero` (every difference `+0`) up to
+/// date.
+fn record_forces<const N: usize>(
+    hist: &mut [[f64; N]],
+    zero: &mut [bool],
+    values: &[f64],
+) -> [f64; N] {
+    let mut err = [0.0f64; N];
+    for ((d, z), &v) in hist.iter_mut().zip(zero.iter_mut()).zip(values) {
+        let pinned = v.to_bits() == 0;
+        if pinned && *z {
+            continue;
+        }
+        record_one(d, v, &mut err);
+        *z = pinned && d.iter().all(|x| x.to_bits() == 0);
     }
     err
 }

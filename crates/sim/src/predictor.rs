@@ -108,12 +108,8 @@ impl Predictor {
         );
         let [q_order, f_order] = self.orders();
         let (zq, zf) = z.split_at_mut(self.nq);
-        for (zi, d) in zq.iter_mut().zip(&self.q) {
-            *zi = extrapolate(d, q_order);
-        }
-        for (zi, d) in zf.iter_mut().zip(&self.f) {
-            *zi = extrapolate(d, f_order);
-        }
+        extrapolate(&self.q, q_order, zq);
+        extrapolate(&self.f, f_order, zf);
     }
 
     /// Records an accepted step: its unknowns `z` (`q[k+1]` first) and
@@ -149,24 +145,41 @@ fn differences_of<const N: usize>(v: f64) -> [f64; N] {
     d
 }
 
-/// The extrapolation one step ahead of order `p` from the backward
-/// differences `d` at the newest step: Newton's form `d[0] + Σ_{1≤j≤p}
-/// d[j]`, in which the differences of close values are exact and their
-/// small sum is added to `d[0]` last, so that it rounds about once.
+/// The extrapolations one step ahead of order `p` (below `N`) from the
+/// backward differences `hist` at the newest step, into `z`: Newton's form
+/// `d[0] + Σ_{1≤j≤p} d[j]` for each unknown, in which the differences of
+/// close values are exact and their small sum is added to `d[0]` last, so
+/// that it rounds about once.
 ///
-/// The sum runs over every order with a test against `p` (the same for
-/// every unknown of a prediction, so the branch is always predicted), from
-/// the empty sum and in order, the additions of `d[1..=p].iter().sum()`:
-/// a fixed-length loop the compiler unrolls.
+/// The order is the same for every unknown of a prediction: it selects a
+/// loop compiled for it ([`extrapolate_order`]), with no test per term.
+fn extrapolate<const N: usize>(hist: &[[f64; N]], p: usize, z: &mut [f64]) {
+    const { assert!(N <= 8, "a loop per order up to 7") };
+    assert!(p < N, "order {p} beyond the history");
+    match p {
+        0 => extrapolate_order::<N, 0>(hist, z),
+        1 => extrapolate_order::<N, 1>(hist, z),
+        2 => extrapolate_order::<N, 2>(hist, z),
+        3 => extrapolate_order::<N, 3>(hist, z),
+        4 => extrapolate_order::<N, 4>(hist, z),
+        5 => extrapolate_order::<N, 5>(hist, z),
+        6 => extrapolate_order::<N, 6>(hist, z),
+        _ => extrapolate_order::<N, 7>(hist, z),
+    }
+}
+
+/// [`extrapolate`] of order `P` (`P < N`): the sum of `d[1..=P]` from the
+/// empty sum and in order, the additions of `d[1..=P].iter().sum()`, in a
+/// fixed-length loop the compiler unrolls.
 #[inline]
-fn extrapolate<const N: usize>(d: &[f64; N], p: usize) -> f64 {
-    let mut sum: f64 = std::iter::empty::<f64>().sum();
-    for (j, &dj) in d.iter().enumerate().skip(1) {
-        if j <= p {
+fn extrapolate_order<const N: usize, const P: usize>(hist: &[[f64; N]], z: &mut [f64]) {
+    for (zi, d) in z.iter_mut().zip(hist) {
+        let mut sum: f64 = std::iter::empty::<f64>().sum();
+        for &dj in d.iter().skip(1).take(P) {
             sum += dj;
         }
+        *zi = d[0] + sum;
     }
-    d[0] + sum
 }
 
 /// Records `values` as the newest step of the histories whose backward
@@ -244,7 +257,11 @@ mod tests {
         for &x in v[..N - 1].iter().rev() {
             record_history(&mut hist, &[x]);
         }
-        std::array::from_fn(|p| extrapolate(&hist[0], p))
+        std::array::from_fn(|p| {
+            let mut z = [0.0];
+            extrapolate(&hist, p, &mut z);
+            z[0]
+        })
     }
 
     #[test]

@@ -163,8 +163,9 @@ fn accept<M: Engine>(model: &M, data: &mut RunData<M>, t: f64) -> bool {
         && data.limit_states == data.limit_trial;
     data.states.copy_from_slice(&data.trial);
     data.limit_states.copy_from_slice(&data.limit_trial);
+    // q[k−1] → q[k−2], q[k] → q[k−1] by swaps, then q[k+1].
     std::mem::swap(&mut data.q_prev2, &mut data.q_prev);
-    data.q_prev.copy_from_slice(&data.q);
+    std::mem::swap(&mut data.q_prev, &mut data.q);
     let nq = model.nq();
     data.q.copy_from_slice(&data.z[..nq]);
     model.advance(data);

@@ -1,13 +1,15 @@
 //! Kinetic and potential energy of the mechanism.
 
-use fbd_dynamics::{FbdData, Mechanism};
+use fbd_dynamics::{BodySpec, FbdData, Mechanism};
 use fbd_kinematics::planar::PlanarData;
 
 /// Kinetic energy at `k` from central-difference body velocities
 /// `(x[k+1] − x[k−1]) / 2Δt`.
 pub fn kinetic_central(mech: &Mechanism, prev: &PlanarData, next: &PlanarData, dt: f64) -> f64 {
-    (0..mech.bodies.len())
-        .map(|b| {
+    mech.bodies
+        .iter()
+        .enumerate()
+        .map(|(b, s)| {
             let a = FbdData::body_coords(mech, prev, b);
             let c = FbdData::body_coords(mech, next, b);
             let v = [
@@ -15,7 +17,7 @@ pub fn kinetic_central(mech: &Mechanism, prev: &PlanarData, next: &PlanarData, d
                 (c[1] - a[1]) / (2.0 * dt),
                 (c[2] - a[2]) / (2.0 * dt),
             ];
-            body_kinetic(mech, b, v)
+            body_kinetic(s, v)
         })
         .sum()
 }
@@ -28,13 +30,12 @@ pub fn kinetic_exact(mech: &Mechanism, kin: &PlanarData, qdot: &[f64]) -> f64 {
             let spec = &mech.bodies[b];
             let v = mech.chains.point_velocity(kin, spec.com, qdot);
             let w = mech.chains.angles[spec.angle].rate(qdot);
-            body_kinetic(mech, b, [v[0], v[1], w])
+            body_kinetic(spec, [v[0], v[1], w])
         })
         .sum()
 }
 
-fn body_kinetic(mech: &Mechanism, b: usize, v: [f64; 3]) -> f64 {
-    let s = &mech.bodies[b];
+fn body_kinetic(s: &BodySpec, v: [f64; 3]) -> f64 {
     0.5 * s.mass * (v[0] * v[0] + v[1] * v[1]) + 0.5 * s.inertia * v[2] * v[2]
 }
 

@@ -27,6 +27,12 @@
 //! order wherever the higher one predicted worse. The result of a step does not depend on the
 //! predictor beyond the solver's tolerance.
 //!
+//! An unknown pinned to zero — a free contact point's force, a free
+//! joint stop's moment: singleton rows whose solution is exactly `+0` —
+//! has a history of zeros, which records to zeros: [`Predictor::record`]
+//! skips such an unknown (its differences, all `+0`, stay as they are),
+//! with the same result bit for bit.
+//!
 //! No allocation after [`Predictor::new`].
 
 /// Highest order of the extrapolation of `q` (it uses `q[k−7..k]`).
@@ -48,6 +54,9 @@ pub struct Predictor {
     /// Per force (the unknowns after `q`), the backward differences of its
     /// solutions at the newest step.
     f: Vec<[f64; MAX_FORCE_ORDER + 1]>,
+    /// Per force, `true` when its differences are all `+0` (a history of
+    /// zeros, skipped by `record`: see the module docs).
+    f_zero: Vec<bool>,
     /// Accepted steps recorded (`k`).
     steps: usize,
     /// How many recorded steps before the newest were solved in the
@@ -68,6 +77,7 @@ impl Predictor {
             nq,
             q: q0.iter().map(|&v| differences_of(v)).collect(),
             f: z0[nq..].iter().map(|&v| differences_of(v)).collect(),
+            f_zero: z0[nq..].iter().map(|v| v.to_bits() == 0).collect(),
             steps: 0,
             smooth: 0,
             orders: [1, 0],
@@ -98,12 +108,8 @@ impl Predictor {
         );
         let [q_order, f_order] = self.orders();
         let (zq, zf) = z.split_at_mut(self.nq);
-        for (zi, d) in zq.iter_mut().zip(&self.q) {
-            *zi = extrapolate(d, q_order);
-        }
-        for (zi, d) in zf.iter_mut().zip(&self.f) {
-            *zi = extrapolate(d, f_order);
-        }
+        extrapolate(&self.q, q_order, zq);
+        extrapolate(&self.f, f_order, zf);
     }
 
     /// Records an accepted step: its unknowns `z` (`q[k+1]` first) and
@@ -121,7 +127,7 @@ impl Predictor {
         let (zq, zf) = z.split_at(self.nq);
         self.orders = [
             argmin(&record_history(&mut self.q, zq)[1..]) + 1,
-            argmin(&record_history(&mut self.f, zf)),
+            argmin(&record_forces(&mut self.f, &mut self.f_zero, zf)),
         ];
         self.smooth = if same_states {
             (self.smooth + 1).min(MAX_Q_ORDER - 1)
@@ -139,24 +145,41 @@ fn differences_of<const N: usize>(v: f64) -> [f64; N] {
     d
 }
 
-/// The extrapolation one step ahead of order `p` from the backward
-/// differences `d` at the newest step: Newton's form `d[0] + Σ_{1≤j≤p}
-/// d[j]`, in which the differences of close values are exact and their
-/// small sum is added to `d[0]` last, so that it rounds about once.
+/// The extrapolations one step ahead of order `p` (below `N`) from the
+/// backward differences `hist` at the newest step, into `z`: Newton's form
+/// `d[0] + Σ_{1≤j≤p} d[j]` for each unknown, in which the differences of
+/// close values are exact and their small sum is added to `d[0]` last, so
+/// that it rounds about once.
 ///
-/// The sum runs over every order with a test against `p` (the same for
-/// every unknown of a prediction, so the branch is always predicted), from
-/// the empty sum and in order, the additions of `d[1..=p].iter().sum()`:
-/// a fixed-length loop the compiler unrolls.
+/// The order is the same for every unknown of a prediction: it selects a
+/// loop compiled for it ([`extrapolate_order`]), with no test per term.
+fn extrapolate<const N: usize>(hist: &[[f64; N]], p: usize, z: &mut [f64]) {
+    const { assert!(N <= 8, "a loop per order up to 7") };
+    assert!(p < N, "order {p} beyond the history");
+    match p {
+        0 => extrapolate_order::<N, 0>(hist, z),
+        1 => extrapolate_order::<N, 1>(hist, z),
+        2 => extrapolate_order::<N, 2>(hist, z),
+        3 => extrapolate_order::<N, 3>(hist, z),
+        4 => extrapolate_order::<N, 4>(hist, z),
+        5 => extrapolate_order::<N, 5>(hist, z),
+        6 => extrapolate_order::<N, 6>(hist, z),
+        _ => extrapolate_order::<N, 7>(hist, z),
+    }
+}
+
+/// [`extrapolate`] of order `P` (`P < N`): the sum of `d[1..=P]` from the
+/// empty sum and in order, the additions of `d[1..=P].iter().sum()`, in a
+/// fixed-length loop the compiler unrolls.
 #[inline]
-fn extrapolate<const N: usize>(d: &[f64; N], p: usize) -> f64 {
-    let mut sum: f64 = std::iter::empty::<f64>().sum();
-    for (j, &dj) in d.iter().enumerate().skip(1) {
-        if j <= p {
+fn extrapolate_order<const N: usize, const P: usize>(hist: &[[f64; N]], z: &mut [f64]) {
+    for (zi, d) in z.iter_mut().zip(hist) {
+        let mut sum: f64 = std::iter::empty::<f64>().sum();
+        for &dj in d.iter().skip(1).take(P) {
             sum += dj;
         }
+        *zi = d[0] + sum;
     }
-    d[0] + sum
 }
 
 /// Records `values` as the newest step of the histories whose backward
@@ -167,18 +190,46 @@ fn extrapolate<const N: usize>(d: &[f64; N], p: usize) -> f64 {
 fn record_history<const N: usize>(hist: &mut [[f64; N]], values: &[f64]) -> [f64; N] {
     let mut err = [0.0f64; N];
     for (d, &v) in hist.iter_mut().zip(values) {
-        let mut new = v;
-        for (dj, e) in d.iter_mut().zip(err.iter_mut()) {
-            let old = *dj;
-            *dj = new;
-            new -= old;
-            // `e.max(|new|)` without its NaN handling (`e` is never NaN;
-            // a NaN `new` leaves it, as `max` would).
-            let a = new.abs();
-            if a > *e {
-                *e = a;
-            }
+        record_one(d, v, &mut err);
+    }
+    err
+}
+
+/// Records `v` as the newest value of the history with backward
+/// differences `d`, raising each `err[p]` to `|∇ᵖ⁺¹v[k+1]|`.
+#[inline]
+fn record_one<const N: usize>(d: &mut [f64; N], v: f64, err: &mut [f64; N]) {
+    let mut new = v;
+    for (dj, e) in d.iter_mut().zip(err.iter_mut()) {
+        let old = *dj;
+        *dj = new;
+        new -= old;
+        // `e.max(|new|)` without its NaN handling (`e` is never NaN;
+        // a NaN `new` leaves it, as `max` would).
+        let a = new.abs();
+        if a > *e {
+            *e = a;
         }
+    }
+}
+
+/// [`record_history`] for the forces, skipping every force whose history
+/// and new value are `+0` (recording it would leave its differences `+0`
+/// and add no error), and keeping `zero` (every difference `+0`) up to
+/// date.
+fn record_forces<const N: usize>(
+    hist: &mut [[f64; N]],
+    zero: &mut [bool],
+    values: &[f64],
+) -> [f64; N] {
+    let mut err = [0.0f64; N];
+    for ((d, z), &v) in hist.iter_mut().zip(zero.iter_mut()).zip(values) {
+        let pinned = v.to_bits() == 0;
+        if pinned && *z {
+            continue;
+        }
+        record_one(d, v, &mut err);
+        *z = pinned && d.iter().all(|x| x.to_bits() == 0);
     }
     err
 }
@@ -206,7 +257,11 @@ mod tests {
         for &x in v[..N - 1].iter().rev() {
             record_history(&mut hist, &[x]);
         }
-        std::array::from_fn(|p| extrapolate(&hist[0], p))
+        std::array::from_fn(|p| {
+            let mut z = [0.0];
+            extrapolate(&hist, p, &mut z);
+            z[0]
+        })
     }
 
     #[test]

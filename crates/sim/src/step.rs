@@ -242,21 +242,26 @@ fn make_record(
     r.newton_iterations = newton_iterations;
     r.state_trials = state_trials;
     r.q.copy_from_slice(&data.q[..lay.nq]);
-    for (c, spec) in mech.contacts.iter().enumerate() {
+    // The unknowns by block: joint forces (x, y), contact forces (Fa, N),
+    // stop moments.
+    let (joint_forces, rest) = data.z[lay.joint_force(0, 0)..].split_at(2 * lay.joints);
+    let (contact_forces, moments) = rest.split_at(2 * mech.contacts.len());
+    let contacts = mech.contacts.iter().zip(contact_forces.chunks_exact(2));
+    for (c, (spec, f)) in contacts.enumerate() {
         r.point[c] = data.fbd.kin.pos[spec.point];
         r.state[c] = data.trial[c].code();
-        r.fa[c] = data.z[lay.contact_fa(c)];
-        r.n[c] = data.z[lay.contact_n(c)];
+        r.fa[c] = f[0];
+        r.n[c] = f[1];
     }
-    for j in 0..lay.joints {
-        r.joint_force[j] = [data.z[lay.joint_force(j, 0)], data.z[lay.joint_force(j, 1)]];
-        r.torque[j] = data.fbd.torque[j];
-        r.limit[j] = LimitCode::Free;
-        r.limit_moment[j] = 0.0;
+    for (rf, f) in r.joint_force.iter_mut().zip(joint_forces.chunks_exact(2)) {
+        *rf = [f[0], f[1]];
     }
-    for (l, &j) in mech.limits.iter().enumerate() {
-        r.limit[j] = LimitCode::of(&data.limit_trial[l]);
-        r.limit_moment[j] = data.z[lay.limit_moment(l)];
+    r.torque.copy_from_slice(&data.fbd.torque);
+    r.limit.fill(LimitCode::Free);
+    r.limit_moment.fill(0.0);
+    for ((&j, state), &moment) in mech.limits.iter().zip(&data.limit_trial).zip(moments) {
+        r.limit[j] = LimitCode::of(state);
+        r.limit_moment[j] = moment;
     }
     r.kinetic = if data.k == 0 {
         energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)

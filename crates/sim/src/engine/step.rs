@@ -29,7 +29,6 @@ use fbd_dynamics::History;
 pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError> {
     let k = data.k;
     let t = k as f64 * model.dt();
-    save_grid(data);
     prepare(model, data)?;
     let first = match solve(model, data) {
         Ok((iterations, trials)) => {
@@ -43,6 +42,9 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
         }
         Err(f) => f,
     };
+    // Stages 1–5 leave the accepted state as it was: it is kept for the
+    // retry only when one is needed.
+    save_grid(data);
     data.failed_trial.copy_from_slice(&data.trial);
     data.failed_limits.copy_from_slice(&data.limit_trial);
     let mut n = 2;
@@ -161,15 +163,17 @@ fn accept<M: Engine>(model: &M, data: &mut RunData<M>, t: f64) -> bool {
         && data.limit_states == data.limit_trial;
     data.states.copy_from_slice(&data.trial);
     data.limit_states.copy_from_slice(&data.limit_trial);
+    // q[k−1] → q[k−2], q[k] → q[k−1] by swaps, then q[k+1].
     std::mem::swap(&mut data.q_prev2, &mut data.q_prev);
-    data.q_prev.copy_from_slice(&data.q);
+    std::mem::swap(&mut data.q_prev, &mut data.q);
     let nq = model.nq();
     data.q.copy_from_slice(&data.z[..nq]);
     model.advance(data);
     same
 }
 
-/// Keeps what a failed attempt may change, to start the retry from it.
+/// Keeps what an attempt in substeps may change (the accepted state, left
+/// unchanged by the failed whole step), to start the next retry from it.
 fn save_grid<M: Engine>(data: &mut RunData<M>) {
     data.grid_q.copy_from_slice(&data.q);
     data.grid_q_prev.copy_from_slice(&data.q_prev);

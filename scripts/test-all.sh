@@ -14,8 +14,10 @@ echo "== cargo clippy (warnings denied)"
 cargo clippy --workspace --all-targets -- -D warnings
 echo "== cargo test"
 cargo test --workspace
-echo "== cargo bench --no-run"
-cargo bench --workspace --no-run
+# The benchmarks compiled and linked with the test build's dependencies
+# (`cargo bench` itself builds them optimised, in a profile of its own).
+echo "== cargo build --benches"
+cargo build --workspace --benches
 
 for part in scripts/test-python.sh scripts/test-browser.sh; do
   if [ -f "$part" ]; then

@@ -5,7 +5,7 @@
 
 use crate::SimError;
 use fbd_dynamics::{JacobianSink, LimitState};
-use fbd_kinematics::{Joint, JointLimits, LimitSide};
+use fbd_kinematics::{Joint, JointLimits};
 
 /// Most solves of one (sub)step's state search: a search that has not
 /// settled by then is treated as a cycle (the step is retried in
@@ -42,21 +42,13 @@ pub(crate) fn regularization(base: f64, h: f64) -> f64 {
 /// than [`LIMIT_ANGLE_TOL`]) is held at that end: the state to solve in.
 #[inline]
 pub(crate) fn limit_arrival(limits: &JointLimits, joint: Joint, angle: f64) -> Option<LimitState> {
-    // `violated(angle − tol).and(violated(angle + tol))` with the range
-    // read once: the side is the one `angle + tol` lies beyond.
-    let [lo, hi] = limits.range(joint);
-    let (below, above) = (angle - LIMIT_ANGLE_TOL, angle + LIMIT_ANGLE_TOL);
-    if !(below < lo || below > hi) {
-        return None;
-    }
-    let (side, end) = if above < lo {
-        (LimitSide::Lower, lo)
-    } else if above > hi {
-        (LimitSide::Upper, hi)
-    } else {
-        return None;
-    };
-    Some(LimitState::At { side, angle: end })
+    limits
+        .violated(joint, angle - LIMIT_ANGLE_TOL)
+        .and(limits.violated(joint, angle + LIMIT_ANGLE_TOL))
+        .map(|side| LimitState::At {
+            side,
+            angle: limits.end(joint, side),
+        })
 }
 
 /// How strongly a stop at `state` pulls its joint towards the end instead

@@ -59,27 +59,30 @@ pub(crate) fn row_scales(
     let moment = force * fbd.length_scale;
     let position = 1e-3 * k * (1.0 + extent);
     // Each row takes one of three scales: `(scale, weight)` pairs, three
-    // divisions per system. Rows: bodies (3 each), contacts (2 each), then
-    // limits (a moment each: free, λ, or at an end, Kθ·δθ).
+    // divisions per system.
     let [force, moment, position] = [force, moment, position].map(|s| (s, 1.0 / s));
-    let contacts_from = lay.contact_row(0);
-    let limits_from = lay.limit_row(0);
-    for (out, weight) in [(scales, false), (weights, true)] {
-        let pick = |(s, w): (f64, f64)| if weight { w } else { s };
-        let (body_rows, rest) = out.split_at_mut(contacts_from);
-        let (contact_rows, rest) = rest.split_at_mut(limits_from - contacts_from);
-        let body = [pick(force), pick(force), pick(moment)];
-        for rows in body_rows.chunks_exact_mut(3) {
-            rows.copy_from_slice(&body);
-        }
-        for (rows, eq) in contact_rows.chunks_exact_mut(2).zip(&fbd.contact) {
-            let (s0, s1) = match eq.state {
-                ContactState::Free => (force, force),
-                ContactState::Stick { .. } => (position, position),
-                ContactState::Slide { .. } => (force, position),
-            };
-            rows.copy_from_slice(&[pick(s0), pick(s1)]);
-        }
-        rest[..lay.limits].fill(pick(moment));
+    let mut set = |row: usize, (s, w): (f64, f64)| {
+        scales[row] = s;
+        weights[row] = w;
+    };
+    for b in 0..lay.bodies {
+        let row = lay.body_row(b);
+        set(row, force);
+        set(row + 1, force);
+        set(row + 2, moment);
+    }
+    for (c, eq) in fbd.contact.iter().enumerate() {
+        let row = lay.contact_row(c);
+        let (s0, s1) = match eq.state {
+            ContactState::Free => (force, force),
+            ContactState::Stick { .. } => (position, position),
+            ContactState::Slide { .. } => (force, position),
+        };
+        set(row, s0);
+        set(row + 1, s1);
+    }
+    // A joint-limit row is a moment, free (λ) or at an end (Kθ·δθ).
+    for l in 0..lay.limits {
+        set(lay.limit_row(l), moment);
     }
 }

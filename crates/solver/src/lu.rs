@@ -60,7 +60,7 @@
 //!   and generic multi-column machinery, which cost about twice as much on
 //!   these sizes; a single stream per sweep has no per-column loop either
 //!   (a chord step's solve of the moving flight's 15 unknowns: 2.5 k → 2.2 k
-//!   instructions, for 0.9 k more per factorisation).
+//!   instructions, for about 1.7 k more per factorisation).
 //!   It matters because a chord step (a step with a kept factorisation) is
 //!   one residual and one solve, and most steps are chord steps.
 //! * The pattern's structure is kept as faer's checked

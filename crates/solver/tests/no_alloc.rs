@@ -153,19 +153,18 @@ fn second_solve_of_a_pattern_does_not_allocate() {
     assert_no_heap("chord steps and refactorisations", stats);
 }
 
-/// The test runs without libtest's harness (`harness = false` in
-/// `Cargo.toml`): the allocation counters are process-global, and the
-/// harness's main thread allocates while it waits for a test to finish, at
-/// a moment no test controls (a rare false failure). Here nothing but the
-/// test runs. `--list` answers as libtest does, for cargo-nextest.
+// The workspace's runner of harness-less tests (one source for the
+// allocation tests of every crate).
+#[path = "../../../tests/common/harness.rs"]
+mod harness;
+
+/// Runs without libtest's harness (`harness = false` in `Cargo.toml`): the
+/// allocation counters are process-global, and the harness's main thread
+/// allocates while it waits for a test to finish, at a moment no test
+/// controls (a rare false failure).
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    if args.iter().any(|a| a == "--list") {
-        if !args.iter().any(|a| a == "--ignored") {
-            println!("second_solve_of_a_pattern_does_not_allocate: test");
-        }
-        return;
-    }
-    second_solve_of_a_pattern_does_not_allocate();
-    println!("test second_solve_of_a_pattern_does_not_allocate ... ok");
+    harness::run_alone(
+        "second_solve_of_a_pattern_does_not_allocate",
+        second_solve_of_a_pattern_does_not_allocate,
+    );
 }

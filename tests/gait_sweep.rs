@@ -28,6 +28,8 @@ fn a_hexapod_sweep_writes_the_walk_columns() {
             shard: None,
             resume: false,
             plot: "touchdown".into(),
+            viewer: false,
+            plots: false,
         },
         &mut text,
     )

@@ -11,9 +11,12 @@ use crate::CliError;
 ///
 /// Simulates the planar two-leg model of the paper's §6 (a hexapod
 /// falling onto flat ground, legs 3 and 4), writing trajectories, contact
-/// events and the plots of the paper's Fig. 7, and walks the 24-DOF
-/// hexapod kinematically with a periodic gait (`model = "hexapod"`).
-/// Every run writes a viewer.html to open in a browser. Without a command, `fbd`
+/// events and the plots of the paper's Fig. 7, and the 24-DOF hexapod
+/// (`model = "hexapod"`): its 3D FBD dynamics with contact, friction and
+/// joint control (standing, dropping, or walking a periodic gait tracked by
+/// the joint controllers), or the gait alone, kinematically (`[gait]`
+/// without `[control] kind = "gait"`). Every run writes a viewer.html to
+/// open in a browser. Without a command, `fbd`
 /// is `fbd run`: the built-in experiment, files in out/ (or --out DIR).
 /// Exit status: 0 ok, 2 usage or configuration error, 3 simulation failed
 /// (partial files written), 4 input/output error, 130 interrupted

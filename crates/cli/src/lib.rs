@@ -12,6 +12,7 @@
 //! or output error. Every error is one line on stderr, `error: …`.
 
 pub mod cli;
+pub mod columnar;
 /// The configuration: the `fbd-scenario` crate.
 pub use fbd_scenario as config;
 pub mod error;

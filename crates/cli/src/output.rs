@@ -81,6 +81,71 @@ pub fn persist(tmp: NamedTempFile, dest: &Path) -> Result<(), CliError> {
     Ok(())
 }
 
+/// A trajectory file larger than this (bytes, estimated before the run)
+/// gets a warning on stderr (docs/reference.md, "Output size").
+pub const LARGE_TRAJECTORY: f64 = 100e6;
+
+/// Bytes per value of `trajectory.csv` (a shortest round-trip decimal and
+/// its comma; about 19 for the 3D hexapod's values) and of
+/// `trajectory.parquet` (8-byte doubles, less where a column repeats).
+fn bytes_per_value(format: fbd_scenario::OutputFormat) -> f64 {
+    match format {
+        fbd_scenario::OutputFormat::Csv => 19.0,
+        fbd_scenario::OutputFormat::Parquet => 8.0,
+    }
+}
+
+/// The warning for a run writing `rows` rows of `columns` values every
+/// `stride`-th step in `format`, when the estimate exceeds
+/// [`LARGE_TRAJECTORY`]: the size and the stride (and format) that would
+/// keep it under.
+pub fn size_warning(
+    rows: usize,
+    columns: usize,
+    stride: usize,
+    format: fbd_scenario::OutputFormat,
+) -> Option<String> {
+    let bytes = rows as f64 * columns as f64 * bytes_per_value(format);
+    if bytes <= LARGE_TRAJECTORY {
+        return None;
+    }
+    let factor = (bytes / LARGE_TRAJECTORY).ceil() as usize;
+    let parquet = match format {
+        fbd_scenario::OutputFormat::Csv => {
+            " or `format = \"parquet\"` (about 2.5 times smaller, many times faster to load)"
+        }
+        fbd_scenario::OutputFormat::Parquet => "",
+    };
+    Some(format!(
+        "warning: {} will be about {:.0} MB ({rows} rows of {columns} columns); `[output] stride = {}` keeps it under {:.0} MB{parquet}",
+        format.trajectory_file(),
+        bytes / 1e6,
+        stride.max(1) * factor,
+        LARGE_TRAJECTORY / 1e6
+    ))
+}
+
+/// Prints [`size_warning`] on stderr, once per process (a sweep's runs
+/// share one).
+pub fn warn_size(rows: usize, columns: usize, stride: usize, format: fbd_scenario::OutputFormat) {
+    static WARNED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+    if let Some(w) = size_warning(rows, columns, stride, format)
+        && !WARNED.swap(true, std::sync::atomic::Ordering::Relaxed)
+    {
+        eprintln!("{w}");
+    }
+}
+
+/// `x` with `decimals` decimals, never `-0.0000`: a value that rounds to
+/// zero prints without a sign.
+pub fn fixed(x: f64, decimals: usize) -> String {
+    let s = format!("{x:.decimals$}");
+    match s.strip_prefix('-') {
+        Some(rest) if rest.bytes().all(|b| b == b'0' || b == b'.') => rest.to_owned(),
+        _ => s,
+    }
+}
+
 /// `n` and the noun agreeing with it: `count(1, "run", "runs")` is
 /// `"1 run"`, `count(2, …)` `"2 runs"`.
 pub fn count(n: usize, one: &str, many: &str) -> String {
@@ -184,7 +249,7 @@ pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliEr
 pub fn remove_stale(dir: &Path, written: &[&str]) -> Result<(), CliError> {
     let known = FILES
         .iter()
-        .chain(&["torques.svg"])
+        .chain(&["torques.svg", "trajectory.parquet"])
         .chain(&crate::hexapod::FILES)
         .chain(&crate::spatial::FILES);
     for name in known.filter(|n| !written.contains(n)) {
@@ -203,6 +268,35 @@ pub fn remove_stale(dir: &Path, written: &[&str]) -> Result<(), CliError> {
         }
     }
     Ok(())
+}
+
+/// The file names of a run (`files`, with `trajectory.csv`) when its
+/// trajectory is written in `format`.
+pub fn files_as(files: &[&'static str], format: fbd_scenario::OutputFormat) -> Vec<&'static str> {
+    files
+        .iter()
+        .map(|&f| {
+            if f == "trajectory.csv" {
+                format.trajectory_file()
+            } else {
+                f
+            }
+        })
+        .collect()
+}
+
+/// `files` without the plots (`*.svg`) when `output.plots` is false and
+/// without `viewer.html` when `output.viewer` is false.
+pub fn selected(
+    files: Vec<&'static str>,
+    output: &fbd_scenario::OutputConfig,
+) -> Vec<&'static str> {
+    files
+        .into_iter()
+        .filter(|f| {
+            (output.plots || !f.ends_with(".svg")) && (output.viewer || *f != "viewer.html")
+        })
+        .collect()
 }
 
 /// Creates `dir` if needed and checks that files can be created in it.
@@ -306,6 +400,11 @@ pub trait RowSink {
     fn state(&mut self, s: StateCode);
     /// A count (`newton_iterations`).
     fn count(&mut self, n: usize);
+    /// A flag (the kinematic gait's `stance{n}`): 1.0 or 0.0 (`1`, `0` in
+    /// the CSV file).
+    fn flag(&mut self, on: bool) {
+        self.num(if on { 1.0 } else { 0.0 });
+    }
 }
 
 /// Hands the values of the planar row of `r` to `sink`, in the order of
@@ -409,41 +508,147 @@ impl<W: Write> RowSink for CsvRow<'_, W> {
     fn count(&mut self, n: usize) {
         self.put(|out, _| write!(out, "{n}"));
     }
+    fn flag(&mut self, on: bool) {
+        self.put(|out, _| out.write_all(if on { b"1" } else { b"0" }));
+    }
 }
 
-/// Streams `trajectory.csv` through a buffer into a temporary file; no
-/// allocation per row.
+/// The trajectory file of a run in the configuration's format
+/// (`[output] format`): `trajectory.csv` or `trajectory.parquet`, the same
+/// columns, each written to a temporary file and renamed into place when
+/// complete. The planar, kinematic and 3D writers hand their rows to it.
+pub enum Table {
+    /// `trajectory.csv`, streamed through a buffer; no allocation per row.
+    Csv {
+        /// The buffered temporary file.
+        out: BufWriter<NamedTempFile>,
+        /// `dir/trajectory.csv`.
+        dest: PathBuf,
+        /// Number formatting.
+        num: ryu::Buffer,
+        /// Times as the decimal of k·Δt.
+        times: StepTimes,
+        /// The first I/O error.
+        error: Option<io::Error>,
+    },
+    /// `trajectory.parquet` ([`crate::columnar`]).
+    Parquet(crate::columnar::ParquetTable),
+}
+
+impl Table {
+    /// Opens the trajectory file in `dir` for `columns` (CSV: writes the
+    /// header); `dt` is the time step.
+    pub fn create(
+        dir: &Path,
+        format: fbd_scenario::OutputFormat,
+        columns: Vec<String>,
+        dt: f64,
+    ) -> Result<Self, CliError> {
+        match format {
+            fbd_scenario::OutputFormat::Csv => {
+                let dest = dir.join("trajectory.csv");
+                let tmp = temp_in(dir, "trajectory.csv")?;
+                let mut out = BufWriter::with_capacity(1 << 16, tmp);
+                writeln!(out, "{}", columns.join(","))
+                    .map_err(|e| CliError::io(dest.display(), &e))?;
+                Ok(Self::Csv {
+                    out,
+                    dest,
+                    num: ryu::Buffer::new(),
+                    times: StepTimes::new(dt),
+                    error: None,
+                })
+            }
+            fbd_scenario::OutputFormat::Parquet => Ok(Self::Parquet(
+                crate::columnar::ParquetTable::create(dir, columns, dt)?,
+            )),
+        }
+    }
+
+    /// Whether an error was kept (later rows are skipped).
+    pub fn failed(&self) -> bool {
+        match self {
+            Self::Csv { error, .. } => error.is_some(),
+            Self::Parquet(_) => false,
+        }
+    }
+
+    /// Writes one row: `fill` hands its values to the sink, in the order of
+    /// the columns. An error is kept and reported by [`Table::finish`].
+    pub fn row(&mut self, fill: impl FnOnce(&mut dyn RowSink)) {
+        match self {
+            Self::Csv {
+                out,
+                num,
+                times,
+                error,
+                ..
+            } => {
+                if error.is_some() {
+                    return;
+                }
+                let mut row = CsvRow::new(out, num, times);
+                fill(&mut row);
+                if let Err(e) = row.end() {
+                    *error = Some(e);
+                }
+            }
+            Self::Parquet(p) => {
+                fill(p);
+                p.end_row();
+            }
+        }
+    }
+
+    /// Flushes (the Parquet footer) and renames the file into place.
+    pub fn finish(self) -> Result<PathBuf, CliError> {
+        match self {
+            Self::Csv {
+                out, dest, error, ..
+            } => {
+                if let Some(e) = error {
+                    return Err(CliError::io(dest.display(), &e));
+                }
+                let tmp = out
+                    .into_inner()
+                    .map_err(|e| CliError::io(dest.display(), e.error()))?;
+                persist(tmp, &dest)?;
+                Ok(dest)
+            }
+            Self::Parquet(p) => p.finish(),
+        }
+    }
+}
+
+/// Streams the planar trajectory (`trajectory.csv`, or
+/// `trajectory.parquet`) into a temporary file; no allocation per CSV row.
 pub struct TrajectoryWriter {
-    out: BufWriter<NamedTempFile>,
-    dest: PathBuf,
-    num: ryu::Buffer,
-    times: StepTimes,
+    table: Table,
     slots: ContactSlots,
-    error: Option<io::Error>,
     rows: usize,
 }
 
 impl TrajectoryWriter {
-    /// Opens the temporary file in `dir` and writes the header for a model
-    /// whose contact points are `contacts` (record order); `dt` is the time
-    /// step (times are written as the decimal of k·Δt).
+    /// Opens the temporary `trajectory.csv` in `dir` and writes the header
+    /// for a model whose contact points are `contacts` (record order); `dt`
+    /// is the time step (times are written as the decimal of k·Δt).
     pub fn create(dir: &Path, contacts: &[ContactSpec], dt: f64) -> Result<Self, CliError> {
-        let dest = dir.join("trajectory.csv");
-        let tmp = temp_in(dir, "trajectory.csv")?;
-        let mut w = Self {
-            out: BufWriter::with_capacity(1 << 16, tmp),
-            dest,
-            num: ryu::Buffer::new(),
-            times: StepTimes::new(dt),
-            slots: ContactSlots::of(contacts),
-            error: None,
+        Self::create_as(dir, contacts, dt, fbd_scenario::OutputFormat::Csv)
+    }
+
+    /// [`TrajectoryWriter::create`] in `format` (`[output] format`).
+    pub fn create_as(
+        dir: &Path,
+        contacts: &[ContactSpec],
+        dt: f64,
+        format: fbd_scenario::OutputFormat,
+    ) -> Result<Self, CliError> {
+        let slots = ContactSlots::of(contacts);
+        Ok(Self {
+            table: Table::create(dir, format, slots.columns(), dt)?,
+            slots,
             rows: 0,
-        };
-        let header = w.slots.columns().join(",");
-        if let Err(e) = writeln!(w.out, "{header}") {
-            return Err(CliError::io(w.dest.display(), &e));
-        }
-        Ok(w)
+        })
     }
 
     /// Rows written so far.
@@ -454,33 +659,16 @@ impl TrajectoryWriter {
     /// Appends the row of `r`. An I/O error is kept and reported by
     /// [`TrajectoryWriter::finish`]; later rows are skipped.
     pub fn write(&mut self, r: &StepRecord) {
-        if self.error.is_some() {
-            return;
+        let slots = &self.slots;
+        self.table.row(|sink| row_values(slots, r, sink));
+        if !self.table.failed() {
+            self.rows += 1;
         }
-        match self.write_row(r) {
-            Ok(()) => self.rows += 1,
-            Err(e) => self.error = Some(e),
-        }
-    }
-
-    fn write_row(&mut self, r: &StepRecord) -> io::Result<()> {
-        let mut row = CsvRow::new(&mut self.out, &mut self.num, &self.times);
-        row_values(&self.slots, r, &mut row);
-        row.end()
     }
 
     /// Flushes and renames the file into place.
     pub fn finish(self) -> Result<PathBuf, CliError> {
-        let dest = self.dest;
-        if let Some(e) = self.error {
-            return Err(CliError::io(dest.display(), &e));
-        }
-        let tmp = self
-            .out
-            .into_inner()
-            .map_err(|e| CliError::io(dest.display(), e.error()))?;
-        persist(tmp, &dest)?;
-        Ok(dest)
+        self.table.finish()
     }
 }
 

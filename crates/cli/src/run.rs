@@ -292,10 +292,19 @@ pub fn simulate(
     let mut traj = match out_dir {
         Some(dir) => {
             output::prepare_dir(dir)?;
-            Some(TrajectoryWriter::create(
+            output::warn_size(
+                model.steps.div_ceil(model.params.stride.max(1)),
+                output::ContactSlots::of(&model.mech.contacts)
+                    .columns()
+                    .len(),
+                model.params.stride,
+                planar.output.format,
+            );
+            Some(TrajectoryWriter::create_as(
                 dir,
                 &model.mech.contacts,
                 model.dt(),
+                planar.output.format,
             )?)
         }
         None => None,
@@ -308,8 +317,13 @@ pub fn simulate(
     every_step.params.stride = 1;
     let mut rows = 0;
     // viewer.html: one frame per trajectory row (decimated when long).
-    let mut view = out_dir
-        .map(|d| PlanarScene::new(&model, model.steps.div_ceil(stride), &viewer::title_of(d)));
+    let mut view = out_dir.filter(|_| planar.output.viewer).map(|_| {
+        PlanarScene::new(
+            &model,
+            model.steps.div_ceil(stride),
+            &viewer::title_of(source, "planar model"),
+        )
+    });
     let run = fbd_sim::run_until(&every_step, stop, |r: &StepRecord| {
         if r.step.is_multiple_of(stride) {
             if let Some(t) = traj.as_mut() {
@@ -354,18 +368,21 @@ pub fn simulate(
         &config.to_toml(),
         &mut keep,
     );
-    let torques = plot::torques_svg(&plot_data).map(|svg| ("torques.svg", svg));
+    let plots = planar.output.plots;
+    let torques = plots
+        .then(|| plot::torques_svg(&plot_data).map(|svg| ("torques.svg", svg)))
+        .flatten();
     let torques_written = torques.is_some();
-    for (name, svg) in [
-        ("tips.svg", plot::tips_svg(&plot_data)),
-        ("forces.svg", plot::forces_svg(&plot_data)),
-        ("stance.svg", plot::stance_svg(&plot_data)),
-        ("joints.svg", plot::joints_svg(&plot_data)),
-        ("energy.svg", plot::energy_svg(&plot_data)),
-    ]
-    .into_iter()
-    .chain(torques)
-    {
+    let svgs = plots.then(|| {
+        [
+            ("tips.svg", plot::tips_svg(&plot_data)),
+            ("forces.svg", plot::forces_svg(&plot_data)),
+            ("stance.svg", plot::stance_svg(&plot_data)),
+            ("joints.svg", plot::joints_svg(&plot_data)),
+            ("energy.svg", plot::energy_svg(&plot_data)),
+        ]
+    });
+    for (name, svg) in svgs.into_iter().flatten().chain(torques) {
         keep(
             svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
                 .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
@@ -374,7 +391,10 @@ pub fn simulate(
     if let Some(v) = view {
         keep(viewer::write(out_dir, &v.finish(&run.events)));
     }
-    let mut files = output::FILES.to_vec();
+    let mut files = output::selected(
+        output::files_as(&output::FILES, planar.output.format),
+        &planar.output,
+    );
     files.extend(torques_written.then_some("torques.svg"));
     if io_error.is_none()
         && let Err(e) = output::remove_stale(out_dir, &files)
@@ -404,6 +424,14 @@ pub fn run_command(
         Some(p) => (config::load(p)?, p.display().to_string()),
         None => (Config::default(), "the built-in default".to_owned()),
     };
+    let dynamic = match &config {
+        Config::Planar(p) => p.dt_warning(),
+        Config::Hexapod(h) if h.is_dynamic() => h.dt_warning(),
+        Config::Hexapod(_) => None,
+    };
+    if let Some(w) = dynamic {
+        eprintln!("{w}");
+    }
     if let Config::Hexapod(h) = &config
         && h.is_dynamic()
     {
@@ -420,7 +448,13 @@ pub fn run_command(
             r,
             Ok(()) | Err(CliError::Simulation(_) | CliError::Interrupted(_))
         ) {
-            output::remove_stale(out_dir, &crate::hexapod::FILES)?;
+            output::remove_stale(
+                out_dir,
+                &output::selected(
+                    output::files_as(&crate::hexapod::FILES, h.output.format),
+                    &h.output,
+                ),
+            )?;
         }
         return r;
     }

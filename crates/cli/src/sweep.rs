@@ -171,6 +171,13 @@ pub struct SweepArgs {
     /// touchdown of either tip).
     #[arg(long, value_name = "COLUMN", default_value = "touchdown")]
     pub plot: String,
+    /// Write each run's viewer.html (some 0.8 MB a run; off by default:
+    /// `fbd view runs/<i>` writes one later).
+    #[arg(long)]
+    pub viewer: bool,
+    /// Write each run's plots (*.svg; off by default).
+    #[arg(long)]
+    pub plots: bool,
 }
 
 /// Subcommands of `fbd sweep`.
@@ -1031,7 +1038,15 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
         Some(j) => j,
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
     };
-    let plan = plan(path)?;
+    let mut plan = plan(path)?;
+    for c in &mut plan.configs {
+        let output = match c {
+            Config::Planar(p) => &mut p.output,
+            Config::Hexapod(h) => &mut h.output,
+        };
+        output.viewer = a.viewer;
+        output.plots = a.plots;
+    }
     let total = plan.configs.len();
     let dir = &a.out;
     crate::output::prepare_dir(dir)?;
@@ -1133,13 +1148,20 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
     } else {
         String::new()
     };
+    let written = dir_bytes(dir);
     writeln!(
         out,
-        "sweep: {}{shard_txt}; ran {ran_n}, skipped {skipped} finished; {} ok, {} failed\nfiles in {}: index.csv sweep.json sweep.svg runs/",
+        "sweep: {}{shard_txt}; ran {ran_n}, skipped {skipped} finished; {} ok, {} failed\nfiles in {}: index.csv sweep.json sweep.svg runs/ ({}{})",
         count(total, "run", "runs"),
         rows.len() - failed.len(),
         failed.len(),
-        dir.display()
+        dir.display(),
+        human_bytes(written),
+        if a.viewer || a.plots {
+            ""
+        } else {
+            "; per-run viewers and plots with --viewer, --plots"
+        }
     )
     .map_err(CliError::stdout)?;
     let interrupted = stop.load(Ordering::SeqCst);
@@ -1165,6 +1187,33 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
         )));
     }
     Ok(())
+}
+
+/// Bytes of the files under `dir` (what the sweep directory holds).
+pub fn dir_bytes(dir: &Path) -> u64 {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .map(|e| match e.file_type() {
+            Ok(t) if t.is_dir() => dir_bytes(&e.path()),
+            Ok(t) if t.is_file() => e.metadata().map_or(0, |m| m.len()),
+            _ => 0,
+        })
+        .sum()
+}
+
+/// `bytes` as `812 kB`, `95.3 MB`, `1.90 GB` (powers of 1000).
+pub fn human_bytes(bytes: u64) -> String {
+    let b = bytes as f64;
+    if b < 1e6 {
+        format!("{:.0} kB", b / 1e3)
+    } else if b < 1e9 {
+        format!("{:.1} MB", b / 1e6)
+    } else {
+        format!("{:.2} GB", b / 1e9)
+    }
 }
 
 fn copy_dir(from: &Path, to: &Path) -> std::io::Result<()> {

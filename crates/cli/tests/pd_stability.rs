@@ -35,7 +35,7 @@ fn an_unstable_kd_is_one_line_before_the_run() {
         "walk.toml",
         "control.kd",
         "got 30 N·m·s/rad",
-        "lower control.kd below 19.7",
+        "control.kd < 19.7",
         "time.dt below",
     ] {
         assert!(e.contains(needle), "{e:?} lacks {needle:?}");

@@ -76,6 +76,28 @@ impl BodyPose {
         )
     }
 
+    /// `(roll, pitch, heading)` (rad) of the body, derived from φ: the
+    /// body's forward axis is its −z, its right +x, its up +y (the gait's
+    /// axes), and `Rot = Ry(heading)·Rx(pitch)·Rz(−roll)`:
+    ///
+    /// * heading: yaw about the vertical +Y, right-handed (counter-clockwise
+    ///   seen from above), 0 facing −Z; equal to φy when the body is level,
+    ///   and taken on the branch nearest φy (continuous with it);
+    /// * pitch: the forward axis above the horizontal (nose up positive),
+    ///   in [−π/2, π/2];
+    /// * roll: about the forward axis, the right side (+x) down positive.
+    pub fn attitude(&self) -> [f64; 3] {
+        let r = self.rotation();
+        // Forward f = Rot·(0, 0, −1), up u = Rot·(0, 1, 0), right l = Rot·(1, 0, 0).
+        let f = [-r[(0, 2)], -r[(1, 2)], -r[(2, 2)]];
+        let pitch = f[1].clamp(-1.0, 1.0).asin();
+        let heading = (-f[0]).atan2(-f[2]);
+        let tau = std::f64::consts::TAU;
+        let heading = heading + tau * ((self.phi.y - heading) / tau).round();
+        let roll = (-r[(1, 0)]).atan2(r[(1, 1)]);
+        [roll, pitch, heading]
+    }
+
     /// A body-frame point in the inertial frame: `R + Rot·p`.
     pub fn to_inertial(&self, p_body: &Vector3<f64>) -> Vector3<f64> {
         self.position + self.rotation() * p_body
@@ -90,6 +112,34 @@ impl BodyPose {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn attitude_recomposes_the_rotation() {
+        // Rot = Ry(heading)·Rx(pitch)·Rz(−roll) for every pose sampled.
+        for (i, phi) in [
+            [0.0, 0.0, 0.0],
+            [0.1, -0.4, 0.2],
+            [-0.3, 2.9, -0.25],
+            [0.05, 7.0, 0.061],
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let p = BodyPose::new([0.0; 3], phi);
+            let [roll, pitch, heading] = p.attitude();
+            let m = rot_y(heading) * rot_x(pitch) * rot_z(-roll);
+            assert!((m - p.rotation()).norm() < 1e-12, "pose {i}");
+            assert!(
+                (heading - phi[1]).abs() < std::f64::consts::PI,
+                "branch {i}"
+            );
+        }
+        // Level: heading is φy; a nose-up tilt about the right axis is pitch.
+        let level = BodyPose::new([0.0; 3], [0.0, 0.7, 0.0]).attitude();
+        assert!((level[2] - 0.7).abs() < 1e-15 && level[0] == 0.0);
+        let nose_up = BodyPose::new([0.0; 3], [0.06, 0.0, 0.0]).attitude();
+        assert!((nose_up[1] - 0.06).abs() < 1e-15 && nose_up[0].abs() < 1e-15);
+    }
 
     #[test]
     fn closed_form_matches_product() {

@@ -10,6 +10,12 @@ use pyo3::types::PyList;
 
 use crate::errors::{config_error, guard, simulation_error};
 
+/// What a Newton failure after the caller's own torques most often means.
+const EXTERNAL_TORQUE_HINT: &str = "; the torques given to step() are applied explicitly: \
+     a feedback law with gains kp, kd is stable only while kp·Δt²/I + 2·kd·Δt/I < 4 \
+     (I: the effective joint inertia, about 1e-2 kg·m² for the default legs), so lower \
+     the gains or time.dt";
+
 /// The planar model stepped one Δt at a time, for controllers written in
 /// Python. `config` is a configuration as for `fbd.run` (None, a path, TOML
 /// text or a dict).
@@ -20,6 +26,10 @@ use crate::errors::{config_error, guard, simulation_error};
 /// `t`, `k` are the current state; `contact_states`, `contact_forces`,
 /// `joint_forces`, `joint_torques` those of the step solved last; `events`,
 /// `reset()`. The GIL is released while stepping.
+///
+/// The configured duration only sets `steps` (what `fbd.run` solves):
+/// `step()` goes on past it, `t` growing, until the caller stops; the
+/// property `past_duration` says whether `k` has reached `steps - 1`.
 #[pyclass(module = "fbd._fbd")]
 pub struct Simulator {
     model: Model,
@@ -125,6 +135,7 @@ impl Simulator {
                 None,
             ));
         }
+        let torques_given = external.is_some();
         self.data.external_torque = external;
         let (model, data) = (&self.model, &mut self.data);
         let last = &mut self.last;
@@ -152,7 +163,12 @@ impl Simulator {
             Ok(Ok(None)) => Ok(()),
             Ok(Ok(Some(interrupt))) => Err(interrupt),
             Ok(Err(e)) => {
-                let msg = format!("{e} ({})", self.source);
+                let hint = if torques_given && matches!(e, SimError::Newton { .. }) {
+                    EXTERNAL_TORQUE_HINT
+                } else {
+                    ""
+                };
+                let msg = format!("{e} ({}){hint}", self.source);
                 let (k, t) = (e.step(), e.step().map(|k| k as f64 * self.model.dt()));
                 self.failed = Some(e);
                 Err(simulation_error(py, &msg, k, t, None))
@@ -200,6 +216,14 @@ impl Simulator {
     #[getter]
     fn steps(&self) -> usize {
         self.model.steps
+    }
+
+    /// Whether the current state is at or past the configured duration
+    /// (`k ≥ steps − 1`): stepping goes on, the duration only bounds
+    /// `fbd.run`.
+    #[getter]
+    fn past_duration(&self) -> bool {
+        self.data.k + 1 >= self.model.steps
     }
 
     /// `q[k] = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)` (m, rad), a new array.

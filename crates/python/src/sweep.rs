@@ -14,13 +14,15 @@ use crate::errors::{cli_error, guard};
 /// failed, the error message (index.csv is written either way); raises
 /// `ConfigError` or `OSError` when the sweep cannot start.
 #[pyfunction]
-#[pyo3(signature = (sweep_config, out, jobs=None, plot="touchdown"))]
+#[pyo3(signature = (sweep_config, out, jobs=None, plot="touchdown", viewer=false, plots=false))]
 pub fn sweep(
     py: Python<'_>,
     sweep_config: PathBuf,
     out: PathBuf,
     jobs: Option<usize>,
     plot: &str,
+    viewer: bool,
+    plots: bool,
 ) -> PyResult<(String, Option<String>)> {
     guard(|| {
         let args = SweepArgs {
@@ -31,6 +33,8 @@ pub fn sweep(
             shard: None,
             resume: false,
             plot: plot.to_owned(),
+            viewer,
+            plots,
         };
         let mut text = Vec::new();
         let result = py.detach(|| sweep_command(args, &mut text));

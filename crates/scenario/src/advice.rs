@@ -2,13 +2,18 @@
 
 use fbd_sim::SimError;
 
-use crate::PlanarConfig;
+use crate::{ConfigFile, PlanarConfig};
 
 /// Steps per time scale below which a run-time failure is blamed on Δt:
 /// `Δt ≤ τ/STEPS_PER_TIME_SCALE` is considered small enough.
 pub const STEPS_PER_TIME_SCALE: f64 = 20.0;
 
-impl PlanarConfig {
+/// Steps per time scale below which a run gets a warning before it
+/// starts (`Δt > τ/WARN_STEPS_PER_TIME_SCALE`: four times the step the
+/// advice asks for, 0.04 s for the built-in robot).
+pub const WARN_STEPS_PER_TIME_SCALE: f64 = 5.0;
+
+impl<I> ConfigFile<I> {
     /// The robot's shortest natural time scale `τ = √(c/g)` (s): how fast
     /// a lower link of length `c` swings under gravity `g`. `None` without
     /// gravity.
@@ -18,7 +23,7 @@ impl PlanarConfig {
     }
 
     /// A time step that resolves the motion: the largest 1, 2 or 5 × 10ⁿ s
-    /// not above `τ / 20` ([`PlanarConfig::time_scale`]); 0.01 s for the
+    /// not above `τ / 20` ([`ConfigFile::time_scale`]); 0.01 s for the
     /// built-in robot.
     pub fn suggested_dt(&self) -> Option<f64> {
         let limit = self.time_scale()? / STEPS_PER_TIME_SCALE;
@@ -31,6 +36,24 @@ impl PlanarConfig {
         format!("{:.1e}", m * decade).parse().ok()
     }
 
+    /// A warning before a dynamic run whose Δt is far too large for the
+    /// robot's motion (`Δt > τ/5`, [`WARN_STEPS_PER_TIME_SCALE`]): the
+    /// steps would not resolve a swing or a touchdown. Names the value to
+    /// use ([`ConfigFile::suggested_dt`]).
+    pub fn dt_warning(&self) -> Option<String> {
+        let tau = self.time_scale()?;
+        let dt = self.time.dt;
+        let suggested = self.suggested_dt()?;
+        (dt > tau / WARN_STEPS_PER_TIME_SCALE).then(|| {
+            format!(
+                "warning: time.dt = {dt} s is far too large for this robot: its lower links swing under gravity on a time scale √(c/g) = {tau:.3} s, which a step should resolve at least {STEPS_PER_TIME_SCALE} times (the run solves {} steps); try time.dt = {suggested}",
+                (self.time.duration / dt).round() as u64 + 1
+            )
+        })
+    }
+}
+
+impl PlanarConfig {
     /// One clause of advice for a run-time failure `e`, or `None`: when Δt
     /// is above [`PlanarConfig::suggested_dt`], says that Δt is likely too
     /// large and suggests that value.

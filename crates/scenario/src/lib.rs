@@ -506,12 +506,47 @@ impl ContactConfig {
 pub struct OutputConfig {
     /// Write every `stride`-th step to `trajectory.csv`.
     pub stride: usize,
+    /// The trajectory's file format: `"csv"` (default, `trajectory.csv`)
+    /// or `"parquet"` (`trajectory.parquet`, the same columns).
+    pub format: OutputFormat,
+    /// Write `viewer.html` (default true; `fbd sweep` sets it false in its
+    /// runs unless `--viewer`).
+    pub viewer: bool,
+    /// Write the plots (`*.svg`; default true; `fbd sweep` sets it false in
+    /// its runs unless `--plots`).
+    pub plots: bool,
 }
 
 impl Default for OutputConfig {
     fn default() -> Self {
         Self {
             stride: PlanarParams::default().stride,
+            format: OutputFormat::Csv,
+            viewer: true,
+            plots: true,
+        }
+    }
+}
+
+/// `[output] format`: the file the trajectory is written to.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum OutputFormat {
+    /// `trajectory.csv`: text, one row per written step (the contract's
+    /// file; default).
+    #[default]
+    Csv,
+    /// `trajectory.parquet`: the same columns in Apache Parquet (numbers
+    /// as float64, states as strings, `newton_iterations` as int64).
+    Parquet,
+}
+
+impl OutputFormat {
+    /// The trajectory's file name in this format.
+    pub fn trajectory_file(self) -> &'static str {
+        match self {
+            Self::Csv => "trajectory.csv",
+            Self::Parquet => "trajectory.parquet",
         }
     }
 }

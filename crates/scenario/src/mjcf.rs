@@ -43,7 +43,8 @@
 //! * sites `hip{n}`, `knee{n}`, `tip{n}` at the points `fbd kinematics`
 //!   prints; Δt is the `timestep`, integrator `implicitfast`.
 //!
-//! Terrain: flat ground or none; any other kind is an error naming
+//! Terrain: flat ground, a slope (a tilted plane, its `zaxis` the slope's
+//! normal) or none; any other kind is an error naming
 //! `terrain.kind` (MuJoCo's height fields are not fbd's analytic
 //! surfaces).
 
@@ -162,22 +163,26 @@ fn servo(p: &SpatialParams) -> Option<Servo> {
 ///
 /// # Errors
 /// [`ConfigError::Semantic`] naming `terrain.kind` for a terrain other
-/// than flat ground or none.
+/// than flat ground, a slope or none.
 pub fn mjcf(params: &SpatialParams, file: &str) -> Result<String, ConfigError> {
     let p = params;
     let unsupported = |kind: &str| {
         ConfigError::semantic(
             file,
             "terrain.kind",
-            "MuJoCo export supports flat ground only",
+            "MuJoCo export supports planar ground only (MuJoCo's height fields are not fbd's analytic surfaces)",
             format!("\"{kind}\""),
-            "\"flat\" or \"none\"",
+            "\"flat\", \"slope\" or \"none\"",
         )
     };
+    // The ground plane: a point of fbd's terrain and its unit normal.
     let ground = match &p.terrain.terrain {
-        Terrain::Flat { height } => Some(*height),
+        Terrain::Flat { height } => Some(([0.0, *height, 0.0], [0.0, 1.0, 0.0])),
         Terrain::None => None,
-        Terrain::Slope { .. } => return Err(unsupported("slope")),
+        Terrain::Slope { .. } => Some((
+            [0.0, p.terrain.height(0.0, 0.0), 0.0],
+            p.terrain.normal(0.0, 0.0),
+        )),
         Terrain::Profile { .. } => return Err(unsupported("profile")),
         Terrain::Sine { .. } => return Err(unsupported("sine")),
         Terrain::Steps { .. } => return Err(unsupported("steps")),
@@ -232,13 +237,17 @@ pub fn mjcf(params: &SpatialParams, file: &str) -> Result<String, ConfigError> {
     );
     let _ = writeln!(w, "  </default>");
     let _ = writeln!(w, "  <worldbody>");
-    if let Some(h) = ground {
+    if let Some((at, n)) = ground {
+        // One sphere radius below the terrain, along its normal (a slope's
+        // plane is tilted: zaxis is its normal).
+        let pos = [at[0] - r * n[0], at[1] - r * n[1], at[2] - r * n[2]];
         let _ = writeln!(
             w,
-            "    <geom name=\"ground\" type=\"plane\" size=\"0 0 1\" pos=\"0 {} 0\" \
-             zaxis=\"0 1 0\" contype=\"0\" conaffinity=\"1\" condim=\"3\" \
+            "    <geom name=\"ground\" type=\"plane\" size=\"0 0 1\" pos=\"{}\" \
+             zaxis=\"{}\" contype=\"0\" conaffinity=\"1\" condim=\"3\" \
              friction=\"{} 0.005 0.0001\" group=\"0\" rgba=\"0.8 0.8 0.8 1\"/>",
-            num(h - r),
+            nums(&pos),
+            nums(&n),
             num(mu)
         );
     }
@@ -703,14 +712,49 @@ mod tests {
     }
 
     #[test]
-    fn other_terrains_are_an_error_naming_the_key() {
+    fn a_slope_is_a_tilted_plane_one_radius_below_it() {
         let p = SpatialParams {
-            terrain: Surface::new(Terrain::slope_deg(10.0, 0.0), 0.0),
+            terrain: Surface::new(Terrain::slope_deg(10.0, 0.05), 0.0),
             ..SpatialParams::default()
         };
-        let e = mjcf(&p, "slope.toml").unwrap_err().to_string();
-        assert!(e.starts_with("slope.toml: terrain.kind:"), "{e}");
-        assert!(e.contains("\"slope\""), "{e}");
+        let xml = mjcf(&p, "slope.toml").unwrap();
+        let doc = parse(&xml);
+        let g = doc
+            .descendants()
+            .find(|n| n.attribute("name") == Some("ground"))
+            .unwrap();
+        let v = |k: &str| -> Vec<f64> {
+            g.attribute(k)
+                .unwrap()
+                .split_whitespace()
+                .map(|x| x.parse().unwrap())
+                .collect()
+        };
+        let (pos, n) = (v("pos"), v("zaxis"));
+        let a = 10f64.to_radians();
+        assert!((n[0] + a.sin()).abs() < 1e-12 && (n[1] - a.cos()).abs() < 1e-12);
+        // pos + r·n is on fbd's terrain y = 0.05 + tan(10°)·x.
+        let on = [pos[0] + SPHERE_RADIUS * n[0], pos[1] + SPHERE_RADIUS * n[1]];
+        assert!((on[1] - (0.05 + a.tan() * on[0])).abs() < 1e-12, "{pos:?}");
+    }
+
+    #[test]
+    fn other_terrains_are_an_error_naming_the_key() {
+        let p = SpatialParams {
+            terrain: Surface::new(
+                Terrain::Sine {
+                    amplitude: 0.01,
+                    wavelength: 1.0,
+                    phase: 0.0,
+                    height: 0.0,
+                },
+                0.0,
+            ),
+            ..SpatialParams::default()
+        };
+        let e = mjcf(&p, "sine.toml").unwrap_err().to_string();
+        assert!(e.starts_with("sine.toml: terrain.kind:"), "{e}");
+        assert!(e.contains("\"sine\""), "{e}");
         let none = SpatialParams {
             terrain: Surface::new(Terrain::None, 0.0),
             ..SpatialParams::default()

@@ -164,7 +164,7 @@ pub(crate) fn pd_stability(
             &why,
             format!("{kd} N·m·s/rad"),
             &format!(
-                "lower control.kd below {kd_max:.4} N·m·s/rad or time.dt below {dt_max:.3e} s"
+                "control.kd < {kd_max:.4} N·m·s/rad: set control.kd below that, or time.dt below {dt_max:.3e} s"
             ),
         )
     } else {
@@ -174,7 +174,7 @@ pub(crate) fn pd_stability(
             &why,
             format!("{kp} N·m/rad"),
             &format!(
-                "lower control.kp below {:.4} N·m/rad or time.dt below {dt_max:.3e} s",
+                "control.kp < {:.4} N·m/rad (even with control.kd = 0): set control.kp below that, or time.dt below {dt_max:.3e} s",
                 4.0 * inertia / (dt * dt)
             ),
         )
@@ -309,7 +309,7 @@ mod tests {
             .to_string();
         assert!(e.starts_with("control.kd: "), "{e}");
         assert!(
-            e.contains("lower control.kd below 20.5000 N·m·s/rad"),
+            e.contains("control.kd < 20.5000 N·m·s/rad: set control.kd below that"),
             "{e}"
         );
         assert!(e.contains("time.dt below 6.920e-4 s"), "{e}");

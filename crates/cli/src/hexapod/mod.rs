@@ -6,18 +6,16 @@
 mod plots;
 
 use std::collections::BTreeMap;
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use fbd_sim::gait::{GaitData, GaitEvent, GaitModel, GaitSummary, LEGS, run_gait};
 use serde::Serialize;
-use tempfile::NamedTempFile;
 
 use crate::CliError;
 use crate::config::{Config, HexapodConfig};
 use crate::output::{self, Ending};
-use crate::steptime::StepTimes;
 use crate::viewer::hexapod::{HexFrame, HexapodScene};
 
 pub use plots::{GaitPlotData, footprints_svg, gait_svg, joints_svg};
@@ -38,7 +36,7 @@ pub const FILES: [&str; 8] = [
 /// pose `rx, ry, rz, phi_x, phi_y, phi_z`, `theta{j}_{n}`, `omega{j}_{n}`,
 /// `alpha{j}_{n}` (joint j = 1..3 of leg n = 1..6, leg by leg),
 /// `foot{n}_x, foot{n}_y, foot{n}_z`, `stance{n}`, `com_x, com_y, com_z`,
-/// `margin`.
+/// `margin`, `roll, pitch, heading` ([`ATTITUDE_COLUMNS`]).
 pub fn columns() -> Vec<String> {
     let mut c: Vec<String> = ["t", "rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
         .iter()
@@ -60,11 +58,18 @@ pub fn columns() -> Vec<String> {
         c.push(format!("stance{n}"));
     }
     c.extend(["com_x", "com_y", "com_z", "margin"].map(str::to_owned));
+    c.extend(ATTITUDE_COLUMNS.map(str::to_owned));
     c
 }
 
+/// The body's attitude derived from φ, after the other columns of the
+/// hexapod files (rad; [`fbd_kinematics::pose::BodyPose::attitude`]):
+/// roll (right side down positive), pitch (nose up positive) and heading
+/// (yaw about the vertical +Y, equal to `phi_y` when level).
+pub const ATTITUDE_COLUMNS: [&str; 3] = ["roll", "pitch", "heading"];
+
 /// Values of a `trajectory.csv` row after `t` ([`row_values`]).
-pub const ROW_VALUES: usize = 6 + 3 * 3 * LEGS + 3 * LEGS + LEGS + 4;
+pub const ROW_VALUES: usize = 6 + 3 * 3 * LEGS + 3 * LEGS + LEGS + 4 + 3;
 
 /// Where the `stance{n}` flags are among the [`row_values`] (1 or 0).
 pub const STANCE: std::ops::Range<usize> = 6 + 12 * LEGS..6 + 13 * LEGS;
@@ -108,70 +113,50 @@ pub fn row_values(d: &GaitData, out: &mut [f64; ROW_VALUES]) {
     [d.com.x, d.com.y, d.com.z, d.margin]
         .into_iter()
         .for_each(&mut put);
+    fbd_kinematics::pose::BodyPose {
+        position: body.position,
+        phi: body.phi,
+    }
+    .attitude()
+    .into_iter()
+    .for_each(&mut put);
 }
 
-/// Streams the hexapod `trajectory.csv` into a temporary file.
+/// Streams the hexapod trajectory (`trajectory.csv` or
+/// `trajectory.parquet`) into a temporary file.
 struct Writer {
-    out: BufWriter<NamedTempFile>,
-    dest: PathBuf,
-    times: StepTimes,
-    error: Option<std::io::Error>,
+    table: output::Table,
     rows: usize,
 }
 
 impl Writer {
-    fn create(dir: &Path, dt: f64) -> Result<Self, CliError> {
-        let tmp = output::temp_in(dir, "trajectory.csv")?;
-        let mut w = Self {
-            out: BufWriter::with_capacity(1 << 16, tmp),
-            dest: dir.join("trajectory.csv"),
-            times: StepTimes::new(dt),
-            error: None,
+    fn create(dir: &Path, dt: f64, format: fbd_scenario::OutputFormat) -> Result<Self, CliError> {
+        Ok(Self {
+            table: output::Table::create(dir, format, columns(), dt)?,
             rows: 0,
-        };
-        let header = columns().join(",");
-        if let Err(e) = writeln!(w.out, "{header}") {
-            w.error = Some(e);
-        }
-        Ok(w)
-    }
-
-    fn row(&mut self, d: &GaitData) -> std::io::Result<()> {
-        let mut b = ryu::Buffer::new();
-        let out = &mut self.out;
-        self.times.write(out, d.step, d.t)?;
-        let mut v = [0.0; ROW_VALUES];
-        row_values(d, &mut v);
-        for (i, x) in v.iter().enumerate() {
-            if STANCE.contains(&i) {
-                out.write_all(if *x == 1.0 { b",1" } else { b",0" })?;
-            } else {
-                out.write_all(b",")?;
-                out.write_all(b.format(*x).as_bytes())?;
-            }
-        }
-        out.write_all(b"\n")
+        })
     }
 
     fn write(&mut self, d: &GaitData) {
-        if self.error.is_none() {
-            match self.row(d) {
-                Ok(()) => self.rows += 1,
-                Err(e) => self.error = Some(e),
+        let mut v = [0.0; ROW_VALUES];
+        row_values(d, &mut v);
+        self.table.row(|sink| {
+            sink.time(d.step, d.t);
+            for (i, x) in v.iter().enumerate() {
+                if STANCE.contains(&i) {
+                    sink.flag(*x == 1.0);
+                } else {
+                    sink.num(*x);
+                }
             }
+        });
+        if !self.table.failed() {
+            self.rows += 1;
         }
     }
 
     fn finish(self) -> Result<PathBuf, CliError> {
-        if let Some(e) = self.error {
-            return Err(CliError::io(self.dest.display(), &e));
-        }
-        let tmp = self
-            .out
-            .into_inner()
-            .map_err(|e| CliError::io(self.dest.display(), e.error()))?;
-        output::persist(tmp, &self.dest)?;
-        Ok(self.dest)
+        self.table.finish()
     }
 }
 
@@ -365,18 +350,26 @@ pub fn simulate(
     let mut traj = match out_dir {
         Some(dir) => {
             output::prepare_dir(dir)?;
-            Some(Writer::create(dir, model.dt)?)
+            output::warn_size(
+                model.steps.div_ceil(stride),
+                columns().len(),
+                stride,
+                h.output.format,
+            );
+            Some(Writer::create(dir, model.dt, h.output.format)?)
         }
         None => None,
     };
-    let mut plot = out_dir.map(|_| GaitPlotData::new(&model));
+    let mut plot = out_dir
+        .filter(|_| h.output.plots)
+        .map(|_| GaitPlotData::new(&model));
     // viewer.html: one frame per trajectory row (decimated when long).
-    let mut view = out_dir.map(|dir| {
+    let mut view = out_dir.filter(|_| h.output.viewer).map(|_| {
         HexapodScene::new(
             model.kin.clone(),
             model.surface.clone(),
             model.steps.div_ceil(stride),
-            &crate::viewer::title_of(dir),
+            &crate::viewer::title_of(source, "hexapod, kinematic gait"),
         )
     });
     let mut rows = 0;
@@ -396,7 +389,7 @@ pub fn simulate(
         }
     });
     let s = summary(&model, stride, rows, &run);
-    let (Some(out_dir), Some(traj), Some(plot), Some(view)) = (out_dir, traj, plot, view) else {
+    let (Some(out_dir), Some(traj)) = (out_dir, traj) else {
         return Ok(HexapodRun {
             run,
             summary: s,
@@ -419,17 +412,21 @@ pub fn simulate(
         &config.to_toml(),
         &mut keep,
     );
-    for (name, svg) in [
-        ("gait.svg", gait_svg(&plot)),
-        ("footprints.svg", footprints_svg(&plot)),
-        ("joints.svg", joints_svg(&plot)),
-    ] {
-        keep(
-            svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
-                .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
-        );
+    if let Some(plot) = plot {
+        for (name, svg) in [
+            ("gait.svg", gait_svg(&plot)),
+            ("footprints.svg", footprints_svg(&plot)),
+            ("joints.svg", joints_svg(&plot)),
+        ] {
+            keep(
+                svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
+                    .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
+            );
+        }
     }
-    keep(crate::viewer::write(out_dir, &view.finish()));
+    if let Some(view) = view {
+        keep(crate::viewer::write(out_dir, &view.finish()));
+    }
     Ok(HexapodRun {
         run,
         summary: s,
@@ -515,5 +512,6 @@ pub fn run_command(
     } else {
         Ending::Completed
     };
-    output::conclude(out, text, out_dir, &FILES, io_error, ending)
+    let files = output::selected(output::files_as(&FILES, h.output.format), &h.output);
+    output::conclude(out, text, out_dir, &files, io_error, ending)
 }

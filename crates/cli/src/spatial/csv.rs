@@ -2,18 +2,16 @@
 //! the model's legs and contact points (`{leg, kind}` data), and the
 //! streaming writer.
 
-use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
+use fbd_scenario::OutputFormat;
 use fbd_sim::spatial::{SpatialParams, SpatialRecord};
-use tempfile::NamedTempFile;
 
 use super::Layout;
 use crate::CliError;
-use crate::output::{self, CsvRow};
-use crate::steptime::StepTimes;
+use crate::output;
 
 /// The body pose columns after `t`.
 pub const POSE_COLUMNS: [&str; 6] = ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"];
@@ -40,7 +38,9 @@ pub fn point_prefix(kind: PointKind) -> &'static str {
 /// * per knee or hip contact point (leg by leg, knee before hip):
 ///   `kneepoint{n}_state, kneepoint{n}_fx, kneepoint{n}_fy,
 ///   kneepoint{n}_fz, kneepoint{n}_n` (`hippoint{n}_…` alike);
-/// * `kinetic, potential, newton_iterations`.
+/// * `kinetic, potential, newton_iterations`;
+/// * `roll, pitch, heading`: the body's attitude derived from φ
+///   ([`crate::hexapod::ATTITUDE_COLUMNS`]).
 pub fn columns(layout: &Layout) -> Vec<String> {
     let mut c: Vec<String> = std::iter::once("t")
         .chain(POSE_COLUMNS)
@@ -75,6 +75,7 @@ pub fn columns(layout: &Layout) -> Vec<String> {
         }
     }
     c.extend(["kinetic", "potential", "newton_iterations"].map(str::to_owned));
+    c.extend(crate::hexapod::ATTITUDE_COLUMNS.map(str::to_owned));
     c
 }
 
@@ -178,44 +179,43 @@ pub fn row_values(
     sink.num(r.kinetic);
     sink.num(r.potential);
     sink.count(r.newton_iterations);
+    let pose =
+        fbd_kinematics::pose::BodyPose::new([r.q[0], r.q[1], r.q[2]], [r.q[3], r.q[4], r.q[5]]);
+    for a in pose.attitude() {
+        sink.num(a);
+    }
 }
 
-/// Streams `trajectory.csv` through a buffer into a temporary file; no
-/// allocation per row.
+/// Streams the trajectory (`trajectory.csv` or `trajectory.parquet`)
+/// into a temporary file; no allocation per CSV row.
 pub struct TrajectoryWriter {
-    out: BufWriter<NamedTempFile>,
-    dest: PathBuf,
-    num: ryu::Buffer,
-    times: StepTimes,
+    table: output::Table,
     layout: Layout,
     slots: Option<Slots>,
     feet: super::Feet,
-    error: Option<io::Error>,
     rows: usize,
 }
 
 impl TrajectoryWriter {
-    /// Opens the temporary file in `dir` and writes the header.
+    /// Opens the temporary `trajectory.csv` in `dir` and writes the header.
     pub fn create(dir: &Path, params: &SpatialParams) -> Result<Self, CliError> {
-        let dest = dir.join("trajectory.csv");
-        let tmp = output::temp_in(dir, "trajectory.csv")?;
+        Self::create_as(dir, params, OutputFormat::Csv)
+    }
+
+    /// [`TrajectoryWriter::create`] in `format` (`[output] format`).
+    pub fn create_as(
+        dir: &Path,
+        params: &SpatialParams,
+        format: OutputFormat,
+    ) -> Result<Self, CliError> {
         let layout = Layout::of(params);
-        let mut w = Self {
-            out: BufWriter::with_capacity(1 << 16, tmp),
-            dest,
-            num: ryu::Buffer::new(),
-            times: StepTimes::new(params.dt),
+        Ok(Self {
+            table: output::Table::create(dir, format, columns(&layout), params.dt)?,
             feet: super::Feet::new(params),
             layout,
             slots: None,
-            error: None,
             rows: 0,
-        };
-        let header = columns(&w.layout).join(",");
-        if let Err(e) = writeln!(w.out, "{header}") {
-            return Err(CliError::io(w.dest.display(), &e));
-        }
-        Ok(w)
+        })
     }
 
     /// Rows written so far.
@@ -226,39 +226,18 @@ impl TrajectoryWriter {
     /// Appends the row of `r`. An I/O error is kept and reported by
     /// [`TrajectoryWriter::finish`]; later rows are skipped.
     pub fn write(&mut self, r: &SpatialRecord) {
-        if self.error.is_some() {
-            return;
+        let slots = self.slots.get_or_insert_with(|| Slots::of(&self.layout, r));
+        let (layout, feet) = (&self.layout, &mut self.feet);
+        self.table
+            .row(|sink| row_values(layout, slots, feet, r, sink));
+        if !self.table.failed() {
+            self.rows += 1;
         }
-        if self.slots.is_none() {
-            self.slots = Some(Slots::of(&self.layout, r));
-        }
-        match self.write_row(r) {
-            Ok(()) => self.rows += 1,
-            Err(e) => self.error = Some(e),
-        }
-    }
-
-    fn write_row(&mut self, r: &SpatialRecord) -> io::Result<()> {
-        let slots = self.slots.take().unwrap_or_default();
-        let mut row = CsvRow::new(&mut self.out, &mut self.num, &self.times);
-        row_values(&self.layout, &slots, &mut self.feet, r, &mut row);
-        let result = row.end();
-        self.slots = Some(slots);
-        result
     }
 
     /// Flushes and renames the file into place.
     pub fn finish(self) -> Result<PathBuf, CliError> {
-        let dest = self.dest;
-        if let Some(e) = self.error {
-            return Err(CliError::io(dest.display(), &e));
-        }
-        let tmp = self
-            .out
-            .into_inner()
-            .map_err(|e| CliError::io(dest.display(), e.error()))?;
-        output::persist(tmp, &dest)?;
-        Ok(dest)
+        self.table.finish()
     }
 }
 

@@ -14,6 +14,7 @@ use std::sync::atomic::AtomicBool;
 
 use fbd_dynamics::PointKind;
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
+use fbd_scenario::OutputConfig;
 use fbd_sim::RunSummary;
 use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_until};
 
@@ -208,6 +209,7 @@ pub struct Outputs {
     steps: usize,
     dir: Option<PathBuf>,
     traj: Option<TrajectoryWriter>,
+    output: OutputConfig,
     plot: Option<plots::Recorder>,
     view: Option<HexapodScene>,
     collect: summary::Collector,
@@ -224,32 +226,54 @@ impl Outputs {
         steps: usize,
         out_dir: Option<&Path>,
     ) -> Result<Self, CliError> {
+        Self::new_as(params, steps, out_dir, &OutputConfig::default(), "hexapod")
+    }
+
+    /// [`Outputs::new`] with the files `output` selects (`[output] format`,
+    /// `viewer`, `plots`).
+    pub fn new_as(
+        params: &SpatialParams,
+        steps: usize,
+        out_dir: Option<&Path>,
+        output: &OutputConfig,
+        source: &str,
+    ) -> Result<Self, CliError> {
+        let format = output.format;
         let layout = Layout::of(params);
         let stride = params.stride.max(1);
         let traj = match out_dir {
             Some(dir) => {
                 output::prepare_dir(dir)?;
-                Some(TrajectoryWriter::create(dir, params)?)
+                output::warn_size(
+                    steps.div_ceil(stride),
+                    columns(&layout).len(),
+                    stride,
+                    format,
+                );
+                Some(TrajectoryWriter::create_as(dir, params, format)?)
             }
             None => None,
         };
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
         Ok(Self {
             collect: summary::Collector::new(&layout, &params.terrain),
-            plot: out_dir.map(|_| plots::Recorder::new(&layout, t_end)),
-            view: out_dir.map(|dir| {
+            plot: out_dir
+                .filter(|_| output.plots)
+                .map(|_| plots::Recorder::new(&layout, t_end)),
+            view: out_dir.filter(|_| output.viewer).map(|_| {
                 HexapodScene::dynamic(
                     params.kinematic_model(),
                     params.terrain.clone(),
                     &layout.legs,
                     &layout.extra_points,
                     steps.div_ceil(stride),
-                    &crate::viewer::title_of(dir),
+                    &crate::viewer::title_of(source, "hexapod, 3D dynamics"),
                 )
             }),
             feet: Feet::new(params),
             dir: out_dir.map(Path::to_owned),
             traj,
+            output: output.clone(),
             layout,
             stride,
             steps,
@@ -287,9 +311,7 @@ impl Outputs {
         let s = self
             .collect
             .finish(params, self.steps, &self.layout, &run, self.rows);
-        let (Some(out_dir), Some(traj), Some(plot), Some(view)) =
-            (self.dir, self.traj, self.plot, self.view)
-        else {
+        let (Some(out_dir), Some(traj)) = (self.dir, self.traj) else {
             return SpatialRun {
                 run,
                 summary: s,
@@ -313,21 +335,26 @@ impl Outputs {
             config_toml,
             &mut keep,
         );
-        let plot = plot.finish(&run);
-        for (name, svg) in [
-            ("feet.svg", plots::feet_svg(&plot)),
-            ("torques.svg", plots::torques_svg(&plot)),
-            ("body.svg", plots::body_svg(&plot)),
-            ("energy.svg", plots::energy_svg(&plot)),
-        ] {
-            keep(
-                svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
-                    .and_then(|s| output::write_file(&out_dir, name, s.as_bytes())),
-            );
+        if let Some(plot) = self.plot {
+            let plot = plot.finish(&run);
+            for (name, svg) in [
+                ("feet.svg", plots::feet_svg(&plot)),
+                ("torques.svg", plots::torques_svg(&plot)),
+                ("body.svg", plots::body_svg(&plot)),
+                ("energy.svg", plots::energy_svg(&plot)),
+            ] {
+                keep(
+                    svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
+                        .and_then(|s| output::write_file(&out_dir, name, s.as_bytes())),
+                );
+            }
         }
-        keep(crate::viewer::write(&out_dir, &view.finish()));
+        if let Some(view) = self.view {
+            keep(crate::viewer::write(&out_dir, &view.finish()));
+        }
+        let files = output::selected(output::files_as(&FILES, self.output.format), &self.output);
         if io_error.is_none()
-            && let Err(e) = output::remove_stale(&out_dir, &FILES)
+            && let Err(e) = output::remove_stale(&out_dir, &files)
         {
             io_error = Some(e);
         }
@@ -335,14 +362,23 @@ impl Outputs {
             run,
             summary: s,
             io_error,
-            files: FILES.to_vec(),
+            files,
         }
     }
+}
+
+/// `[output]` of a configuration's text (the defaults when it has none).
+fn output_of(config_toml: &str) -> OutputConfig {
+    toml::from_str::<toml::Table>(config_toml)
+        .ok()
+        .and_then(|t| t.get("output")?.clone().try_into().ok())
+        .unwrap_or_default()
 }
 
 /// Simulates `params` (read from `source`; `config_toml` is the complete
 /// configuration for `config.toml`), handing every `stride`-th record to
 /// `on_row`; when `out_dir` is given, writes every file of a dynamic
+/// (the trajectory in the `[output] format` of `config_toml`)
 /// hexapod run there, streaming `trajectory.csv`, even after a simulation
 /// error (which is in `run.error`). The run stops before its next step
 /// once `stop` is set (`run.interrupted`). Fails for an invalid model or
@@ -362,7 +398,13 @@ pub fn simulate(
         file: source.to_owned(),
         message: e.to_string(),
     })?;
-    let mut out = Outputs::new(params, model.steps, out_dir)?;
+    let mut out = Outputs::new_as(
+        params,
+        model.steps,
+        out_dir,
+        &output_of(config_toml),
+        source,
+    )?;
     let run = run_until(&model, stop, |r: &SpatialRecord| out.push(r, on_row));
     Ok(out.finish(params, run, config_toml))
 }
@@ -413,8 +455,11 @@ pub fn run_command(
     ));
     if let Some(h) = summary.final_height {
         text.push_str(&format!(
-            "body moved {:.4} m (x {:.4} m, z {:.4} m), final height {:.4} m\n",
-            summary.distance, summary.displacement[0], summary.displacement[2], h
+            "body moved {} m (x {} m, z {} m), final height {} m\n",
+            output::fixed(summary.distance, 4),
+            output::fixed(summary.displacement[0], 4),
+            output::fixed(summary.displacement[2], 4),
+            output::fixed(h, 4)
         ));
     }
     let ending = if let Some(e) = &run.error {

@@ -380,12 +380,26 @@ const BODY_HTML: &str = r#"<header><h1 id="title">fbd viewer</h1><span id="info"
 </main>
 "#;
 
-/// The page title of a run written to `dir`: the folder's name.
-pub fn title_of(dir: &Path) -> String {
-    dir.file_name().map_or_else(
-        || dir.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    )
+/// The page title of a run of the configuration `source` (a path, or the
+/// built-in default's description) of `model` (e.g. `hexapod, 3D
+/// dynamics`): the file's name without `.toml` (`hexapod_walk`), with its
+/// folder for a sweep run's `runs/12/config.toml` (`12/config`), then the
+/// model.
+pub fn title_of(source: &str, model: &str) -> String {
+    let path = Path::new(source);
+    let name = match (path.extension(), path.file_stem()) {
+        (Some(ext), Some(stem)) if ext == "toml" => {
+            let stem = stem.to_string_lossy();
+            match path.parent().and_then(Path::file_name) {
+                Some(parent) if stem == "config" => {
+                    format!("{}/{stem}", parent.to_string_lossy())
+                }
+                _ => stem.into_owned(),
+            }
+        }
+        _ => source.to_owned(),
+    };
+    format!("{name} · {model}")
 }
 
 /// Writes `dir/viewer.html` all-or-nothing.

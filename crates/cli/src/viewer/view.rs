@@ -394,7 +394,20 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
     let config = config::load(&config_file)?;
     let source = config_file.display().to_string();
     let traj = dir.join("trajectory.csv");
-    let title = super::title_of(dir);
+    let title = super::title_of(
+        &source,
+        match &config {
+            Config::Planar(_) => "planar model",
+            Config::Hexapod(c) if c.is_dynamic() => "hexapod, 3D dynamics",
+            Config::Hexapod(_) => "hexapod, kinematic gait",
+        },
+    );
+    if !traj.exists() && dir.join("trajectory.parquet").exists() {
+        return Err(CliError::Usage(format!(
+            "{}: `fbd view` reads trajectory.csv, and this run wrote trajectory.parquet (`[output] format = \"parquet\"`); `fbd run` with `[output] viewer = true` writes the viewer itself",
+            dir.display()
+        )));
+    }
     let scene = match &config {
         Config::Planar(c) => {
             let model = c.model(&source)?;

@@ -17,13 +17,13 @@ The GIL is released while simulating, so Python threads (e.g.
 
 from __future__ import annotations
 
-import csv
-import json
-import os
-from collections.abc import Mapping
+import csv as _csv
+import json as _json
+import os as _os
+from collections.abc import Mapping as _Mapping
 from typing import Any, Dict, Iterator, List, Optional, Sequence, Tuple, Union
 
-import numpy as np
+import numpy as _np
 
 from . import _fbd
 from ._errors import ConfigError, SimulationError
@@ -46,12 +46,17 @@ __all__ = [
 
 __version__ = "0.1.0"
 
+
+def __dir__() -> List[str]:
+    """The public API only (``dir(fbd)``), not the imported helpers."""
+    return sorted(__all__ + ["__version__"])
+
 #: What a configuration may be: None (the built-in default experiment), a
 #: path, TOML text, or a dict with the keys of the files.
-ConfigLike = Union[None, str, "os.PathLike[str]", Mapping[str, Any]]
+ConfigLike = Union[None, str, "_os.PathLike[str]", Mapping[str, Any]]
 
 
-class Result(Mapping):
+class Result(_Mapping):
     """The outcome of :func:`run`: every column of ``trajectory.csv``.
 
     ``result["rx"]`` is a column as a NumPy array (float64; the state
@@ -86,17 +91,17 @@ class Result(Mapping):
     def __init__(self, raw: Dict[str, Any]) -> None:
         self.columns: List[str] = list(raw["columns"])
         data = raw["data"]
-        self._data: Dict[str, np.ndarray] = {}
+        self._data: Dict[str, _np.ndarray] = {}
         for name in self.columns:
             v = data[name]
-            self._data[name] = v if isinstance(v, np.ndarray) else np.array(v, dtype="<U3")
+            self._data[name] = v if isinstance(v, _np.ndarray) else _np.array(v, dtype="<U3")
         self.events: List[Dict[str, Any]] = list(raw["events"])
-        self.summary: Dict[str, Any] = json.loads(raw["summary"])
+        self.summary: Dict[str, Any] = _json.loads(raw["summary"])
         self.source: str = raw["source"]
         err = raw.get("error")
         self.error: Optional[str] = None if err is None else err["message"]
 
-    def __getitem__(self, name: str) -> np.ndarray:
+    def __getitem__(self, name: str) -> _np.ndarray:
         try:
             return self._data[name]
         except KeyError:
@@ -128,7 +133,7 @@ class Result(Mapping):
         return f"<fbd.Result {self.source}: {self.rows} rows, {len(self.events)} events, {status}>"
 
 
-def run(config: ConfigLike = None, out: Union[None, str, "os.PathLike[str]"] = None) -> Result:
+def run(config: ConfigLike = None, out: Union[None, str, "_os.PathLike[str]"] = None) -> Result:
     """Simulates ``config`` and returns its :class:`Result`.
 
     Args:
@@ -149,7 +154,7 @@ def run(config: ConfigLike = None, out: Union[None, str, "os.PathLike[str]"] = N
 
     The GIL is released while simulating.
     """
-    raw = _fbd.run(config, None if out is None else os.fspath(out))
+    raw = _fbd.run(config, None if out is None else _os.fspath(out))
     result = Result(raw)
     err = raw.get("error")
     if err is not None:
@@ -168,20 +173,20 @@ def kinematics(config: ConfigLike = None) -> Dict[str, Any]:
     inertial frame (m): the JSON of ``fbd kinematics`` as Python objects,
     ``{"legs": [{"leg": 3, "hip": [x, y, z], "knee": ..., "tip": ...}, ...]}``.
     """
-    return json.loads(_fbd.kinematics_json(config))
+    return _json.loads(_fbd.kinematics_json(config))
 
 
-def _rows(a: Any, width: int, name: str) -> Tuple[np.ndarray, bool]:
-    arr = np.ascontiguousarray(np.asarray(a, dtype=np.float64))
+def _rows(a: Any, width: int, name: str) -> Tuple[_np.ndarray, bool]:
+    arr = _np.ascontiguousarray(_np.asarray(a, dtype=_np.float64))
     single = arr.ndim == 1
     if single:
         arr = arr.reshape(1, -1)
     if arr.ndim != 2 or arr.shape[1] != width:
-        raise ValueError(f"{name}: expected shape ({width},) or (N, {width}), got {np.shape(a)}")
+        raise ValueError(f"{name}: expected shape ({width},) or (N, {width}), got {_np.shape(a)}")
     return arr, single
 
 
-def planar_fk(q: Any, config: ConfigLike = None) -> Dict[str, np.ndarray]:
+def planar_fk(q: Any, config: ConfigLike = None) -> Dict[str, _np.ndarray]:
     """Forward kinematics of the planar model.
 
     Args:
@@ -199,7 +204,7 @@ def planar_fk(q: Any, config: ConfigLike = None) -> Dict[str, np.ndarray]:
     return {k: v[0] for k, v in out.items()} if single else out
 
 
-def hexapod_fk(q: Any, config: ConfigLike = None) -> Dict[str, np.ndarray]:
+def hexapod_fk(q: Any, config: ConfigLike = None) -> Dict[str, _np.ndarray]:
     """Forward kinematics of the 24-DOF hexapod (D-H, eqs. 1–5).
 
     Args:
@@ -222,7 +227,7 @@ def leg_ik(
     config: ConfigLike = None,
     leg: Optional[int] = None,
     knee: str = "up",
-) -> np.ndarray:
+) -> _np.ndarray:
     """Inverse kinematics of one leg: ``(θ1, θ2, θ3)`` (rad) placing the tip
     at each target.
 
@@ -258,15 +263,15 @@ class SweepResult:
         self.out = out
         self.message = message
         self.failed = failed
-        self.index: Dict[str, Union[np.ndarray, List[str]]] = {}
-        with open(os.path.join(out, "index.csv"), newline="") as f:
-            rows = list(csv.reader(f))
+        self.index: Dict[str, Union[_np.ndarray, List[str]]] = {}
+        with open(_os.path.join(out, "index.csv"), newline="") as f:
+            rows = list(_csv.reader(f))
         header, body = rows[0], rows[1:]
         for i, name in enumerate(header):
             cells = [r[i] if i < len(r) else "" for r in body]
             try:
-                self.index[name] = np.array(
-                    [float(c) if c != "" else np.nan for c in cells], dtype=np.float64
+                self.index[name] = _np.array(
+                    [float(c) if c != "" else _np.nan for c in cells], dtype=_np.float64
                 )
             except ValueError:
                 self.index[name] = cells
@@ -281,20 +286,26 @@ class SweepResult:
 
 
 def sweep(
-    sweep_config: Union[str, "os.PathLike[str]"],
-    out: Union[str, "os.PathLike[str]"],
+    sweep_config: Union[str, "_os.PathLike[str]"],
+    out: Union[str, "_os.PathLike[str]"],
     jobs: Optional[int] = None,
+    viewer: bool = False,
+    plots: bool = False,
 ) -> SweepResult:
     """Runs a sweep file (the format of ``fbd sweep``) into ``out`` on
     ``jobs`` threads (every core by default), with the GIL released.
 
     Failed runs do not raise: they are rows of ``index.csv`` with their
-    error, and ``SweepResult.failed`` says which.
+    error, and ``SweepResult.failed`` says which. Each run's ``viewer.html``
+    and plots are written only with ``viewer=True``, ``plots=True`` (as
+    ``fbd sweep --viewer --plots``).
 
     Raises:
         ConfigError: the sweep file or its base configuration is invalid.
         OSError: the output directory cannot be written.
     """
-    out = os.fspath(out)
-    message, failed = _fbd.sweep(os.fspath(sweep_config), out, jobs)
+    out = _os.fspath(out)
+    message, failed = _fbd.sweep(
+        _os.fspath(sweep_config), out, jobs, viewer=viewer, plots=plots
+    )
     return SweepResult(out, message, failed)

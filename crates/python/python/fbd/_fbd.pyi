@@ -12,7 +12,12 @@ def run(config: Any = None, out: Optional[str] = None) -> Dict[str, Any]:
     kinematic gait) with the GIL released: ``{"columns", "data", "events",
     "summary" (JSON text), "error", "source"}``; ``fbd.run`` wraps it."""
 def sweep(
-    sweep_config: str, out: str, jobs: Optional[int] = None, plot: str = "touchdown"
+    sweep_config: str,
+    out: str,
+    jobs: Optional[int] = None,
+    plot: str = "touchdown",
+    viewer: bool = False,
+    plots: bool = False,
 ) -> Tuple[str, Optional[str]]: ...
 def kinematics_json(config: Any = None) -> str: ...
 def config_toml(config: Any = None) -> str: ...
@@ -63,6 +68,10 @@ class Simulator:
     @property
     def steps(self) -> int:
         """Steps of the configured duration, ``round(duration/dt) + 1``."""
+    @property
+    def past_duration(self) -> bool:
+        """Whether ``k ≥ steps − 1``: ``step()`` goes on past the configured
+        duration (it only bounds :func:`fbd.run`)."""
     @property
     def q(self) -> npt.NDArray[np.float64]:
         """``q[k] = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)`` (m, rad)."""

@@ -149,7 +149,7 @@ fn dynamic_walk_and_walk_on_ice() {
     let figures = format!("{on_ice:.3} m against {walk:.3} m");
     has(
         &r,
-        &format!("the robot ends {figures}"),
+        &format!("the robot ends {on_ice:.3} m up it against {walk:.3} m"),
         "walk on ice: distances",
     );
     has(

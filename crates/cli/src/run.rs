@@ -195,7 +195,7 @@ fn summary(
         newton_iterations: run.newton_iterations,
         newton_iterations_per_step: output::IterationsPerStep::of(run),
         chord_iterations: run.chord_iterations,
-        full_newton_iterations: run.newton_iterations - run.chord_iterations,
+        full_newton_iterations: run.newton_iterations.saturating_sub(run.chord_iterations),
         numeric_factorizations: run.numeric_factorizations,
         wall_seconds: run.wall_seconds,
         steps_per_second,

@@ -271,7 +271,7 @@ impl Collector {
                 max: self.iter_max,
             },
             chord_iterations: run.chord_iterations,
-            full_newton_iterations: run.newton_iterations - run.chord_iterations,
+            full_newton_iterations: run.newton_iterations.saturating_sub(run.chord_iterations),
             numeric_factorizations: run.numeric_factorizations,
             wall_seconds: run.wall_seconds,
             steps_per_second: (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds),

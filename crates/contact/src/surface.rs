@@ -42,7 +42,7 @@ use crate::terrain::Terrain;
 /// The smoothing radius (m) of a height map's mean surface, the ground a
 /// walking body follows (about the size of a foot's reach, so that one
 /// stair or bump under one foot does not shake the body).
-pub const MEAN_RADIUS: f64 = 0.1;
+pub const MEAN_RADIUS: f64 = 0.4;
 
 /// A height map and its smoothed mean surface.
 #[derive(Clone, Debug, PartialEq)]

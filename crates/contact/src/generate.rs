@@ -262,7 +262,10 @@ mod tests {
         let a = g.grid(&sampling()).unwrap();
         assert_eq!(a, g.grid(&sampling()).unwrap());
         let [lo, hi] = a.range();
-        assert!((lo - 0.02).abs() < 1e-12 && (hi - 0.08).abs() < 1e-12, "{lo} {hi}");
+        assert!(
+            (lo - 0.02).abs() < 1e-12 && (hi - 0.08).abs() < 1e-12,
+            "{lo} {hi}"
+        );
         let other = Generator::Random {
             amplitude: 0.03,
             wavelength: 0.3,

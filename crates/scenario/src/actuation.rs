@@ -479,10 +479,9 @@ impl TerrainConfig {
                 ("step_height", self.step_height.is_some()),
                 ("step_width", self.step_width.is_some()),
             ],
-            TerrainKind::Heightfield => &[
-                ("file", self.file.is_some()),
-                ("size", self.size.is_some()),
-            ],
+            TerrainKind::Heightfield => {
+                &[("file", self.file.is_some()), ("size", self.size.is_some())]
+            }
             TerrainKind::Random | TerrainKind::Pyramids | TerrainKind::Sines => &[
                 ("amplitude", self.amplitude.is_some()),
                 ("wavelength", self.wavelength.is_some()),

@@ -524,9 +524,9 @@ impl TerrainConfig {
     /// The terrain of the simulator.
     pub fn terrain(&self) -> Terrain {
         if terrain_map::is_map(self.kind) {
-            return self
-                .map_section()
-                .unwrap_or(Terrain::Flat { height: self.height });
+            return self.map_section().unwrap_or(Terrain::Flat {
+                height: self.height,
+            });
         }
         self.terrain_kind()
     }

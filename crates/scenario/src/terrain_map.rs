@@ -479,7 +479,15 @@ impl TerrainConfig {
         };
         let path = Path::new(f).parent().unwrap_or(Path::new("")).join(&name);
         let shown = path.display().to_string();
-        let fail = |what: String| semantic(f, "terrain.file", &format!("{shown}: {what}"), &name, "a heightfield file (docs/reference.md)");
+        let fail = |what: String| {
+            semantic(
+                f,
+                "terrain.file",
+                &format!("{shown}: {what}"),
+                &name,
+                "a heightfield file (docs/reference.md)",
+            )
+        };
         let h = read_heights(&path).map_err(fail)?;
         let values = match h.scale {
             Some([lo, hi]) => {
@@ -573,7 +581,11 @@ impl TerrainConfig {
         let generator = match self.kind {
             TerrainKind::Random => Generator::Random {
                 amplitude: need("amplitude", self.amplitude)?,
-                wavelength: positive(f, "terrain.wavelength", need("wavelength", self.wavelength)?)?,
+                wavelength: positive(
+                    f,
+                    "terrain.wavelength",
+                    need("wavelength", self.wavelength)?,
+                )?,
                 seed,
             },
             TerrainKind::Stairs => Generator::Stairs {
@@ -596,11 +608,19 @@ impl TerrainConfig {
             },
             TerrainKind::Pyramids => Generator::Pyramids {
                 amplitude: need("amplitude", self.amplitude)?,
-                wavelength: positive(f, "terrain.wavelength", need("wavelength", self.wavelength)?)?,
+                wavelength: positive(
+                    f,
+                    "terrain.wavelength",
+                    need("wavelength", self.wavelength)?,
+                )?,
             },
             TerrainKind::Sines => Generator::Sines {
                 amplitude: need("amplitude", self.amplitude)?,
-                wavelength: positive(f, "terrain.wavelength", need("wavelength", self.wavelength)?)?,
+                wavelength: positive(
+                    f,
+                    "terrain.wavelength",
+                    need("wavelength", self.wavelength)?,
+                )?,
             },
             k => {
                 return Err(semantic(

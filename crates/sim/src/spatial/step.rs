@@ -250,9 +250,7 @@ fn system<'a>(
         data.fbd.contact[c] = SpatialContactEquation {
             state,
             frame: frame(surface, x, z),
-            mu_dynamic: surface
-                .friction_at(&model.params.friction, x, z)
-                .mu_dynamic,
+            mu_dynamic: surface.friction_at(&model.params.friction, x, z).mu_dynamic,
             regularization: b + model.contact_bumper[c],
         };
     }

@@ -236,7 +236,8 @@ impl Outputs {
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
         Ok(Self {
             collect: summary::Collector::new(&layout, &params.terrain),
-            plot: out_dir.map(|_| plots::Recorder::new(&layout, t_end)),
+            plot: out_dir
+                .map(|_| plots::Recorder::new(&layout, t_end).with_surface(&params.terrain)),
             view: out_dir.map(|dir| {
                 HexapodScene::dynamic(
                     params.kinematic_model(),

@@ -43,9 +43,10 @@
 //! * sites `hip{n}`, `knee{n}`, `tip{n}` at the points `fbd kinematics`
 //!   prints; Δt is the `timestep`, integrator `implicitfast`.
 //!
-//! Terrain: flat ground or none; any other kind is an error naming
-//! `terrain.kind` (MuJoCo's height fields are not fbd's analytic
-//! surfaces).
+//! Terrain: flat ground, none, or a height map (`heightfield` and the
+//! generated kinds, as a MuJoCo `hfield`); any other kind is an error
+//! naming `terrain.kind` (MuJoCo's height fields are not fbd's analytic
+//! profiles).
 
 use std::fmt::Write;
 
@@ -160,9 +161,10 @@ fn servo(p: &SpatialParams) -> Option<Servo> {
 /// MuJoCo's hfield of the height map `g` (see the module docs): MuJoCo's
 /// hfield lies in its geom's x–y plane with elevation along z; the geom's
 /// frame has x = fbd's +X, y = fbd's −Z and z = fbd's +Y. MuJoCo's columns
-/// run along its x (fbd's rows), its rows along its y, from −y to +y (fbd's
-/// columns from +Z to −Z). The elevation data are normalised by MuJoCo to
-/// `[0, 1]` and scaled by `size[2]` = the map's height range.
+/// run along its x (fbd's rows), its rows along its y from +y to −y (fbd's
+/// columns, from −Z to +Z: checked with MuJoCo 4.0.0's `mj_ray` on a
+/// sampled plane). The elevation data are normalised by MuJoCo to `[0, 1]`
+/// and scaled by `size[2]` = the map's height range.
 fn hfield_asset(g: &fbd_contact::HeightGrid) -> String {
     let (nr, nc) = (g.nrow(), g.ncol());
     let [x0, x1, z0, z1] = g.bounds();
@@ -171,7 +173,7 @@ fn hfield_asset(g: &fbd_contact::HeightGrid) -> String {
     let mut data = Vec::with_capacity(nr * nc);
     for r in 0..nc {
         for c in 0..nr {
-            data.push(h[c * nc + (nc - 1 - r)] - lo);
+            data.push(h[c * nc + r] - lo);
         }
     }
     format!(

@@ -243,11 +243,14 @@ fn run_example(name: &str) -> (SpatialParams, Vec<SpatialRecord>, fbd_sim::RunSu
     (p, rows, r.run)
 }
 
+/// The centres of mass of the body and of each leg's upper and lower link.
+type Centres = ([f64; 3], Vec<[[f64; 3]; 2]>);
+
 /// Coulomb's law (with the friction under the point) and Newton's second
 /// law of every body on every interior row.
 fn check_rows(p: &SpatialParams, rows: &[SpatialRecord]) -> f64 {
     let model = p.kinematic_model();
-    let coms: Vec<([f64; 3], Vec<[[f64; 3]; 2]>)> = rows
+    let coms: Vec<Centres> = rows
         .iter()
         .map(|r| {
             let mut q = [0.0; NQ];

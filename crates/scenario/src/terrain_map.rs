@@ -439,7 +439,7 @@ impl TerrainConfig {
             None => DEFAULT_SIZE,
         };
         for (axis, e) in size.iter().enumerate() {
-            if !(*e > 0.0) {
+            if *e <= 0.0 {
                 return Err(semantic(
                     f,
                     "terrain.size",

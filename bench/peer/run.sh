@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# fbd vs MuJoCo on the same models, one core, dt = 1 ms (issues 5, 11, 14).
+# fbd vs MuJoCo on the same models, one core, dt = 1 ms (issues 5, 11, 14,
+# 24: hexapod_rough stands on a random height map, MuJoCo on its hfield).
 #
 #   bench/peer/run.sh            # from anywhere; needs cargo and python3
 #   REPEAT=5 bench/peer/run.sh   # best of 5 rounds per case (default 3)
@@ -60,6 +61,7 @@ all=(
     "passive_fall planar passive_fall"
     "hexapod_stand hexapod stand"
     "hexapod_walk hexapod walk"
+    "hexapod_rough hexapod stand"
 )
 wanted="${CASES:-}"
 
@@ -140,14 +142,14 @@ done
 # trajectory.csv, t = the run's end).
 for note in "${notes[@]}"; do
     IFS='|' read -r name mj mujoco <<< "$note"
-    python3 - "$out/$name/trajectory.csv" "$mj" "$mujoco" << 'EOF'
+    python3 - "$out/$name/trajectory.csv" "$mj" "$mujoco" "$name" << 'EOF'
 import csv, json, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 case, mj = sys.argv[2], json.loads(sys.argv[3])
 first, last = rows[0], rows[-1]
 print()
 if case == "stand":
-    print(f"hexapod_stand at t = {float(last['t']):g} s: normal force of the ground on each foot (N)")
+    print(f"{sys.argv[4]} at t = {float(last['t']):g} s: normal force of the ground on each foot (N)")
     print(f"{'foot':>6} {'fbd':>10} {'MuJoCo':>10}")
     total = 0.0
     for n in range(1, 7):

@@ -12,7 +12,11 @@ For random poses (seeded) of a hexapod configuration:
 * total mass equal to the configuration's (body + six legs), and the
   central body's inertia tensor (with products of inertia) to 1e-12;
 * a configuration with only tips in contact has six contact spheres, the
-  default one eighteen (tips, knees, hips).
+  default one eighteen (tips, knees, hips);
+* a height map exported as an hfield is fbd's ground: a CSV heightfield
+  sampled from a plane, its height under vertical rays (`mj_ray`) at the
+  samples is the plane's minus the sphere radius, to MuJoCo's float32
+  storage (rows along +X, columns along +Z: orientation and scaling).
 
     python3 bench/peer/test_mjcf.py          # or: pytest bench/peer/test_mjcf.py
 
@@ -153,8 +157,36 @@ def test_contact_spheres():
         assert spheres == count, (points, spheres)
 
 
+def test_hfield_is_fbds_height_map():
+    fbd = fbd_bin()
+
+    def plane(x, z):
+        return 0.02 + 0.1 * x - 0.05 * z + 0.03 * x * z
+
+    with tempfile.TemporaryDirectory() as tmp:
+        rows = [",".join(str(plane(-1 + 0.5 * i, -0.6 + 0.4 * j)) for j in range(4)) for i in range(5)]
+        (Path(tmp) / "g.csv").write_text("\n".join(rows) + "\n")
+        text = (
+            'model = "hexapod"\n[initial]\nposition = [0.0, 2.0, 0.0]\n'
+            '[terrain]\nkind = "heightfield"\nfile = "g.csv"\nsize = [2.0, 1.2]\n'
+        )
+        model, data, _ = load(fbd, text, tmp)
+    ground = np.array([1, 0, 0, 0, 0, 0], dtype=np.uint8)
+    worst = 0.0
+    for i in range(5):
+        for j in range(4):
+            x = min(max(-1 + 0.5 * i, -0.999), 0.999)
+            z = min(max(-0.6 + 0.4 * j, -0.599), 0.599)
+            hit = np.array([-1], dtype=np.int32)
+            d = mujoco.mj_ray(model, data, np.array([x, 1.0, z]), np.array([0.0, -1.0, 0.0]), ground, 1, -1, hit)
+            assert model.geom(hit[0]).name == "ground"
+            worst = max(worst, abs(1.0 - d - (plane(x, z) - 0.01)))
+    assert worst < 1e-4, worst
+
+
 if __name__ == "__main__":
     test_forward_kinematics_masses_and_velocities()
     test_contact_spheres()
+    test_hfield_is_fbds_height_map()
     print("test_mjcf: all passed (MuJoCo", mujoco.__version__ + ")")
     sys.exit(0)

@@ -185,6 +185,7 @@
     const lg = new THREE.BufferGeometry();
     lg.setAttribute('position', new THREE.Float32BufferAttribute(lines, 3));
     scene.add(new THREE.LineSegments(lg, new THREE.LineBasicMaterial({ color: 0xc8bca8 })));
+    drawPatches(scene, S, 0.002);
   } else if (S.terrain.kind === 'profile' && S.terrain.xy.length >= 4) {
     const xy = S.terrain.xy;
     const m = xy.length / 2;
@@ -552,3 +553,45 @@
   };
   seek(0);
 })();
+
+// Friction patches [x0, x1, z0, z1, μS, μD] as translucent rectangles
+// draped `lift` m above a grid terrain (bluer the more slippery), each
+// labelled with its μS in the page's title of the mesh.
+function drawPatches(scene, S, lift) {
+  const T = S.terrain;
+  if (!S.patches || T.kind !== 'grid') return;
+  const { x0, x1, z0, z1, n, y } = T;
+  const h = (x, z) => {
+    const u = Math.max(0, Math.min(n - 1, (x - x0) / (x1 - x0) * (n - 1)));
+    const v = Math.max(0, Math.min(n - 1, (z - z0) / (z1 - z0) * (n - 1)));
+    const i = Math.min(n - 2, Math.floor(u)), j = Math.min(n - 2, Math.floor(v));
+    const a = u - i, b = v - j;
+    return (1 - a) * (1 - b) * y[j * n + i] + a * (1 - b) * y[j * n + i + 1]
+      + (1 - a) * b * y[(j + 1) * n + i] + a * b * y[(j + 1) * n + i + 1];
+  };
+  for (const [px0, px1, pz0, pz1, mus] of S.patches) {
+    const ax = Math.max(px0, x0), bx = Math.min(px1, x1), az = Math.max(pz0, z0), bz = Math.min(pz1, z1);
+    if (!(ax < bx && az < bz)) continue;
+    const m = 24, pos = [], idx = [];
+    for (let j = 0; j <= m; j++) {
+      for (let i = 0; i <= m; i++) {
+        const x = ax + (bx - ax) * i / m, z = az + (bz - az) * j / m;
+        pos.push(x, h(x, z) + lift, z);
+      }
+    }
+    for (let j = 0; j < m; j++) {
+      for (let i = 0; i < m; i++) {
+        const k = j * (m + 1) + i;
+        idx.push(k, k + m + 1, k + 1, k + 1, k + m + 1, k + m + 2);
+      }
+    }
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(pos, 3));
+    g.setIndex(idx);
+    const slip = Math.max(0, Math.min(1, 1 - mus));
+    const color = new THREE.Color().setRGB(0.9 - 0.6 * slip, 0.9 - 0.3 * slip, 1.0);
+    const mesh = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ color, transparent: true, opacity: 0.55, side: THREE.DoubleSide, depthWrite: false }));
+    mesh.name = `friction patch muS=${mus}`;
+    scene.add(mesh);
+  }
+}

@@ -11,15 +11,21 @@
 //! until the states are consistent.
 
 pub mod error;
+pub mod generate;
+pub mod grid;
 pub mod machine;
 pub mod mode;
+pub mod patch;
 pub mod spatial;
 pub mod surface;
 pub mod terrain;
 
 pub use error::ContactError;
+pub use generate::{Generator, Sampling};
+pub use grid::{GridIssue, HeightGrid};
 pub use machine::{ContactMode, ContactTrial, switch};
 pub use mode::{ContactParams, ContactState, Friction, StateCode, Trial, transition};
+pub use patch::{FrictionPatch, friction_at};
 pub use spatial::{SpatialState, SpatialTrial, transition_spatial};
 pub use surface::Surface;
 pub use terrain::{STEP_RAMP, Terrain, TerrainIssue};

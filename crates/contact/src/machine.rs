@@ -76,6 +76,9 @@ pub trait ContactTrial {
     fn slip_speed(&self, state: &Self::Mode) -> f64;
     /// The speed below which a slide has stopped (m/s).
     fn stop_speed(params: &ContactParams) -> f64;
+    /// Where the point is on the ground, `(x, z)` of `p[k]` (`z = 0` in the
+    /// plane): where its friction is looked up.
+    fn location(&self) -> [f64; 2];
 }
 
 /// The switching rules of docs/reference.md. `None` when `state` is
@@ -168,6 +171,9 @@ impl ContactTrial for Trial {
     fn clearance_next(&self, terrain: &Terrain) -> f64 {
         terrain.clearance(self.p_next)
     }
+    fn location(&self) -> [f64; 2] {
+        [self.p_k[0], 0.0]
+    }
     fn crossing(&self, terrain: &Terrain) -> [f64; 2] {
         terrain.crossing(self.p_k, self.p_next)
     }
@@ -241,6 +247,9 @@ impl ContactTrial for SpatialTrial {
     }
     fn clearance_next(&self, surface: &Surface) -> f64 {
         spatial::clearance(surface, self.p_next)
+    }
+    fn location(&self) -> [f64; 2] {
+        [self.p_k[0], self.p_k[2]]
     }
     fn crossing(&self, surface: &Surface) -> [f64; 3] {
         spatial::crossing(surface, self.p_k, self.p_next)

@@ -118,6 +118,9 @@ pub fn frame(surface: &Surface, x: f64, z: f64) -> [[f64; 3]; 3] {
 /// [`crate::Terrain::crossing`] in the profile's section, which holds the
 /// whole path's height profile), on the surface.
 pub fn crossing(surface: &Surface, p0: [f64; 3], p1: [f64; 3]) -> [f64; 3] {
+    if surface.grid().is_some() {
+        return crossing_3d(surface, p0, p1);
+    }
     let (s0, s1) = (surface.along(p0[0], p0[2]), surface.along(p1[0], p1[2]));
     let c = surface.terrain.crossing([s0, p0[1]], [s1, p1[1]]);
     // Fraction of the path at the crossing (along s, or along y when the
@@ -133,6 +136,47 @@ pub fn crossing(surface: &Surface, p0: [f64; 3], p1: [f64; 3]) -> [f64; 3] {
     let x = p0[0] + f * (p1[0] - p0[0]);
     let z = p0[2] + f * (p1[2] - p0[2]);
     [x, surface.height(x, z), z]
+}
+
+/// [`crossing`] on a height map: the root of `g(s) = clearance(p0 +
+/// s·(p1 − p0))` on `[0, 1]` by the safeguarded secant/bisection of
+/// [`crate::Terrain::crossing`], put on the surface.
+fn crossing_3d(surface: &Surface, p0: [f64; 3], p1: [f64; 3]) -> [f64; 3] {
+    let at = |s: f64| {
+        [
+            p0[0] + s * (p1[0] - p0[0]),
+            p0[1] + s * (p1[1] - p0[1]),
+            p0[2] + s * (p1[2] - p0[2]),
+        ]
+    };
+    let g0 = clearance(surface, p0);
+    if !g0.is_finite() || g0 <= 0.0 {
+        return project(surface, p0);
+    }
+    let g1 = clearance(surface, p1);
+    if g1 >= 0.0 {
+        return project(surface, p1);
+    }
+    let (mut lo, mut hi, mut glo, mut ghi) = (0.0, 1.0, g0, g1);
+    for _ in 0..100 {
+        let mut s = lo + glo * (hi - lo) / (glo - ghi);
+        if !(s > lo && s < hi) || (hi - lo) < 1e-3 {
+            s = 0.5 * (lo + hi);
+        }
+        let g = clearance(surface, at(s));
+        if g.abs() < 1e-14 || hi - lo < 1e-15 {
+            lo = s;
+            break;
+        }
+        if g > 0.0 {
+            lo = s;
+            glo = g;
+        } else {
+            hi = s;
+            ghi = g;
+        }
+    }
+    project(surface, at(lo))
 }
 
 /// The point of the surface at straight-line distance `dist` from `from`

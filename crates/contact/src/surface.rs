@@ -14,25 +14,56 @@
 //! ```
 //!
 //! With ψ = 0 (the default) `ϱ(x, z) = ϱ_planar(x)`: the planar model's
-//! terrain, unchanged in every X–Y section. Every kind is covered; a fully
-//! two-dimensional height map is not (no planar kind needs one).
+//! terrain, unchanged in every X–Y section. Every planar kind is covered; a
+//! fully two-dimensional surface is a height map (below).
 //! `ϱ″` is zero for flat, slope, profile and steps (they are piecewise
 //! linear; the kinks are a set of measure zero) and analytic for sine.
 //!
 //! [`Surface::mean_height`] is the surface without the risers of `steps`
 //! (the staircase's mean line): a body that follows it climbs smoothly.
+//!
+//! **Height maps.** A fully two-dimensional surface is a [`HeightGrid`]
+//! ([`Surface::from_grid`]: a heightfield file or a generated terrain),
+//! interpolated with a continuous normal and analytic gradient and Hessian
+//! (see [`crate::grid`]). Its profile direction is +X (ψ = 0: the contact
+//! frame's first tangent lies in the X–Y plane). Its
+//! [`Surface::mean_height`] is the grid smoothed over [`MEAN_RADIUS`].
+//!
+//! **Friction patches.** A surface carries its [`FrictionPatch`]es:
+//! [`Surface::friction_at`] is the friction at a point of the ground.
 
+use std::sync::Arc;
+
+use crate::grid::HeightGrid;
+use crate::mode::Friction;
+use crate::patch::{FrictionPatch, friction_at};
 use crate::terrain::Terrain;
+
+/// The smoothing radius (m) of a height map's mean surface, the ground a
+/// walking body follows (about the size of a foot's reach, so that one
+/// stair or bump under one foot does not shake the body).
+pub const MEAN_RADIUS: f64 = 0.4;
+
+/// A height map and its smoothed mean surface.
+#[derive(Clone, Debug, PartialEq)]
+struct Map {
+    grid: HeightGrid,
+    mean: HeightGrid,
+}
 
 /// A terrain surface `y = ϱ(x, z)` (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Surface {
-    /// The planar profile `ϱ(s)`.
+    /// The planar profile `ϱ(s)` (unused by a height map).
     pub terrain: Terrain,
     /// `cos ψ` of the profile direction.
     cos: f64,
     /// `sin ψ` of the profile direction.
     sin: f64,
+    /// A height map replacing the extruded profile.
+    map: Option<Arc<Map>>,
+    /// Friction patches, the last listed winning.
+    patches: Arc<[FrictionPatch]>,
 }
 
 impl Default for Surface {
@@ -48,7 +79,73 @@ impl Surface {
     /// model; π/2: along −Z, the forward direction of a robot at zero yaw).
     pub fn new(terrain: Terrain, direction: f64) -> Self {
         let (sin, cos) = direction.sin_cos();
-        Self { terrain, cos, sin }
+        Self {
+            terrain,
+            cos,
+            sin,
+            map: None,
+            patches: Arc::from(Vec::new()),
+        }
+    }
+
+    /// The height map `grid` (profile direction +X).
+    pub fn from_grid(grid: HeightGrid) -> Self {
+        let mean = grid.smoothed(MEAN_RADIUS);
+        Self {
+            map: Some(Arc::new(Map { grid, mean })),
+            ..Self::new(Terrain::Flat { height: 0.0 }, 0.0)
+        }
+    }
+
+    /// The surface with friction `patches` (the last listed wins).
+    pub fn with_patches(mut self, patches: Vec<FrictionPatch>) -> Self {
+        self.patches = Arc::from(patches);
+        self
+    }
+
+    /// The height map, if the surface is one.
+    pub fn grid(&self) -> Option<&HeightGrid> {
+        self.map.as_ref().map(|m| &m.grid)
+    }
+
+    /// The friction patches.
+    pub fn patches(&self) -> &[FrictionPatch] {
+        &self.patches
+    }
+
+    /// The friction at `(x, z)`: the last patch holding the point, else
+    /// `base` (the ground's own).
+    #[inline]
+    pub fn friction_at(&self, base: &Friction, x: f64, z: f64) -> Friction {
+        friction_at(&self.patches, base, x, z)
+    }
+
+    /// The Hessian `[ϱxx, ϱxz, ϱzz]` (zero on the piecewise-linear
+    /// profile kinds, as [`Surface::mean_height`] says).
+    pub fn hessian(&self, x: f64, z: f64) -> [f64; 3] {
+        if let Some(m) = &self.map {
+            return m.grid.eval(x, z).2;
+        }
+        let dd = match &self.terrain {
+            Terrain::Sine { .. } => self.mean_height(x, z).2,
+            _ => 0.0,
+        };
+        let [ux, uz] = self.direction();
+        [dd * ux * ux, dd * ux * uz, dd * uz * uz]
+    }
+
+    /// `vᵀ·H̄·v` of the mean surface ([`Surface::mean_height`]) for the
+    /// horizontal velocity `v = (vx, vz)`: the centripetal part of a
+    /// terrain-following body's vertical acceleration.
+    pub fn mean_curvature(&self, x: f64, z: f64, v: [f64; 2]) -> f64 {
+        if let Some(m) = &self.map {
+            let [hxx, hxz, hzz] = m.mean.eval(x, z).2;
+            return hxx * v[0] * v[0] + 2.0 * hxz * v[0] * v[1] + hzz * v[1] * v[1];
+        }
+        let dd = self.mean_height(x, z).2;
+        let [ux, uz] = self.direction();
+        let vu = ux * v[0] + uz * v[1];
+        dd * vu * vu
     }
 
     /// The profile coordinate `s = x·cos ψ − z·sin ψ` (m).
@@ -59,18 +156,24 @@ impl Surface {
 
     /// `true` when there is a ground.
     pub fn exists(&self) -> bool {
-        self.terrain.exists()
+        self.map.is_some() || self.terrain.exists()
     }
 
     /// `ϱ(x, z)` (m); `−∞` without ground.
     #[inline]
     pub fn height(&self, x: f64, z: f64) -> f64 {
+        if let Some(m) = &self.map {
+            return m.grid.height(x, z);
+        }
         self.terrain.height(self.along(x, z))
     }
 
     /// `(∂ϱ/∂x, ∂ϱ/∂z)`.
     #[inline]
     pub fn gradient(&self, x: f64, z: f64) -> [f64; 2] {
+        if let Some(m) = &self.map {
+            return m.grid.eval(x, z).1;
+        }
         let d = self.terrain.slope(self.along(x, z));
         [d * self.cos, -d * self.sin]
     }
@@ -86,8 +189,14 @@ impl Surface {
     /// smooth surface a walking body follows: `ϱ` itself for flat, slope,
     /// profile and sine, and for `steps` the staircase's mean line
     /// `height + step_height·(s/step_width − ½)` (the risers removed).
-    /// Returns `(ϱ, [ϱx, ϱz], ϱ″)` with `H = ϱ″·u·uᵀ`.
+    /// Returns `(ϱ, [ϱx, ϱz], ϱ″)` with `H = ϱ″·u·uᵀ`. For a height map:
+    /// the grid smoothed over [`MEAN_RADIUS`], `ϱ″` its `ϱxx`
+    /// ([`Surface::mean_curvature`] has the whole Hessian).
     pub fn mean_height(&self, x: f64, z: f64) -> (f64, [f64; 2], f64) {
+        if let Some(m) = &self.map {
+            let (h, g, [hxx, _, _]) = m.mean.eval(x, z);
+            return (h, g, hxx);
+        }
         let s = self.along(x, z);
         let (h, d, dd) = match &self.terrain {
             Terrain::Steps {

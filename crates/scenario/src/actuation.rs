@@ -291,6 +291,57 @@ fn terrain_keys(kind: TerrainKind) -> &'static [&'static str] {
         TerrainKind::Profile => &["points", "file"],
         TerrainKind::Sine => &["amplitude", "wavelength", "phase_deg", "height"],
         TerrainKind::Steps => &["step_height", "step_width", "height"],
+        TerrainKind::Heightfield => &["file", "size", "center", "elevation"],
+        TerrainKind::Random => &[
+            "amplitude",
+            "wavelength",
+            "seed",
+            "size",
+            "center",
+            "resolution",
+            "height",
+        ],
+        TerrainKind::Stairs => &[
+            "tread",
+            "riser",
+            "heading_deg",
+            "count",
+            "origin",
+            "size",
+            "center",
+            "resolution",
+            "edge_radius",
+            "height",
+        ],
+        TerrainKind::Stones => &[
+            "stone",
+            "gap",
+            "depth",
+            "amplitude",
+            "seed",
+            "size",
+            "center",
+            "resolution",
+            "edge_radius",
+            "height",
+        ],
+        TerrainKind::Pyramids => &[
+            "amplitude",
+            "wavelength",
+            "size",
+            "center",
+            "resolution",
+            "edge_radius",
+            "height",
+        ],
+        TerrainKind::Sines => &[
+            "amplitude",
+            "wavelength",
+            "size",
+            "center",
+            "resolution",
+            "height",
+        ],
     }
 }
 
@@ -302,6 +353,12 @@ fn kind_name(kind: TerrainKind) -> &'static str {
         TerrainKind::Profile => "profile",
         TerrainKind::Sine => "sine",
         TerrainKind::Steps => "steps",
+        TerrainKind::Heightfield => "heightfield",
+        TerrainKind::Random => "random",
+        TerrainKind::Stairs => "stairs",
+        TerrainKind::Stones => "stones",
+        TerrainKind::Pyramids => "pyramids",
+        TerrainKind::Sines => "sines",
     }
 }
 
@@ -318,6 +375,9 @@ impl TerrainConfig {
     /// relative to the directory of `config_file`. The complete
     /// configuration written back then holds the points themselves.
     pub fn load_profile_file(&mut self, config_file: &str) -> Result<(), ConfigError> {
+        if self.kind == TerrainKind::Heightfield {
+            return Ok(()); // a height map ([`TerrainConfig::load_map`])
+        }
         let Some(name) = self.file.take() else {
             return Ok(());
         };
@@ -372,7 +432,7 @@ impl TerrainConfig {
     /// Checks the keys of the terrain kind; errors name `terrain.key`.
     pub fn validate_kind(&self, file: &str) -> Result<(), ConfigError> {
         let used = terrain_keys(self.kind);
-        let given: [(&str, bool); 8] = [
+        let given: [(&str, bool); 22] = [
             ("angle_deg", self.angle_deg.is_some()),
             ("points", self.points.is_some()),
             ("file", self.file.is_some()),
@@ -381,6 +441,20 @@ impl TerrainConfig {
             ("phase_deg", self.phase_deg.is_some()),
             ("step_height", self.step_height.is_some()),
             ("step_width", self.step_width.is_some()),
+            ("size", self.size.is_some()),
+            ("center", self.center.is_some()),
+            ("elevation", self.elevation.is_some()),
+            ("resolution", self.resolution.is_some()),
+            ("edge_radius", self.edge_radius.is_some()),
+            ("seed", self.seed.is_some()),
+            ("tread", self.tread.is_some()),
+            ("riser", self.riser.is_some()),
+            ("heading_deg", self.heading_deg.is_some()),
+            ("count", self.count.is_some()),
+            ("origin", self.origin.is_some()),
+            ("stone", self.stone.is_some()),
+            ("gap", self.gap.is_some()),
+            ("depth", self.depth.is_some()),
         ];
         let kind = kind_name(self.kind);
         for (key, is_given) in given {
@@ -404,6 +478,22 @@ impl TerrainConfig {
             TerrainKind::Steps => &[
                 ("step_height", self.step_height.is_some()),
                 ("step_width", self.step_width.is_some()),
+            ],
+            TerrainKind::Heightfield => {
+                &[("file", self.file.is_some()), ("size", self.size.is_some())]
+            }
+            TerrainKind::Random | TerrainKind::Pyramids | TerrainKind::Sines => &[
+                ("amplitude", self.amplitude.is_some()),
+                ("wavelength", self.wavelength.is_some()),
+            ],
+            TerrainKind::Stairs => &[
+                ("tread", self.tread.is_some()),
+                ("riser", self.riser.is_some()),
+            ],
+            TerrainKind::Stones => &[
+                ("stone", self.stone.is_some()),
+                ("gap", self.gap.is_some()),
+                ("depth", self.depth.is_some()),
             ],
             TerrainKind::None | TerrainKind::Flat => &[],
         };
@@ -485,6 +575,13 @@ impl TerrainConfig {
                 step_width: self.step_width.unwrap_or(f64::NAN),
                 height,
             },
+            // Height maps: [`TerrainConfig::terrain`] takes their section.
+            TerrainKind::Heightfield
+            | TerrainKind::Random
+            | TerrainKind::Stairs
+            | TerrainKind::Stones
+            | TerrainKind::Pyramids
+            | TerrainKind::Sines => Terrain::Flat { height },
         }
     }
 }

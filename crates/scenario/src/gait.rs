@@ -3,7 +3,6 @@
 //! [`GaitModel`]. A kinematic run without `[gait]` (`dynamics =
 //! "kinematic"`) stands: the initial pose is held for the duration.
 
-use fbd_contact::Surface;
 use fbd_kinematics::hexapod::{HexapodData, HexapodModel, forward};
 use fbd_kinematics::ik::KneeBranch;
 use fbd_kinematics::leg::LegGeometry;
@@ -441,7 +440,7 @@ pub fn default_stance(h: &HexapodConfig) -> Option<HexapodInitial> {
         },
         &mut fk,
     );
-    let surface = Surface::new(h.terrain.terrain(), 0.0);
+    let surface = h.terrain.surface();
     let ground = |x: f64, z: f64| {
         if surface.exists() {
             surface.height(x, z)
@@ -555,7 +554,7 @@ impl HexapodConfig {
         GaitModel::new(
             kin,
             params,
-            Surface::new(self.terrain.terrain(), 0.0),
+            self.terrain.surface(),
             masses,
             self.time.dt,
             self.time.duration,

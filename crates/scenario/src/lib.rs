@@ -69,6 +69,8 @@ pub use gait::{
 };
 mod advice;
 pub mod mjcf;
+mod terrain_map;
+pub use terrain_map::{PatchConfig, read_heights};
 mod spatial;
 pub use actuation::{ControlConfig, ControlKind, ControlLegConfig, TargetDeg};
 pub use spatial::{DynamicsKind, InertiaConfig, PHI_Z_SINGULAR, euler_rate_matrix};
@@ -372,6 +374,19 @@ pub enum TerrainKind {
     /// Staircase `y = height + step_height·floor(x/step_width)` (risers
     /// smoothed over `fbd_contact::STEP_RAMP`).
     Steps,
+    /// A height map read from `file` (PNG, NumPy, CSV or MuJoCo binary)
+    /// over `size` centred on `center`.
+    Heightfield,
+    /// Smooth random ground (`amplitude`, `wavelength`, `seed`).
+    Random,
+    /// A staircase (`tread`, `riser`, `heading_deg`, `count`, `origin`).
+    Stairs,
+    /// Stepping stones (`stone`, `gap`, `depth`, `amplitude`, `seed`).
+    Stones,
+    /// Square pyramids (`amplitude`, `wavelength`).
+    Pyramids,
+    /// `amplitude·sin(2πx/λ)·sin(2πz/λ)` (`wavelength` λ).
+    Sines,
 }
 
 /// `[terrain]`.
@@ -412,6 +427,57 @@ pub struct TerrainConfig {
     pub mu_static: f64,
     /// Dynamic friction coefficient μD (`0 ≤ μD ≤ μS`).
     pub mu_dynamic: f64,
+    /// Height map extent `[x, z]` (m): required by `heightfield`, default
+    /// `[3, 3]` for the generated kinds.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub size: Option<Vec<f64>>,
+    /// Height map centre `[x, z]` (m), default `[0, 0]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub center: Option<Vec<f64>>,
+    /// Heights `[min, max]` (m) of black and white (PNG) or of the lowest
+    /// and highest sample (MuJoCo binary).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub elevation: Option<Vec<f64>>,
+    /// Grid spacing of a generated terrain (m), default 0.01.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub resolution: Option<f64>,
+    /// Rounding radius of a generated terrain's edges (m), default 0.01.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub edge_radius: Option<f64>,
+    /// Seed of `random` and `stones`, default 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// Stair run (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tread: Option<f64>,
+    /// Stair rise (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub riser: Option<f64>,
+    /// Direction the stairs climb (degrees from +X towards −Z, as a yaw),
+    /// default 0.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heading_deg: Option<f64>,
+    /// Number of stairs, default 3.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub count: Option<u32>,
+    /// A point `[x, z]` of the first riser, default `center`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub origin: Option<Vec<f64>>,
+    /// Stepping stone side (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub stone: Option<f64>,
+    /// Gap between stepping stones (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub gap: Option<f64>,
+    /// Depth of the gaps between stepping stones (m).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub depth: Option<f64>,
+    /// Friction patches `[[terrain.patch]]` (the last listed wins).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub patch: Vec<PatchConfig>,
+    /// The height map built from the keys above ([`TerrainConfig::load_map`]).
+    #[serde(skip)]
+    pub map: Option<fbd_contact::Surface>,
 }
 
 impl Default for TerrainConfig {
@@ -434,6 +500,22 @@ impl Default for TerrainConfig {
             step_width: None,
             mu_static: p.friction.mu_static,
             mu_dynamic: p.friction.mu_dynamic,
+            size: None,
+            center: None,
+            elevation: None,
+            resolution: None,
+            edge_radius: None,
+            seed: None,
+            tread: None,
+            riser: None,
+            heading_deg: None,
+            count: None,
+            origin: None,
+            stone: None,
+            gap: None,
+            depth: None,
+            patch: Vec::new(),
+            map: None,
         }
     }
 }
@@ -441,6 +523,11 @@ impl Default for TerrainConfig {
 impl TerrainConfig {
     /// The terrain of the simulator.
     pub fn terrain(&self) -> Terrain {
+        if terrain_map::is_map(self.kind) {
+            return self.map_section().unwrap_or(Terrain::Flat {
+                height: self.height,
+            });
+        }
         self.terrain_kind()
     }
 
@@ -822,6 +909,7 @@ impl<I> ConfigFile<I> {
             joint_limits: self.leg.joint_limits(),
             terrain: self.terrain.terrain(),
             friction: self.terrain.friction(),
+            patches: self.terrain.patches("").unwrap_or_default(),
             contact_points: self.contact.contact_points(),
             stride: self.output.stride,
             ..PlanarParams::default()
@@ -854,6 +942,7 @@ impl<I> ConfigFile<I> {
             );
         }
         self.terrain.validate_kind(file)?;
+        self.terrain.patches(file)?;
         // The physical domains (positive masses, lengths and time step,
         // gravity a magnitude, 0 ≤ μD ≤ μS, stride ≥ 1, …) have one source,
         // the simulator's parameter check; the file is added here.
@@ -1302,8 +1391,14 @@ fn from_table(table: &toml::Table) -> Result<Config, toml::de::Error> {
 /// Loads a `[terrain] file` profile into `points` ([`TerrainConfig::load_profile_file`]).
 fn load_profile(config: &mut Config, file: &str) -> Result<(), ConfigError> {
     match config {
-        Config::Planar(c) => c.terrain.load_profile_file(file),
-        Config::Hexapod(c) => c.terrain.load_profile_file(file),
+        Config::Planar(c) => {
+            c.terrain.load_profile_file(file)?;
+            c.terrain.load_map(file)
+        }
+        Config::Hexapod(c) => {
+            c.terrain.load_profile_file(file)?;
+            c.terrain.load_map(file)
+        }
     }
 }
 

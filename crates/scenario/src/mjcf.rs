@@ -44,9 +44,10 @@
 //!   prints; Δt is the `timestep`, integrator `implicitfast`.
 //!
 //! Terrain: flat ground, a slope (a tilted plane, its `zaxis` the slope's
-//! normal) or none; any other kind is an error naming
+//! normal), none, or a height map (`heightfield` and the generated kinds,
+//! as a MuJoCo `hfield`); any other kind is an error naming
 //! `terrain.kind` (MuJoCo's height fields are not fbd's analytic
-//! surfaces).
+//! profiles).
 
 use std::fmt::Write;
 
@@ -158,25 +159,83 @@ fn servo(p: &SpatialParams) -> Option<Servo> {
     })
 }
 
+/// MuJoCo's hfield of the height map `g` (see the module docs): MuJoCo's
+/// hfield lies in its geom's x–y plane with elevation along z; the geom's
+/// frame has x = fbd's +X, y = fbd's −Z and z = fbd's +Y. MuJoCo's columns
+/// run along its x (fbd's rows), its rows along its y from +y to −y (fbd's
+/// columns, from −Z to +Z: checked with MuJoCo 4.0.0's `mj_ray` on a
+/// sampled plane). The elevation data are normalised by MuJoCo to `[0, 1]`
+/// and scaled by `size[2]` = the map's height range.
+fn hfield_asset(g: &fbd_contact::HeightGrid) -> String {
+    let (nr, nc) = (g.nrow(), g.ncol());
+    let [x0, x1, z0, z1] = g.bounds();
+    let [lo, hi] = g.range();
+    let h = g.heights();
+    let mut data = Vec::with_capacity(nr * nc);
+    for r in 0..nc {
+        for c in 0..nr {
+            data.push(h[c * nc + r] - lo);
+        }
+    }
+    format!(
+        "    <hfield name=\"terrain\" nrow=\"{nc}\" ncol=\"{nr}\" size=\"{} {} {} {}\" elevation=\"{}\"/>",
+        num(0.5 * (x1 - x0)),
+        num(0.5 * (z1 - z0)),
+        num((hi - lo).max(1e-9)),
+        num(HFIELD_BASE),
+        nums(&data)
+    )
+}
+
+/// Thickness (m) of the hfield's base below its lowest point.
+const HFIELD_BASE: f64 = 0.1;
+
+/// The geom placing the hfield of `g` (one sphere radius below fbd's
+/// surface, as the plane).
+fn hfield_geom(g: &fbd_contact::HeightGrid, mu: f64) -> String {
+    let [x0, x1, z0, z1] = g.bounds();
+    let [lo, _] = g.range();
+    format!(
+        "    <geom name=\"ground\" type=\"hfield\" hfield=\"terrain\" pos=\"{} {} {}\" \
+         xyaxes=\"1 0 0 0 0 -1\" contype=\"0\" conaffinity=\"1\" condim=\"3\" \
+         friction=\"{} 0.005 0.0001\" group=\"0\" rgba=\"0.8 0.8 0.8 1\"/>",
+        num(0.5 * (x0 + x1)),
+        num(lo - SPHERE_RADIUS),
+        num(0.5 * (z0 + z1)),
+        num(mu)
+    )
+}
+
 /// The robot of `params` as a MuJoCo MJCF document (see the module docs).
 /// `file` names the configuration in errors.
 ///
 /// # Errors
 /// [`ConfigError::Semantic`] naming `terrain.kind` for a terrain other
-/// than flat ground, a slope or none.
+/// than flat ground, a slope, a height map or none, and naming
+/// `terrain.patch` for friction patches.
 pub fn mjcf(params: &SpatialParams, file: &str) -> Result<String, ConfigError> {
     let p = params;
     let unsupported = |kind: &str| {
         ConfigError::semantic(
             file,
             "terrain.kind",
-            "MuJoCo export supports planar ground only (MuJoCo's height fields are not fbd's analytic surfaces)",
+            "MuJoCo export supports flat ground, a slope, a height map or none",
             format!("\"{kind}\""),
-            "\"flat\", \"slope\" or \"none\"",
+            "\"flat\", \"slope\", \"heightfield\" (or a generated height map) or \"none\"",
         )
     };
+    if !p.terrain.patches().is_empty() {
+        return Err(ConfigError::semantic(
+            file,
+            "terrain.patch",
+            "cannot be exported: MuJoCo's friction belongs to a geom, not to a place",
+            format!("{} patches", p.terrain.patches().len()),
+            "no [[terrain.patch]]",
+        ));
+    }
     // The ground plane: a point of fbd's terrain and its unit normal.
     let ground = match &p.terrain.terrain {
+        _ if p.terrain.grid().is_some() => None,
         Terrain::Flat { height } => Some(([0.0, *height, 0.0], [0.0, 1.0, 0.0])),
         Terrain::None => None,
         Terrain::Slope { .. } => Some((
@@ -236,7 +295,15 @@ pub fn mjcf(params: &SpatialParams, file: &str) -> Result<String, ConfigError> {
         num(mu)
     );
     let _ = writeln!(w, "  </default>");
+    if let Some(g) = p.terrain.grid() {
+        let _ = writeln!(w, "  <asset>");
+        let _ = writeln!(w, "{}", hfield_asset(g));
+        let _ = writeln!(w, "  </asset>");
+    }
     let _ = writeln!(w, "  <worldbody>");
+    if let Some(g) = p.terrain.grid() {
+        let _ = writeln!(w, "{}", hfield_geom(g, mu));
+    }
     if let Some((at, n)) = ground {
         // One sphere radius below the terrain, along its normal (a slope's
         // plane is tilted: zaxis is its normal).

@@ -22,7 +22,7 @@
 //! table, the body 0.6 m up and level ([`default_q0`]); with `[gait]` (a
 //! `kind = "gait"` controller) the kinematic gait's default stance.
 
-use fbd_contact::{ContactParams, Surface};
+use fbd_contact::ContactParams;
 use fbd_kinematics::nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use fbd_kinematics::pose::{BodyPose, rot_x};
 use fbd_sim::Control;
@@ -639,7 +639,7 @@ impl HexapodConfig {
             joint_limits: l.joint_limits(),
             q0,
             qdot0,
-            terrain: Surface::new(c.terrain.terrain(), 0.0),
+            terrain: c.terrain.surface(),
             friction: c.terrain.friction(),
             contact_points: c.contact.contact_points(),
             contact: ContactParams::default(),

@@ -2,7 +2,7 @@
 //! radians. The CLI fills them from a TOML configuration (degrees there).
 
 use crate::control::Control;
-use fbd_contact::{Friction, Terrain};
+use fbd_contact::{Friction, FrictionPatch, Terrain};
 use fbd_dynamics::mechanism::ContactPoints;
 use fbd_kinematics::JointLimits;
 
@@ -59,6 +59,9 @@ pub struct PlanarParams {
     pub terrain: Terrain,
     /// Soil friction. Default μS = 0.4, μD = 0.3 (paper §6).
     pub friction: Friction,
+    /// Friction patches along the line `z = 0` (the last listed wins;
+    /// [`Self::friction`] elsewhere). Default none.
+    pub patches: Vec<FrictionPatch>,
     /// Which points can touch the terrain. Default: tips, knees and hips.
     pub contact_points: ContactPoints,
     /// Write every `stride`-th step. Default 1.
@@ -101,6 +104,7 @@ impl Default for PlanarParams {
             qdot0: [0.0; 7],
             terrain: Terrain::Flat { height: 0.0 },
             friction: Friction::default(),
+            patches: Vec::new(),
             contact_points: ContactPoints::default(),
             stride: 1,
             control: Control::None,

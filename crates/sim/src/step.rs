@@ -21,7 +21,7 @@ use crate::rules::regularization;
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
 use crate::{Data, Model, SimError};
-use fbd_contact::{ContactState, Terrain, Trial};
+use fbd_contact::{ContactState, Friction, Terrain, Trial, friction_at};
 use fbd_dynamics::{
     ContactEquation, FbdData, History, LimitEquation, advance, evaluate_next, prepare_step,
 };
@@ -107,9 +107,12 @@ impl Engine for Model {
             dt: data.fbd.dt,
         }
     }
+    fn friction_at(&self, at: [f64; 2]) -> Friction {
+        friction_at(&self.params.patches, &self.params.friction, at[0], at[1])
+    }
     fn contact_violation(&self, data: &Data, state: &ContactState, t: &Trial) -> f64 {
         let k = data.fbd.position_gain;
-        let mu = self.params.friction.mu_static;
+        let mu = self.friction_at([t.p_k[0], 0.0]).mu_static;
         match *state {
             ContactState::Free => k * (-self.params.terrain.clearance(t.p_next)).max(0.0),
             ContactState::Stick { .. } => (-t.n).max(0.0) + (t.fa.abs() - mu * t.n).max(0.0),
@@ -212,7 +215,8 @@ fn set_contact_equations(model: &Model, data: &mut Data) {
             state,
             tangent,
             normal,
-            mu_dynamic: model.params.friction.mu_dynamic,
+            mu_dynamic: friction_at(&model.params.patches, &model.params.friction, x, 0.0)
+                .mu_dynamic,
             regularization: beta + model.contact_bumper[c],
         };
     }

@@ -1,7 +1,8 @@
 //! The plots of a hexapod run: `gait.svg` (the gait diagram: a bar per leg,
 //! black in stance), `footprints.svg` (top view: body path, footholds,
 //! support polygons and the centre of mass at a few instants) and
-//! `joints.svg` (joint angles versus time).
+//! `joints.svg` (joint angles versus time; on a height map also each foot's
+//! height against the terrain under it).
 
 use fbd_sim::gait::stability::convex_hull;
 use fbd_sim::gait::{GaitData, GaitModel, LEGS};
@@ -47,6 +48,11 @@ pub struct GaitPlotData {
     pub footholds: [Vec<[f64; 2]>; LEGS],
     /// Support polygons at a few instants.
     pub supports: Vec<Support>,
+    /// On a height map: per leg, the foot's height and the terrain's under
+    /// it (m) at the sample times (drawn as a fourth panel of
+    /// `joints.svg`); empty on the profile kinds.
+    pub heights: [[Vec<f64>; 2]; LEGS],
+    surface: Option<fbd_contact::Surface>,
     last_t: f64,
     was_stance: [bool; LEGS],
 }
@@ -59,6 +65,11 @@ impl GaitPlotData {
         Self {
             every,
             snapshot_every: steps.div_ceil(POLYGONS).max(1),
+            surface: model
+                .surface
+                .grid()
+                .is_some()
+                .then(|| model.surface.clone()),
             ..Self::default()
         }
     }
@@ -107,6 +118,13 @@ impl GaitPlotData {
             }
         }
         self.path.push([d.body.position.x, d.body.position.z]);
+        if let Some(s) = &self.surface {
+            for (leg, [foot, ground]) in self.heights.iter_mut().enumerate() {
+                let f = d.feet[leg];
+                foot.push(f.y);
+                ground.push(s.height(f.x, f.z));
+            }
+        }
     }
 }
 
@@ -261,11 +279,15 @@ pub fn footprints_svg(d: &GaitPlotData) -> PlotResult {
 pub fn joints_svg(d: &GaitPlotData) -> PlotResult {
     let mut buf = String::new();
     {
-        let root = SVGBackend::with_string(&mut buf, (960, 900)).into_drawing_area();
+        let n = if d.heights[0][0].is_empty() { 3 } else { 4 };
+        let root = SVGBackend::with_string(&mut buf, (960, 300 * n as u32)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let panels = root.split_evenly((3, 1));
+        let panels = root.split_evenly((n, 1));
         let (t0, t1) = range(d.t.iter());
-        for (j, panel) in panels.iter().enumerate() {
+        if n == 4 {
+            heights_panel(d, &panels[3], (t0, t1))?;
+        }
+        for (j, panel) in panels.iter().take(3).enumerate() {
             let (y0, y1) = range(d.theta[j].iter().flatten());
             let mut chart = ChartBuilder::on(panel)
                 .caption(format!("θ{} (deg)", j + 1), ("sans-serif", 20))
@@ -297,4 +319,52 @@ pub fn joints_svg(d: &GaitPlotData) -> PlotResult {
         root.present().map_err(err)?;
     }
     Ok(buf)
+}
+
+/// The fourth panel of `joints.svg` on a height map: each foot's height
+/// (solid) and the terrain's under it (dashed), in the leg's colour.
+fn heights_panel<DB: DrawingBackend>(
+    d: &GaitPlotData,
+    panel: &DrawingArea<DB, plotters::coord::Shift>,
+    (t0, t1): (f64, f64),
+) -> Result<(), String> {
+    let (y0, y1) = range(d.heights.iter().flatten().flatten());
+    let mut chart = ChartBuilder::on(panel)
+        .caption(
+            "foot heights (solid) and the terrain under each foot (dashed) (m)",
+            ("sans-serif", 20),
+        )
+        .margin(10)
+        .x_label_area_size(36)
+        .y_label_area_size(60)
+        .build_cartesian_2d(t0..t1, y0..y1)
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time (s)")
+        .x_label_formatter(&tick)
+        .y_label_formatter(&tick)
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(err)?;
+    for (leg, [foot, ground]) in d.heights.iter().enumerate() {
+        let c = leg_color(leg);
+        chart
+            .draw_series(LineSeries::new(
+                d.t.iter().zip(foot).map(|(a, b)| (*a, *b)),
+                c.stroke_width(2),
+            ))
+            .map_err(err)?
+            .label(format!("leg {}", leg + 1))
+            .legend(legend_line(c, 2));
+        chart
+            .draw_series(DashedLineSeries::new(
+                d.t.iter().zip(ground).map(|(a, b)| (*a, *b)),
+                4,
+                3,
+                c.stroke_width(1),
+            ))
+            .map_err(err)?;
+    }
+    draw_legend(&mut chart)
 }

@@ -259,7 +259,7 @@ impl Outputs {
             collect: summary::Collector::new(&layout, &params.terrain),
             plot: out_dir
                 .filter(|_| output.plots)
-                .map(|_| plots::Recorder::new(&layout, t_end)),
+                .map(|_| plots::Recorder::new(&layout, t_end).with_surface(&params.terrain)),
             view: out_dir.filter(|_| output.viewer).map(|_| {
                 HexapodScene::dynamic(
                     params.kinematic_model(),

@@ -2,13 +2,15 @@
 //! reduced per time column, [`crate::plot::MinMax`]), one colour per leg
 //! (the plots' shared palette):
 //!
-//! * `feet.svg` — the normal force of every foot;
+//! * `feet.svg` — the normal force of every foot, and its height against
+//!   the height of the terrain under it (`ϱ(x, z)` at the foot, dashed);
 //! * `torques.svg` — the actuator torques τ1, τ2, τ3 of every leg, one
 //!   chart per joint;
 //! * `body.svg` — the body height `Ry`, and the body angles φx, φy, φz;
 //! * `energy.svg` — kinetic, potential and total energy (as the planar
 //!   run draws it).
 
+use fbd_contact::Surface;
 use fbd_sim::RunSummary;
 use fbd_sim::spatial::SpatialRecord;
 use plotters::style::RGBColor;
@@ -32,6 +34,9 @@ pub struct Recorder {
     columns: Columns,
     legs: Vec<usize>,
     normal: Vec<MinMax>,
+    /// Per leg: the foot's height and the terrain's under it.
+    height: Vec<[MinMax; 2]>,
+    surface: Option<Surface>,
     torque: Vec<[MinMax; 3]>,
     body: [MinMax; 4],
     energy: [MinMax; 3],
@@ -45,6 +50,12 @@ impl Recorder {
             columns: Columns::new(0.0, t_end),
             legs: layout.legs.clone(),
             normal: layout.legs.iter().map(|_| m()).collect(),
+            height: layout
+                .legs
+                .iter()
+                .map(|_| std::array::from_fn(|_| m()))
+                .collect(),
+            surface: None,
             torque: layout
                 .legs
                 .iter()
@@ -53,6 +64,12 @@ impl Recorder {
             body: std::array::from_fn(|_| m()),
             energy: std::array::from_fn(|_| m()),
         }
+    }
+
+    /// Draws each foot's height against the terrain `surface` under it.
+    pub fn with_surface(mut self, surface: &Surface) -> Self {
+        self.surface = surface.exists().then(|| surface.clone());
+        self
     }
 
     /// Adds one step; `s` matches the record's rows to the layout.
@@ -64,6 +81,15 @@ impl Recorder {
         let col = self.columns.of(t);
         for (i, m) in self.normal.iter_mut().enumerate() {
             m.push_at(col, t, s.tips[i].map_or(0.0, |c| r.contacts[c].normal));
+        }
+        if let Some(surface) = &self.surface {
+            for (i, [foot, ground]) in self.height.iter_mut().enumerate() {
+                if let Some(c) = s.tips[i] {
+                    let p = r.contacts[c].point;
+                    foot.push_at(col, t, p[1]);
+                    ground.push_at(col, t, surface.height(p[0], p[2]));
+                }
+            }
         }
         for (i, ms) in self.torque.iter_mut().enumerate() {
             let tau = s.legs[i].map_or([0.0; 3], |l| r.legs[l].torque);
@@ -94,7 +120,15 @@ impl Recorder {
         }
         let [height, phi_x, phi_y, phi_z] = self.body;
         let [kinetic, potential, total] = self.energy;
+        let mut heights = Vec::new();
+        if self.surface.is_some() {
+            for (&n, [foot, ground]) in self.legs.iter().zip(self.height) {
+                heights.push(trace(format!("foot {n}"), foot));
+                heights.push(trace(format!("ground under {n}"), ground));
+            }
+        }
         SpatialPlotData {
+            heights,
             feet: self
                 .legs
                 .iter()
@@ -126,6 +160,9 @@ pub struct SpatialPlotData {
     pub legs: Vec<usize>,
     /// Normal force of each leg's foot, labelled `leg n` (N).
     pub feet: Vec<Trace>,
+    /// Per leg: its foot's height and the terrain's under it (m); empty
+    /// without ground.
+    pub heights: Vec<Trace>,
     /// Torques τ1, τ2, τ3 (one vector per joint), one curve per leg,
     /// labelled `leg n` (N·m).
     pub torques: [Vec<Trace>; 3],
@@ -174,9 +211,40 @@ impl SpatialPlotData {
 /// `feet.svg`: the normal force of every foot versus time.
 pub fn feet_svg(d: &SpatialPlotData) -> PlotResult<String> {
     let series = d.per_leg(&d.feet);
+    if d.heights.is_empty() {
+        return stacked_time_chart(
+            None,
+            &[("Normal forces of the feet", "normal force (N)", &series)],
+            &d.events,
+            d.t_range(),
+        );
+    }
+    // Each foot solid, the terrain under it dashed, in the leg's colour.
+    let heights: Vec<(&Trace, Style)> = d
+        .heights
+        .iter()
+        .enumerate()
+        .map(|(k, t)| {
+            (
+                t,
+                Style {
+                    color: leg_color(d.legs[k / 2]),
+                    width: if k % 2 == 0 { 2 } else { 1 },
+                    dashed: k % 2 == 1,
+                },
+            )
+        })
+        .collect();
     stacked_time_chart(
         None,
-        &[("Normal forces of the feet", "normal force (N)", &series)],
+        &[
+            ("Normal forces of the feet", "normal force (N)", &series),
+            (
+                "Foot heights (solid) and the terrain under each foot (dashed)",
+                "height (m)",
+                &heights,
+            ),
+        ],
         &d.events,
         d.t_range(),
     )

@@ -400,6 +400,7 @@ impl HexapodScene {
         let mut s = std::mem::take(&mut self.scene);
         s.rows = self.rows;
         s.terrain = surface_view(&self.surface, &s.p);
+        s.patches = super::patch_views(self.surface.patches());
         for k in 1..s.state.len() {
             let (a, b) = (s.state[k - 1].as_bytes(), s.state[k].as_bytes());
             for slot in 0..self.labels.len().min(a.len()).min(b.len()) {

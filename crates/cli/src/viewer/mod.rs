@@ -162,6 +162,10 @@ pub struct Scene {
     pub ring: Vec<usize>,
     /// The ground.
     pub terrain: TerrainView,
+    /// Friction patches `[x_min, x_max, z_min, z_max, μS, μD]` (m), drawn
+    /// on the ground.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub patches: Vec<[f64; 6]>,
     /// Rows of the run (`trajectory.csv`).
     pub rows: usize,
     /// Row index of each frame.
@@ -227,8 +231,27 @@ pub(crate) fn terrain_view(terrain: &fbd_contact::Terrain, p: &[Vec<f64>]) -> Te
     TerrainView::Profile { xy }
 }
 
-/// Samples per side of a [`TerrainView::Grid`].
+/// Samples per side of a [`TerrainView::Grid`] (121 on a height map, to
+/// draw its bumps and edges).
 const GRID_SAMPLES: usize = 61;
+
+/// The friction patches of the scene (see [`Scene::patches`]).
+pub(crate) fn patch_views(patches: &[fbd_contact::FrictionPatch]) -> Vec<[f64; 6]> {
+    patches
+        .iter()
+        .map(|p| {
+            [
+                p.x[0],
+                p.x[1],
+                p.z[0],
+                p.z[1],
+                p.friction.mu_static,
+                p.friction.mu_dynamic,
+            ]
+            .map(round)
+        })
+        .collect()
+}
 
 /// The surface `y = ϱ(x, z)` over the x–z range of the frames' points
 /// (`p`, `[x, y, z, …]` per frame), widened by 0.6 m on every side.
@@ -251,7 +274,11 @@ pub(crate) fn surface_view(surface: &fbd_contact::Surface, p: &[Vec<f64>]) -> Te
     let half = 0.5 * (hi[0] - lo[0]).max(hi[1] - lo[1]) + 0.6;
     let (cx, cz) = (0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]));
     let (x0, x1, z0, z1) = (cx - half, cx + half, cz - half, cz + half);
-    let n = GRID_SAMPLES;
+    let n = if surface.grid().is_some() {
+        2 * GRID_SAMPLES - 1
+    } else {
+        GRID_SAMPLES
+    };
     let at = |a: f64, b: f64, i: usize| a + (b - a) * i as f64 / (n - 1) as f64;
     let mut y = Vec::with_capacity(n * n);
     for j in 0..n {

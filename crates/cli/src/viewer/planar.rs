@@ -128,6 +128,7 @@ impl<'a> PlanarScene<'a> {
             ring: Vec::new(),
             dynamic: false,
             terrain: Default::default(),
+            patches: Vec::new(),
             rows: 0,
             row: Vec::new(),
             t: Vec::new(),
@@ -265,6 +266,7 @@ impl<'a> PlanarScene<'a> {
             })
             .collect();
         s.terrain = terrain_view(&self.model.params.terrain, &s.p);
+        s.patches = super::patch_views(&self.model.params.patches);
         let names: Vec<String> = s.contacts.iter().map(|c| c.name.clone()).collect();
         s.panels.push(Panel {
             title: "Normal contact forces (N)".into(),

@@ -133,6 +133,11 @@ pub trait Engine: Sized {
     fn friction(&self) -> &Friction {
         self.settings().friction
     }
+    /// The Coulomb friction at `(x, z)` of the ground (its friction
+    /// patches; [`Engine::friction`] elsewhere).
+    fn friction_at(&self, _at: [f64; 2]) -> Friction {
+        *self.friction()
+    }
     /// Contact tolerances.
     fn contact_params(&self) -> &ContactParams {
         self.settings().contact

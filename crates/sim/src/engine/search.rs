@@ -136,11 +136,12 @@ fn keep_if_best<M: Engine>(model: &M, data: &mut RunData<M>) -> f64 {
 /// Applies the switching rules to the trial solution (see the module
 /// docs); `true` if any point or joint limit switched.
 fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
-    let mu_s = model.friction().mu_static;
     let mut touchdown = false;
     let mut best: Option<(usize, M::State, f64)> = None;
     for c in 0..model.contacts() {
         let trial = model.trial(data, c);
+        let friction = model.friction_at(trial.location());
+        let mu_s = friction.mu_static;
         let state = data.trial[c];
         data.seen[c] |= 1 << (state.code() as u8);
         if let Some(anchor) = state.anchor() {
@@ -151,7 +152,7 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
             &state,
             &trial,
             model.ground(),
-            model.friction(),
+            &friction,
             model.contact_params(),
         ) else {
             continue;

@@ -292,12 +292,10 @@ impl BodyPlan {
         // Terrain following.
         let (mut gy, mut gyd, mut gydd) = (0.0, 0.0, 0.0);
         if p.follow_terrain && self.surface.exists() && p.walking {
-            let (h, [gx, gz], dd) = self.surface.mean_height(x, z);
-            let [ux, uz] = self.surface.direction();
-            let vu = ux * vx + uz * vz;
+            let (h, [gx, gz], _) = self.surface.mean_height(x, z);
             gy = h - self.ground0;
             gyd = gx * vx + gz * vz;
-            gydd = gx * ax + gz * az + dd * vu * vu;
+            gydd = gx * ax + gz * az + self.surface.mean_curvature(x, z, [vx, vz]);
         }
         // Sway σ = sway·s·sin(2πt/T) along l(ψ).
         let w = std::f64::consts::TAU / p.period;

@@ -272,7 +272,7 @@ impl SpatialParams {
             joint_limits: p.joint_limits,
             q0,
             qdot0,
-            terrain: Surface::new(p.terrain.clone(), 0.0),
+            terrain: Surface::new(p.terrain.clone(), 0.0).with_patches(p.patches.clone()),
             friction: p.friction,
             contact_points: p.contact_points,
             control,

@@ -26,7 +26,7 @@ use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::LimitCode;
 use crate::rules::{Sink, regularization};
 use fbd_contact::spatial::{clearance, frame, point_at_distance, project};
-use fbd_contact::{SpatialState, SpatialTrial, Surface};
+use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
     half_momentum_and_rotation, pattern, pattern_key, prepare_step, set_previous,
@@ -139,9 +139,15 @@ impl Engine for SpatialModel {
     fn trial(&self, data: &SpatialData, c: usize) -> SpatialTrial {
         trial_of(self, data, c)
     }
+    fn friction_at(&self, at: [f64; 2]) -> Friction {
+        self.params
+            .terrain
+            .friction_at(&self.params.friction, at[0], at[1])
+    }
     fn contact_violation(&self, data: &SpatialData, state: &SpatialState, t: &SpatialTrial) -> f64 {
         let k = data.fbd.position_gain;
-        let mu = self.params.friction.mu_static;
+        let friction = self.friction_at([t.p_k[0], t.p_k[2]]);
+        let mu = friction.mu_static;
         match *state {
             SpatialState::Free => k * (-clearance(&self.params.terrain, t.p_next)).max(0.0),
             SpatialState::Stick { .. } => {
@@ -151,7 +157,7 @@ impl Engine for SpatialModel {
                 // A slide slower than the stop speed carries less than μD·N
                 // (regularised direction): that deficit is a violation too.
                 let s = t.slip();
-                let deficit = self.params.friction.mu_dynamic * t.n - t.ft[0].hypot(t.ft[1]);
+                let deficit = friction.mu_dynamic * t.n - t.ft[0].hypot(t.ft[1]);
                 (-t.n).max(0.0) + k * (-(s[0] * dir[0] + s[1] * dir[1])).max(0.0) + deficit.max(0.0)
             }
         }
@@ -244,7 +250,7 @@ fn system<'a>(
         data.fbd.contact[c] = SpatialContactEquation {
             state,
             frame: frame(surface, x, z),
-            mu_dynamic: model.params.friction.mu_dynamic,
+            mu_dynamic: surface.friction_at(&model.params.friction, x, z).mu_dynamic,
             regularization: b + model.contact_bumper[c],
         };
     }

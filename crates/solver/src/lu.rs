@@ -102,8 +102,7 @@ pub(crate) enum FactorPath {
     /// faer's pivoting LU: the reference path, or the first factorisation
     /// of the pattern (which compiles it).
     Faer,
-    /// faer's pivoting LU after a compiled pivot failed its check (the
-    /// pattern compiled again on faer's row order).
+    /// faer's pivoting LU after a compiled pivot failed its check.
     Fallback,
 }
 
@@ -344,6 +343,8 @@ pub(crate) struct Factors {
     upper: Vec<(u32, u32, f64)>,
     /// Scratch of [`Self::solve`].
     work: Vec<f64>,
+    /// The compiled program's row order (`CompiledLu::choose_rows`).
+    row_choice: Vec<usize>,
     /// The pattern whose factorisation this holds (none after the dense
     /// warm-up or a failed factorisation).
     owner: Option<usize>,
@@ -372,6 +373,7 @@ impl Factors {
             lower: Vec::with_capacity(n * n.saturating_sub(1) / 2),
             upper: Vec::with_capacity(n * n.saturating_sub(1) / 2),
             work: vec![0.0; n],
+            row_choice: Vec::with_capacity(n),
             owner: None,
         };
         if n == 0 {
@@ -514,18 +516,28 @@ impl Factors {
                     self.upper.push((i as u32, j as u32, v * pivot_inv));
                 }
             }
-            if compiled && (path == FactorPath::Fallback || !pattern.compiled.is_compiled()) {
-                // Compiled on faer's row order of these values: the first
-                // time (allocates), or again after a fallback when the new
-                // program fits the first one's storage (never allocates;
-                // else the old program stays).
-                pattern.compiled.compile(
-                    pattern.structure.col_ptr(),
-                    pattern.structure.row_idx(),
-                    pattern.col_perm.arrays().0,
-                    &self.row_perm,
-                    path == FactorPath::Faer,
-                );
+            if compiled && !pattern.compiled.is_compiled() {
+                // Compiled on these values, at the pattern's first
+                // factorisation (it allocates, as the pattern's
+                // registration does). A fallback keeps the program: the
+                // next factorisation tries it again (a failed pivot is
+                // mostly a passing cancellation, an entry that is zero at
+                // that state; recompiling on such values was measured
+                // dearer, 1.6 M instructions a time on the hexapod walk).
+                let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
+                let fwd = pattern.col_perm.arrays().0;
+                let program = &mut pattern.compiled;
+                // The row order: threshold Markowitz on these values (less
+                // fill than faer's partial pivoting), else faer's.
+                let rows = match program.choose_rows(col_ptr, row_idx, fwd, reduced) {
+                    Some(order) => {
+                        self.row_choice.clear();
+                        self.row_choice.extend_from_slice(order);
+                        &self.row_choice
+                    }
+                    None => &self.row_perm,
+                };
+                program.compile(col_ptr, row_idx, fwd, rows, path == FactorPath::Faer);
             }
         }
         self.owner = Some(pattern.id);

@@ -410,21 +410,24 @@ fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, 
         SpatialControl::Gait { gait, .. } => {
             let mut g = crate::gait::GaitData::new(gait);
             let stride = gait.steps / GAIT_POSES + 1;
-            for k in 0..=gait.steps {
+            // Only the sampled steps: the gait's closed-form inverse
+            // kinematics needs the previous angles only to stay on their
+            // turn (±2π), which `stride` ms of a gait never leaves, so each
+            // sample is the angles the run's controller computes at that
+            // step (a 26th of the gait's steps on a 5 s walk at 1 ms).
+            for k in (0..=gait.steps).step_by(stride) {
                 // A gait that cannot place a foot fails at that step of
                 // the run, with its own error.
                 if crate::gait::step_targets(gait, &mut g, k).is_err() {
                     break;
                 }
-                if k % stride == 0 {
-                    let stance = g.stance();
-                    poses.push((
-                        mech.legs.iter().map(|&n| g.legs[n - 1].theta).collect(),
-                        (0..nlegs)
-                            .filter(|&s| ground && stance[mech.legs[s] - 1])
-                            .collect(),
-                    ));
-                }
+                let stance = g.stance();
+                poses.push((
+                    mech.legs.iter().map(|&n| g.legs[n - 1].theta).collect(),
+                    (0..nlegs)
+                        .filter(|&s| ground && stance[mech.legs[s] - 1])
+                        .collect(),
+                ));
             }
         }
         SpatialControl::None => {}

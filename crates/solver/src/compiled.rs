@@ -355,8 +355,7 @@ impl CompiledLu {
             a[s as usize] = v;
         }
         let mut t = 0usize;
-        for k in 0..self.m {
-            let ps = self.pivot[k];
+        for (k, (&ps, inv_k)) in self.pivot.iter().zip(pivot_inv.iter_mut()).enumerate() {
             if ps == u32::MAX {
                 return Err(PivotFailed);
             }
@@ -376,7 +375,7 @@ impl CompiledLu {
                 return Err(PivotFailed);
             }
             let inv = p.recip();
-            pivot_inv[k] = inv;
+            *inv_k = inv;
             let us = &self.u_slots[self.u_ptr[k] as usize..self.u_ptr[k + 1] as usize];
             let w = us.len();
             for &s in ls {

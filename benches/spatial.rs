@@ -3,7 +3,10 @@
 //! (standing on six feet: 96 unknowns), its sparse LU (faer, symbolic
 //! factorisation cached per contact pattern) and one whole step standing
 //! (PD stance on six sticking feet) and walking (the tripod gait tracked by
-//! PD, `examples/hexapod_walk.toml`, steps 0.5–2.5 s).
+//! PD, `examples/hexapod_walk.toml`, steps 0.5–2.5 s) and landing
+//! (`examples/hexapod_drop.toml`, steps 0.3–1 s: touchdown of the feet,
+//! then of the hips); the numeric LU both compiled (the default) and by
+//! faer's pivoting LU (the reference path).
 //!
 //! `cargo bench -p fbd-suite --bench spatial`
 
@@ -106,9 +109,29 @@ fn bench(c: &mut Criterion) {
     c.bench_function("spatial/numeric_lu", |b| {
         b.iter(|| solver.factorize_loaded(None).expect("factorisation"))
     });
+    // The same by faer's pivoting LU, the reference path (the compiled LU
+    // off).
+    let mut faer_solver = NewtonSolver::new(fbd_solver::NewtonParams {
+        compiled_lu: false,
+        ..stand.newton
+    });
+    {
+        let mut sys = fbd_sim::spatial::step::system_for_bench(&stand, &mut data);
+        faer_solver.load_jacobian(&mut sys, &z);
+    }
+    c.bench_function("spatial/numeric_lu_faer", |b| {
+        b.iter(|| faer_solver.factorize_loaded(None).expect("factorisation"))
+    });
 
-    // One whole step, standing and walking.
-    for (name, model, from) in [("stand", &stand, 500usize), ("walk", &walk, 500usize)] {
+    // One whole step, standing, walking, and landing (the passive drop:
+    // the six feet touch down at 0.321 s, the hips at 0.417 s, then rest
+    // on twelve sticking points).
+    let drop = example("hexapod_drop.toml");
+    for (name, model, from) in [
+        ("stand", &stand, 500usize),
+        ("walk", &walk, 500usize),
+        ("landing", &drop, 300usize),
+    ] {
         c.bench_function(&format!("spatial/step_{name}"), |b| {
             b.iter_custom(|iters| {
                 let mut total = Duration::ZERO;

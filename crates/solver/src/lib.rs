@@ -14,6 +14,7 @@
 //!   ([`NewtonParams::chord_steps`]) reuses the kept factorisation. After
 //!   the first solve of a pattern, solving does not allocate.
 
+mod compiled;
 mod error;
 mod lu;
 mod newton;

@@ -92,6 +92,19 @@ use faer::sparse::linalg::lu::{LuSymbolicParams, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 use crate::SolverError;
+use crate::compiled::CompiledLu;
+
+/// Which path a factorisation took (see [`crate::compiled`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum FactorPath {
+    /// The compiled program of the pattern.
+    Compiled,
+    /// faer's pivoting LU: the reference path, or the first factorisation
+    /// of the pattern (which compiles it).
+    Faer,
+    /// faer's pivoting LU after a compiled pivot failed its check.
+    Fallback,
+}
 
 /// Cached per-pattern data: the reduced CSC structure (singleton rows
 /// taken out, see the module docs), the dense slot map, the column
@@ -139,6 +152,9 @@ pub(crate) struct Pattern {
     pub(crate) chords_since: usize,
     /// Chord steps of the last solve after its last factorisation.
     last_chords: usize,
+    /// The compiled numeric LU (empty until the first factorisation with
+    /// the compiled path enabled).
+    compiled: CompiledLu,
 }
 
 impl Pattern {
@@ -275,6 +291,7 @@ impl Pattern {
             solves_since: 0,
             chords_since: 0,
             last_chords: 0,
+            compiled: CompiledLu::default(),
         }
     }
 
@@ -326,6 +343,8 @@ pub(crate) struct Factors {
     upper: Vec<(u32, u32, f64)>,
     /// Scratch of [`Self::solve`].
     work: Vec<f64>,
+    /// The compiled program's row order (`CompiledLu::choose_rows`).
+    row_choice: Vec<usize>,
     /// The pattern whose factorisation this holds (none after the dense
     /// warm-up or a failed factorisation).
     owner: Option<usize>,
@@ -354,6 +373,7 @@ impl Factors {
             lower: Vec::with_capacity(n * n.saturating_sub(1) / 2),
             upper: Vec::with_capacity(n * n.saturating_sub(1) / 2),
             work: vec![0.0; n],
+            row_choice: Vec::with_capacity(n),
             owner: None,
         };
         if n == 0 {
@@ -407,7 +427,8 @@ impl Factors {
         pattern: &mut Pattern,
         values: &[f64],
         mem: &mut MemBuffer,
-    ) -> Result<(), SolverError> {
+        compiled: bool,
+    ) -> Result<FactorPath, SolverError> {
         let n = self.n;
         assert_eq!(pattern.m, n, "pattern and storage dimensions differ");
         self.owner = None;
@@ -418,6 +439,37 @@ impl Factors {
             *p = v.recip();
         }
         pattern.coupling.copy_from_slice(couplings);
+        let mut path = FactorPath::Faer;
+        if compiled && n > 0 && pattern.compiled.is_compiled() {
+            let program = &mut pattern.compiled;
+            if program.factor(reduced, &mut self.pivot_inv).is_ok() {
+                for (s, &p) in self.row_src.iter_mut().zip(&program.row_perm) {
+                    *s = pattern.kept_rows[p];
+                }
+                // The sweeps' streams: fixed entries, this factorisation's
+                // values (`U`'s divided by their column's pivot).
+                self.lower.clear();
+                self.lower.extend(
+                    program
+                        .lower
+                        .iter()
+                        .map(|&(i, j, s)| (i, j, program.value(s))),
+                );
+                self.upper.clear();
+                let pivot_inv = &self.pivot_inv;
+                self.upper.extend(
+                    program
+                        .upper
+                        .iter()
+                        .map(|&(i, j, s)| (i, j, program.value(s) * pivot_inv[j as usize])),
+                );
+                self.owner = Some(pattern.id);
+                pattern.solves_since = 0;
+                pattern.chords_since = 0;
+                return Ok(FactorPath::Compiled);
+            }
+            path = FactorPath::Fallback;
+        }
         if n > 0 {
             let matrix = SparseColMatRef::new(pattern.structure.as_ref(), reduced);
             match factorize_simplicial_numeric_lu(
@@ -464,11 +516,34 @@ impl Factors {
                     self.upper.push((i as u32, j as u32, v * pivot_inv));
                 }
             }
+            if compiled && !pattern.compiled.is_compiled() {
+                // Compiled on these values, at the pattern's first
+                // factorisation (it allocates, as the pattern's
+                // registration does). A fallback keeps the program: the
+                // next factorisation tries it again (a failed pivot is
+                // mostly a passing cancellation, an entry that is zero at
+                // that state; recompiling on such values was measured
+                // dearer, 1.6 M instructions a time on the hexapod walk).
+                let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
+                let fwd = pattern.col_perm.arrays().0;
+                let program = &mut pattern.compiled;
+                // The row order: threshold Markowitz on these values (less
+                // fill than faer's partial pivoting), else faer's.
+                let rows = match program.choose_rows(col_ptr, row_idx, fwd, reduced) {
+                    Some(order) => {
+                        self.row_choice.clear();
+                        self.row_choice.extend_from_slice(order);
+                        &self.row_choice
+                    }
+                    None => &self.row_perm,
+                };
+                program.compile(col_ptr, row_idx, fwd, rows, path == FactorPath::Faer);
+            }
         }
         self.owner = Some(pattern.id);
         pattern.solves_since = 0;
         pattern.chords_since = 0;
-        Ok(())
+        Ok(path)
     }
 
     /// Solves `J x = rhs` in place with the last factorisation of
@@ -602,7 +677,7 @@ mod tests {
                 ));
             let mut factors = Factors::new(pattern.m, &mut mem);
             factors
-                .factor(&mut pattern, &values, &mut mem)
+                .factor(&mut pattern, &values, &mut mem, false)
                 .expect("nonsingular");
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
             let mut ours = b.clone();
@@ -643,6 +718,110 @@ mod tests {
         }
     }
 
+    /// Solution of `pattern`'s system with `values` and right-hand side
+    /// `b`, through `factors` (compiled path or not), with its path.
+    fn solve_with(
+        factors: &mut Factors,
+        pattern: &mut Pattern,
+        values: &[f64],
+        b: &[f64],
+        mem: &mut MemBuffer,
+        compiled: bool,
+    ) -> (Vec<f64>, FactorPath) {
+        let path = factors
+            .factor(pattern, values, mem, compiled)
+            .expect("nonsingular");
+        let mut x = b.to_vec();
+        factors.solve(pattern, &mut x);
+        (x, path)
+    }
+
+    #[test]
+    fn compiled_lu_matches_faer() {
+        let cases = [(5, 1), (19, 2), (31, 3), (64, 4), (150, 5)]
+            .into_iter()
+            .flat_map(|(n, seed)| [matrix(n, seed), with_singletons(n, seed)]);
+        for triplets in cases {
+            let n = 1 + triplets.iter().map(|t| t.0.max(t.1)).max().unwrap();
+            let mut entries: Vec<(usize, usize)> = triplets.iter().map(|t| (t.0, t.1)).collect();
+            let mut pattern = Pattern::build(0, n, &mut entries);
+            let mut mem = MemBuffer::new(Factors::scratch(n));
+            let mut factors = Factors::new(pattern.m, &mut mem);
+            let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
+            // Values of the pattern, scaled per entry by `1 + eps·sin`.
+            let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
+            let values_at = |eps: f64| {
+                let mut values = vec![0.0; nnz];
+                for (k, &(i, j, v)) in triplets.iter().enumerate() {
+                    values[slot[i * n + j] as usize] += v * (1.0 + eps * (k as f64).sin());
+                }
+                values
+            };
+            let first = values_at(0.0);
+            let (_, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
+            assert_eq!(path, FactorPath::Faer, "the first factorisation compiles");
+            for eps in [0.0, 1e-3, 0.05] {
+                let values = values_at(eps);
+                let (ours, path) =
+                    solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, true);
+                assert_eq!(path, FactorPath::Compiled, "n = {n}, eps = {eps}");
+                let (theirs, path) =
+                    solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, false);
+                assert_eq!(path, FactorPath::Faer);
+                let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+                for i in 0..n {
+                    assert!(
+                        (ours[i] - theirs[i]).abs() <= 1e-12 * scale,
+                        "n = {n}, eps = {eps}, x[{i}]: compiled {} faer {}",
+                        ours[i],
+                        theirs[i]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_failed_pivot_falls_back_to_faer() {
+        // [[a, 1], [1, 1]]: compiled on a = 2 (row 0 pivots first), then
+        // a = 1e-3 fails the check (|a| < 0.01·1) and faer pivots on row 1.
+        let n = 2;
+        let mut entries = vec![(0, 0), (0, 1), (1, 0), (1, 1)];
+        let mut pattern = Pattern::build(0, n, &mut entries);
+        let slot = pattern.slot.clone();
+        let values_for = |a: f64| {
+            let mut v = vec![0.0; 4];
+            for (i, j, x) in [(0, 0, a), (0, 1, 1.0), (1, 0, 1.0), (1, 1, 1.0)] {
+                v[slot[i * n + j] as usize] = x;
+            }
+            v
+        };
+        let mut mem = MemBuffer::new(Factors::scratch(n));
+        let mut factors = Factors::new(pattern.m, &mut mem);
+        let b = [1.0, 2.0];
+        let first = values_for(2.0);
+        let (_, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
+        assert_eq!(path, FactorPath::Faer);
+        let (x, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
+        assert_eq!(path, FactorPath::Compiled);
+        // 2x + y = 1, x + y = 2: x = −1, y = 3.
+        assert!((x[0] + 1.0).abs() < 1e-15 && (x[1] - 3.0).abs() < 1e-15);
+        let small = values_for(1e-3);
+        let (x, path) = solve_with(&mut factors, &mut pattern, &small, &b, &mut mem, true);
+        assert_eq!(path, FactorPath::Fallback);
+        // a·x + y = 1, x + y = 2: x = 1/(1 − a), y = 2 − x.
+        let exact = [1.0 / (1.0 - 1e-3), 2.0 - 1.0 / (1.0 - 1e-3)];
+        assert!((x[0] - exact[0]).abs() < 1e-14 && (x[1] - exact[1]).abs() < 1e-14);
+        // The program stays: the same values fall back again, the first
+        // ones pass it again.
+        let (y, path) = solve_with(&mut factors, &mut pattern, &small, &b, &mut mem, true);
+        assert_eq!(path, FactorPath::Fallback);
+        assert_eq!(x, y);
+        let (x, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
+        assert_eq!(path, FactorPath::Compiled);
+        assert!((x[0] + 1.0).abs() < 1e-15 && (x[1] - 3.0).abs() < 1e-15);
+    }
+
     #[test]
     fn singleton_rows_leave_the_lu() {
         let n = 19;
@@ -671,7 +850,9 @@ mod tests {
         }
         let mut mem = MemBuffer::new(Factors::scratch(1));
         let mut factors = Factors::new(0, &mut mem);
-        factors.factor(&mut pattern, &values, &mut mem).unwrap();
+        factors
+            .factor(&mut pattern, &values, &mut mem, false)
+            .unwrap();
         let mut x = vec![1.0, 2.0, 3.0, 4.0];
         factors.solve(&mut pattern, &mut x);
         // Row i: (i + 1)·x[i + 1] = b[i].

@@ -14,7 +14,7 @@
 
 use faer::dyn_stack::{MemBuffer, StackReq};
 
-use crate::lu::{Factors, Pattern};
+use crate::lu::{FactorPath, Factors, Pattern};
 use crate::{JacobianSink, NewtonSystem, SolverError};
 
 /// Tuning parameters of [`NewtonSolver`].
@@ -98,6 +98,16 @@ pub struct NewtonParams {
     /// running cost grows. `0` disables it (the factorisation is renewed
     /// only when a chord step contracts too little). Default: `0`.
     pub refactor_cost: f64,
+    /// **The compiled LU** (`crate::compiled`): each pattern's numeric LU
+    /// compiled, at its first factorisation, into a flat list of
+    /// operations on faer's column ordering and the row order of faer's
+    /// partial pivoting on those values; later factorisations run the list
+    /// and re-verify each pivot (threshold `0.01` of its column), falling
+    /// back to faer's pivoting LU (and compiling again) when one fails
+    /// ([`NewtonSolver::lu_fallbacks`]). `false`: every factorisation by
+    /// faer's pivoting LU, the reference path. Solutions agree to
+    /// round-off. Default: `true`.
+    pub compiled_lu: bool,
 }
 
 impl Default for NewtonParams {
@@ -111,6 +121,7 @@ impl Default for NewtonParams {
             chord_steps: 0,
             chord_contraction: 0.5,
             refactor_cost: 0.0,
+            compiled_lu: true,
         }
     }
 }
@@ -146,6 +157,10 @@ struct Workspace {
     mem: MemBuffer,
     mem_req: StackReq,
     numeric_factorizations: u64,
+    /// Factorisations by the compiled LU.
+    compiled_factorizations: u64,
+    /// Compiled factorisations abandoned for faer's (a pivot failed).
+    lu_fallbacks: u64,
 }
 
 /// Newton solver with a cache of symbolic LU factorisations keyed by
@@ -204,6 +219,8 @@ impl NewtonSolver {
                 mem: MemBuffer::new(StackReq::EMPTY),
                 mem_req: StackReq::EMPTY,
                 numeric_factorizations: 0,
+                compiled_factorizations: 0,
+                lu_fallbacks: 0,
             },
             symbolic_factorizations: 0,
         }
@@ -229,6 +246,18 @@ impl NewtonSolver {
     /// one-off dense warm-up per new pattern).
     pub fn numeric_factorizations(&self) -> u64 {
         self.ws.numeric_factorizations
+    }
+
+    /// Of [`Self::numeric_factorizations`], those done by the compiled LU
+    /// (see [`NewtonParams::compiled_lu`]).
+    pub fn compiled_factorizations(&self) -> u64 {
+        self.ws.compiled_factorizations
+    }
+
+    /// Compiled factorisations abandoned because a pivot failed its check
+    /// (each then factored by faer, and the pattern compiled again).
+    pub fn lu_fallbacks(&self) -> u64 {
+        self.ws.lu_fallbacks
     }
 
     /// Number of pattern keys currently cached.
@@ -390,7 +419,12 @@ impl NewtonSolver {
             .expect("factorize_loaded: call load_jacobian first");
         let pattern = &mut self.patterns[index].1;
         let factors = &mut self.factors[pattern.factors];
-        factors.factor(pattern, &self.ws.values, &mut self.ws.mem)?;
+        factors.factor(
+            pattern,
+            &self.ws.values,
+            &mut self.ws.mem,
+            self.params.compiled_lu,
+        )?;
         if let Some(dx) = dx {
             assert_eq!(dx.len(), pattern.n, "dx has the wrong length");
             negate(dx, &self.ws.r);
@@ -617,7 +651,11 @@ impl Workspace {
                 return Err(SolverError::NonFinite { iter: full });
             }
             negate(&mut self.dx, &self.r);
-            factors.factor(pattern, &self.values, &mut self.mem)?;
+            match factors.factor(pattern, &self.values, &mut self.mem, params.compiled_lu)? {
+                FactorPath::Compiled => self.compiled_factorizations += 1,
+                FactorPath::Fallback => self.lu_fallbacks += 1,
+                FactorPath::Faer => {}
+            }
             factorizations += 1;
             self.numeric_factorizations += 1;
             factors.solve(pattern, &mut self.dx);

@@ -216,6 +216,8 @@ pub struct Outputs {
     feet: Feet,
     slots: Option<csv::Slots>,
     rows: usize,
+    /// The model's start-up stability check (s), for `summary.json`.
+    pub stability_check_seconds: f64,
 }
 
 impl Outputs {
@@ -256,6 +258,7 @@ impl Outputs {
         };
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
         Ok(Self {
+            stability_check_seconds: 0.0,
             collect: summary::Collector::new(&layout, &params.terrain),
             plot: out_dir
                 .filter(|_| output.plots)
@@ -308,9 +311,10 @@ impl Outputs {
     /// Writes every file (each attempted, the first failure kept) and
     /// removes those of an earlier run of another kind.
     pub fn finish(self, params: &SpatialParams, run: RunSummary, config_toml: &str) -> SpatialRun {
-        let s = self
+        let mut s = self
             .collect
             .finish(params, self.steps, &self.layout, &run, self.rows);
+        s.stability_check_seconds = self.stability_check_seconds;
         let (Some(out_dir), Some(traj)) = (self.dir, self.traj) else {
             return SpatialRun {
                 run,
@@ -405,6 +409,7 @@ pub fn simulate(
         &output_of(config_toml),
         source,
     )?;
+    out.stability_check_seconds = model.stability_check_seconds;
     let run = run_until(&model, stop, |r: &SpatialRecord| out.push(r, on_row));
     Ok(out.finish(params, run, config_toml))
 }

@@ -65,6 +65,11 @@ pub struct SpatialSummary {
     pub steps_per_second: Option<f64>,
     /// Symbolic LU factorisations performed.
     pub symbolic_factorizations: usize,
+    /// Wall time (s) of the start-up stability check of the joint
+    /// controller (before the stepping loop, not in `wall_seconds`); near
+    /// zero when an earlier run of the process had the same robot and
+    /// poses.
+    pub stability_check_seconds: f64,
     /// Contact, joint-limit and retried-step events, as `events.csv`.
     pub events: Vec<EventJson>,
     /// Steps solved again in substeps.
@@ -276,6 +281,7 @@ impl Collector {
             wall_seconds: run.wall_seconds,
             steps_per_second: (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds),
             symbolic_factorizations: run.symbolic_factorizations,
+            stability_check_seconds: 0.0,
             events: output::run_events(run, &times)
                 .into_iter()
                 .map(|e| e.2)

@@ -39,4 +39,4 @@ pub use model::{GaitData, GaitModel, InitialPose};
 pub use params::{Command, GaitKind, GaitParams, LEGS};
 pub use run::{GaitEvent, GaitEventKind, GaitSummary, run_gait};
 pub use stability::Masses;
-pub use step::step;
+pub use step::{step, step_targets};

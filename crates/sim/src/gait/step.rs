@@ -32,6 +32,39 @@ pub fn anchor(model: &GaitModel, leg: usize, k: Option<usize>) -> Vector3<f64> {
 /// A [`GaitError`] naming the leg and the time when a foot target is out of
 /// reach, a leg is singular or a joint passes its limit.
 pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), GaitError> {
+    let (support, n_support, trig) = targets(model, data, k)?;
+    let pose = BodyPose {
+        position: data.body.position,
+        phi: data.body.phi,
+    };
+    // The IK's sines and cosines and the body's rotation: no trigonometry.
+    forward_trig(&model.kin, &pose, &data.body.rotation, &trig, &mut data.fk);
+    data.com = centre_of_mass(&model.masses, &data.fk);
+    data.margin = margin(&support[..n_support], [data.com.x, data.com.z]);
+    Ok(())
+}
+
+/// The part of [`step`] a joint controller needs: step `k`'s phases,
+/// feet, body state and the legs' joint angles, rates and accelerations
+/// (`data.legs`), without the forward kinematics, centre of mass and
+/// stability margin (`data.fk`, `data.com` and `data.margin` keep their
+/// previous values). The same numbers as [`step`]'s.
+///
+/// # Errors
+/// As [`step`].
+pub fn step_targets(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), GaitError> {
+    targets(model, data, k).map(|_| ())
+}
+
+/// [`step_targets`], returning the stance feet's horizontal positions
+/// (their number) and each leg's sines and cosines for the forward
+/// kinematics.
+#[allow(clippy::type_complexity)]
+fn targets(
+    model: &GaitModel,
+    data: &mut GaitData,
+    k: usize,
+) -> Result<([[f64; 2]; LEGS], usize, [LegTrig; LEGS]), GaitError> {
     let t = model.time(k);
     let p = &model.params;
     let planar = model.plan.planar_at_step(k);
@@ -76,16 +109,8 @@ pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), Gait
         data.foot_velocity[leg] = vel;
         data.foot_acceleration[leg] = acc;
     }
-    let pose = BodyPose {
-        position: body.position,
-        phi: body.phi,
-    };
-    // The IK's sines and cosines and the body's rotation: no trigonometry.
-    forward_trig(&model.kin, &pose, &body.rotation, &trig, &mut data.fk);
-    data.com = centre_of_mass(&model.masses, &data.fk);
-    data.margin = margin(&support[..n_support], [data.com.x, data.com.z]);
     data.body = body;
     data.step = k;
     data.t = t;
-    Ok(())
+    Ok((support, n_support, trig))
 }

@@ -67,7 +67,7 @@ pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(),
     if let (SpatialControl::Gait { gait, .. }, Some(g)) = (&model.params.control, &mut data.control)
     {
         let k = data.k.min(gait.steps);
-        crate::gait::step(gait, g, k).map_err(|e| SimError::Control {
+        crate::gait::step_targets(gait, g, k).map_err(|e| SimError::Control {
             step: data.k,
             t,
             message: e.to_string(),

@@ -32,6 +32,10 @@ pub struct SpatialModel {
     /// when its violation is at most this force (N). Default `1e-7 ×`
     /// weight.
     pub cycle_tolerance: f64,
+    /// Wall time (s) of the start-up stability check of the joint
+    /// controller (`pd_stability`) in [`SpatialModel::new`]; near zero
+    /// when its result came from the process's cache.
+    pub stability_check_seconds: f64,
 }
 
 /// The body's inertia tensor from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`.
@@ -215,7 +219,9 @@ impl SpatialModel {
             p.contact_points,
             &p.joint_limits,
         );
+        let start = std::time::Instant::now();
         pd_stability(p, &mech)?;
+        let stability_check_seconds = start.elapsed().as_secs_f64();
         for lim in &mech.limits {
             if let Err(e) = p.joint_limits.check(lim.joint, p.q0[lim.q_index]) {
                 check(
@@ -267,6 +273,7 @@ impl SpatialModel {
             initial_states,
             max_substeps: 64,
             cycle_tolerance: 1e-7 * total_mass * p.gravity.abs().max(1.0),
+            stability_check_seconds,
             mech,
         })
     }
@@ -308,6 +315,77 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
     if kp == 0.0 && kd == 0.0 {
         return Ok(());
     }
+    let (inertia, joint) = cached_fastest_mode(p, mech);
+    crate::rules::pd_stability(
+        kp,
+        kd,
+        inertia,
+        p.dt,
+        &format!("leg {} theta{}", mech.legs[joint / 3], joint % 3 + 1),
+    )
+}
+
+/// Results of [`fastest_mode_over_poses`] kept in this process, keyed by
+/// the parameters with what it does not read normalised away (the gains
+/// and limits of the controller, friction, contact tolerances, initial
+/// rates, output stride): the runs of a sweep over gains or friction, and
+/// the resets of an environment, compute it once. At most
+/// [`MODE_CACHE`] entries, the oldest dropped first.
+static MODES: std::sync::Mutex<Vec<(SpatialParams, (f64, usize))>> =
+    std::sync::Mutex::new(Vec::new());
+
+/// Entries of [`MODES`].
+const MODE_CACHE: usize = 16;
+
+/// [`fastest_mode_over_poses`], through the cache [`MODES`].
+fn cached_fastest_mode(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usize) {
+    let mut key = p.clone();
+    match &mut key.control {
+        SpatialControl::None => {}
+        SpatialControl::Pd {
+            kp,
+            kd,
+            torque_limit,
+            ..
+        }
+        | SpatialControl::Trajectory {
+            kp,
+            kd,
+            torque_limit,
+            ..
+        }
+        | SpatialControl::Gait {
+            kp,
+            kd,
+            torque_limit,
+            ..
+        } => {
+            (*kp, *kd, *torque_limit) = (0.0, 0.0, None);
+        }
+    }
+    key.friction = Default::default();
+    key.contact = Default::default();
+    key.qdot0.clear();
+    key.stride = 0;
+    key.duration = 0.0;
+    if let Ok(cache) = MODES.lock()
+        && let Some((_, mode)) = cache.iter().find(|(k, _)| *k == key)
+    {
+        return *mode;
+    }
+    let mode = fastest_mode_over_poses(p, mech);
+    if let Ok(mut cache) = MODES.lock() {
+        if cache.len() == MODE_CACHE {
+            cache.remove(0);
+        }
+        cache.push((key, mode));
+    }
+    mode
+}
+
+/// The smallest effective joint inertia over the poses of
+/// [`pd_stability`] and its joint (index `3·slot + j`).
+fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usize) {
     let nlegs = mech.legs.len();
     // Without ground no foot ever stands: the free robot's modes.
     let ground = p.terrain.exists();
@@ -332,21 +410,24 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
         SpatialControl::Gait { gait, .. } => {
             let mut g = crate::gait::GaitData::new(gait);
             let stride = gait.steps / GAIT_POSES + 1;
-            for k in 0..=gait.steps {
+            // Only the sampled steps: the gait's closed-form inverse
+            // kinematics needs the previous angles only to stay on their
+            // turn (±2π), which `stride` ms of a gait never leaves, so each
+            // sample is the angles the run's controller computes at that
+            // step (a 26th of the gait's steps on a 5 s walk at 1 ms).
+            for k in (0..=gait.steps).step_by(stride) {
                 // A gait that cannot place a foot fails at that step of
                 // the run, with its own error.
-                if crate::gait::step(gait, &mut g, k).is_err() {
+                if crate::gait::step_targets(gait, &mut g, k).is_err() {
                     break;
                 }
-                if k % stride == 0 {
-                    let stance = g.stance();
-                    poses.push((
-                        mech.legs.iter().map(|&n| g.legs[n - 1].theta).collect(),
-                        (0..nlegs)
-                            .filter(|&s| ground && stance[mech.legs[s] - 1])
-                            .collect(),
-                    ));
-                }
+                let stance = g.stance();
+                poses.push((
+                    mech.legs.iter().map(|&n| g.legs[n - 1].theta).collect(),
+                    (0..nlegs)
+                        .filter(|&s| ground && stance[mech.legs[s] - 1])
+                        .collect(),
+                ));
             }
         }
         SpatialControl::None => {}
@@ -371,11 +452,5 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
             (inertia, joint) = (mode.inertia, mode.joint);
         }
     }
-    crate::rules::pd_stability(
-        kp,
-        kd,
-        inertia,
-        p.dt,
-        &format!("leg {} theta{}", mech.legs[joint / 3], joint % 3 + 1),
-    )
+    (inertia, joint)
 }

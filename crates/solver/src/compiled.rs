@@ -1,0 +1,398 @@
+//! The numeric LU of one reduced pattern compiled into a flat list of
+//! operations: no symbolic work, no pivot search, no per-column dispatch
+//! at a factorisation.
+//!
+//! # What is compiled
+//!
+//! faer's symbolic analysis gives the column ordering `Q` (COLAMD, see
+//! [`crate::lu`]); the values of the pattern's first factorisation give a
+//! row order `P`, by threshold Markowitz pivoting along `Q`
+//! ([`CompiledLu::choose_rows`]: among the rows whose entry is at least a
+//! tenth of the column's largest, the one of least fill; faer's partial
+//! pivoting, which takes the largest entry, filled the factors more: the
+//! hexapod walk's solves cost 15 % less with this order). With both fixed,
+//! the fill of `P·A·Q = L·U` is a property of the pattern alone, found once
+//! by a symbolic elimination ([`CompiledLu::compile`]): every entry of `L`
+//! and `U` gets a slot in one dense-free value array, and the elimination
+//! becomes
+//!
+//! * a scatter of the Jacobian's values (CSC order) into their slots;
+//! * for each pivot `k`, in order: the pivot check, the scaling of `L`'s
+//!   column `k` by `1/u_kk`, and the rank-one update
+//!   `a_ij −= l_ik·u_kj` of every `(i, j)` of `L`'s column `k` times `U`'s
+//!   row `k`, whose target slots are one precomputed stream.
+//!
+//! The result is copied into the `(row, column, value)` streams of the
+//! triangular sweeps ([`crate::lu::Factors`]), whose entries are fixed at
+//! compile time too.
+//!
+//! # Numerically safe pivots
+//!
+//! The row order is the one faer's partial pivoting chose on the first
+//! factorisation of the pattern; later Jacobians of the same pattern have
+//! other values. Each pivot is therefore re-verified against threshold
+//! partial pivoting: `|u_kk| ≥ PIVOT_THRESHOLD · max_i |l_ik·u_kk|` over
+//! its column (the largest entry a partial pivoting could have chosen),
+//! and `u_kk ≠ 0`. A pivot that fails (or a non-finite one) abandons the
+//! compiled factorisation: the caller factors with faer's pivoting LU (the
+//! reference path) and counts the fallback; the program stays for the next
+//! factorisation. Results equal faer's to round-off (different order of
+//! the same sums), not bit for bit.
+
+/// The threshold of the pivot check: a pivot at least a hundredth of the
+/// largest entry of its column, which bounds `L`'s entries by 100. Measured
+/// (fallbacks / factorisations, `bench/peer`): the moving planar flight
+/// 483 / 6353 at 0.1, 139 / 6384 at 0.01, 17 / 6350 at 0.001; the hexapod
+/// walk 54, 40 and 38 of 186 (its failed pivots are cancellations to
+/// round-off, `1e-5` against `3e6`, which no threshold accepts).
+pub const PIVOT_THRESHOLD: f64 = 0.01;
+
+/// The threshold of the row choice at compilation
+/// ([`CompiledLu::choose_rows`]): a pivot at least a tenth of its column's
+/// largest entry (UMFPACK's default for threshold partial pivoting), a
+/// margin of ten over the check of later factorisations
+/// ([`PIVOT_THRESHOLD`]).
+pub const ROW_CHOICE_THRESHOLD: f64 = 0.1;
+
+/// A compiled numeric LU of one reduced pattern with a fixed row order.
+#[derive(Default)]
+pub(crate) struct CompiledLu {
+    /// Dimension.
+    m: usize,
+    /// Slot of each value of the reduced CSC structure.
+    scatter: Vec<u32>,
+    /// Slot of pivot `k`.
+    pivot: Vec<u32>,
+    /// `L`'s column `k` below the diagonal: `l_slots[l_ptr[k]..l_ptr[k+1]]`.
+    l_ptr: Vec<u32>,
+    l_slots: Vec<u32>,
+    /// `U`'s row `k` right of the diagonal: `u_slots[u_ptr[k]..u_ptr[k+1]]`.
+    u_ptr: Vec<u32>,
+    u_slots: Vec<u32>,
+    /// The targets of the rank-one updates, pivot after pivot, `L`'s rows
+    /// outer, `U`'s columns inner.
+    updates: Vec<u32>,
+    /// Number of slots.
+    slots: usize,
+    /// The value array.
+    a: Vec<f64>,
+    /// The pivot row order: reduced row of pivot position `i`.
+    pub(crate) row_perm: Vec<usize>,
+    /// The forward sweep's stream `(row, column, slot)`, `L`'s columns in
+    /// order.
+    pub(crate) lower: Vec<(u32, u32, u32)>,
+    /// The backward sweep's stream `(row, column, slot)`, `U`'s columns
+    /// last first, entries above the diagonal.
+    pub(crate) upper: Vec<(u32, u32, u32)>,
+    /// Scratch of [`Self::compile`], kept so that a compilation of the
+    /// same dimension does not allocate.
+    scratch: Scratch,
+}
+
+/// Scratch of [`CompiledLu::compile`].
+#[derive(Default)]
+struct Scratch {
+    row_pos: Vec<usize>,
+    col_pos: Vec<usize>,
+    nz: Vec<bool>,
+    slot: Vec<u32>,
+    rows: Vec<usize>,
+    cols: Vec<usize>,
+    /// [`CompiledLu::choose_rows`]: the dense elimination, the rows
+    /// taken, the order.
+    dense: Vec<f64>,
+    used: Vec<bool>,
+    order: Vec<usize>,
+}
+
+/// A pivot failed its check: factor with faer instead.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct PivotFailed;
+
+impl CompiledLu {
+    /// Compiles the LU of the `m × m` reduced structure (`col_ptr`,
+    /// `row_idx`, CSC) with column order `fwd` (ordered position →
+    /// column) and row order `row_perm` (pivot position → row), reusing
+    /// this value's storage. The first compilation allocates, with room
+    /// for programs of twice its size; a later one (a fallback's new row
+    /// order) only when `grow`, else it returns `false` and leaves the
+    /// program as it was when the new one does not fit.
+    pub(crate) fn compile(
+        &mut self,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        row_perm: &[usize],
+        grow: bool,
+    ) -> bool {
+        let m = fwd.len();
+        assert!(u32::try_from(m * m).is_ok(), "dimension {m} beyond u32");
+        let first = !self.is_compiled() || self.m != m;
+        let sc = &mut self.scratch;
+        sc.row_pos.resize(m, 0);
+        sc.col_pos.resize(m, 0);
+        sc.nz.clear();
+        sc.nz.resize(m * m, false);
+        sc.slot.resize(m * m, u32::MAX);
+        sc.rows.reserve(m);
+        sc.cols.reserve(m);
+        for (i, &r) in row_perm.iter().enumerate() {
+            sc.row_pos[r] = i;
+        }
+        for (c, &j) in fwd.iter().enumerate() {
+            sc.col_pos[j] = c;
+        }
+        // Symbolic elimination on a dense boolean matrix of P·A·Q, and the
+        // program's sizes.
+        let nz = &mut sc.nz;
+        for j in 0..m {
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                nz[sc.row_pos[r] * m + sc.col_pos[j]] = true;
+            }
+        }
+        let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
+        for k in 0..m {
+            sc.rows.clear();
+            sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
+            sc.cols.clear();
+            sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
+            for &i in &sc.rows {
+                for &j in &sc.cols {
+                    nz[i * m + j] = true;
+                }
+            }
+            n_l += sc.rows.len();
+            n_u += sc.cols.len();
+            n_upd += sc.rows.len() * sc.cols.len();
+        }
+        let n_slots = nz.iter().filter(|&&z| z).count();
+        if first {
+            // Room for a later row order's program of up to twice the size.
+            let dense = m * m;
+            self.a.reserve(2 * n_slots.min(dense));
+            self.l_slots.reserve(2 * n_l.min(dense));
+            self.lower.reserve(2 * n_l.min(dense));
+            self.u_slots.reserve(2 * n_u.min(dense));
+            self.upper.reserve(2 * n_u.min(dense));
+            self.updates.reserve(2 * n_upd.min(dense * m));
+            self.scatter.reserve(row_idx.len());
+            self.pivot.reserve(m);
+            self.l_ptr.reserve(m + 1);
+            self.u_ptr.reserve(m + 1);
+            self.row_perm.reserve(m);
+        } else if !grow
+            && (n_slots > self.a.capacity()
+                || n_l > self.l_slots.capacity().min(self.lower.capacity())
+                || n_u > self.u_slots.capacity().min(self.upper.capacity())
+                || n_upd > self.updates.capacity())
+        {
+            return false;
+        }
+        self.m = m;
+        // Slots, row-major.
+        let slot = &mut sc.slot;
+        let mut slots = 0u32;
+        for (s, &z) in slot.iter_mut().zip(nz.iter()) {
+            *s = if z {
+                slots += 1;
+                slots - 1
+            } else {
+                u32::MAX
+            };
+        }
+        self.slots = slots as usize;
+        self.scatter.clear();
+        for j in 0..m {
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                self.scatter.push(slot[sc.row_pos[r] * m + sc.col_pos[j]]);
+            }
+        }
+        self.pivot.clear();
+        self.l_ptr.clear();
+        self.l_slots.clear();
+        self.u_ptr.clear();
+        self.u_slots.clear();
+        self.updates.clear();
+        self.l_ptr.push(0);
+        self.u_ptr.push(0);
+        for k in 0..m {
+            // A structurally zero pivot gets no slot: it never verifies,
+            // faer reports the singularity.
+            self.pivot.push(slot[k * m + k]);
+            sc.rows.clear();
+            sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
+            sc.cols.clear();
+            sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
+            self.l_slots
+                .extend(sc.rows.iter().map(|&i| slot[i * m + k]));
+            self.u_slots
+                .extend(sc.cols.iter().map(|&j| slot[k * m + j]));
+            for &i in &sc.rows {
+                self.updates
+                    .extend(sc.cols.iter().map(|&j| slot[i * m + j]));
+            }
+            self.l_ptr.push(self.l_slots.len() as u32);
+            self.u_ptr.push(self.u_slots.len() as u32);
+        }
+        self.lower.clear();
+        for k in 0..m {
+            for i in k + 1..m {
+                if nz[i * m + k] {
+                    self.lower.push((i as u32, k as u32, slot[i * m + k]));
+                }
+            }
+        }
+        self.upper.clear();
+        for j in (0..m).rev() {
+            for i in 0..j {
+                if nz[i * m + j] {
+                    self.upper.push((i as u32, j as u32, slot[i * m + j]));
+                }
+            }
+        }
+        self.row_perm.clear();
+        self.row_perm.extend_from_slice(row_perm);
+        self.a.clear();
+        self.a.resize(self.slots, 0.0);
+        true
+    }
+
+    /// A row order for the compiled program chosen on `values` (the
+    /// reduced CSC values) by threshold Markowitz pivoting along the column
+    /// order `fwd`: at each column, among the rows whose entry is at least
+    /// [`ROW_CHOICE_THRESHOLD`] of the column's largest, the one with the
+    /// fewest entries right of the column (the least fill; ties to the
+    /// larger entry). A dense elimination of the first values, once per
+    /// compilation. `None` when a column has no usable entry (faer's order
+    /// is then used). Writes the order into `order`; allocation-free once
+    /// the scratch has this dimension.
+    pub(crate) fn choose_rows(
+        &mut self,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        values: &[f64],
+    ) -> Option<&[usize]> {
+        let m = fwd.len();
+        let sc = &mut self.scratch;
+        sc.dense.clear();
+        sc.dense.resize(m * m, 0.0);
+        sc.nz.clear();
+        sc.nz.resize(m * m, false);
+        sc.used.clear();
+        sc.used.resize(m, false);
+        sc.order.clear();
+        let (d, nz) = (&mut sc.dense, &mut sc.nz);
+        // Rows as given, columns in order: d[r·m + c].
+        for (c, &j) in fwd.iter().enumerate() {
+            for (&r, &v) in row_idx[col_ptr[j]..col_ptr[j + 1]]
+                .iter()
+                .zip(&values[col_ptr[j]..col_ptr[j + 1]])
+            {
+                d[r * m + c] = v;
+                nz[r * m + c] = true;
+            }
+        }
+        for k in 0..m {
+            let mut column = 0.0f64;
+            for r in 0..m {
+                if !sc.used[r] && nz[r * m + k] {
+                    column = column.max(d[r * m + k].abs());
+                }
+            }
+            if !(column > 0.0 && column.is_finite()) {
+                return None;
+            }
+            let mut best: Option<(usize, usize, f64)> = None;
+            for r in 0..m {
+                let v = d[r * m + k].abs();
+                if sc.used[r] || !nz[r * m + k] || v < ROW_CHOICE_THRESHOLD * column {
+                    continue;
+                }
+                let count = (k + 1..m).filter(|&j| nz[r * m + j]).count();
+                if best.is_none_or(|(_, c, b)| count < c || (count == c && v > b)) {
+                    best = Some((r, count, v));
+                }
+            }
+            let (p, _, _) = best?;
+            sc.used[p] = true;
+            sc.order.push(p);
+            let inv = d[p * m + k].recip();
+            for i in 0..m {
+                if sc.used[i] || !nz[i * m + k] {
+                    continue;
+                }
+                let l = d[i * m + k] * inv;
+                for j in k + 1..m {
+                    if nz[p * m + j] {
+                        d[i * m + j] -= l * d[p * m + j];
+                        nz[i * m + j] = true;
+                    }
+                }
+            }
+        }
+        Some(&self.scratch.order)
+    }
+
+    /// Whether a program has been compiled.
+    pub(crate) fn is_compiled(&self) -> bool {
+        self.pivot.len() == self.m && self.l_ptr.len() == self.m + 1
+    }
+
+    /// The numeric LU of `values` (the reduced CSC values): the factors
+    /// into the slots, `1/u_kk` into `pivot_inv`. Allocation-free.
+    ///
+    /// # Errors
+    /// [`PivotFailed`] when a pivot fails its check (see the module docs).
+    pub(crate) fn factor(
+        &mut self,
+        values: &[f64],
+        pivot_inv: &mut [f64],
+    ) -> Result<(), PivotFailed> {
+        let a = &mut self.a[..self.slots];
+        a.fill(0.0);
+        for (&s, &v) in self.scatter.iter().zip(values) {
+            a[s as usize] = v;
+        }
+        let mut t = 0usize;
+        for (k, (&ps, inv_k)) in self.pivot.iter().zip(pivot_inv.iter_mut()).enumerate() {
+            if ps == u32::MAX {
+                return Err(PivotFailed);
+            }
+            let p = a[ps as usize];
+            let ls = &self.l_slots[self.l_ptr[k] as usize..self.l_ptr[k + 1] as usize];
+            let mut column = 0.0f64;
+            for &s in ls {
+                let v = a[s as usize].abs();
+                if v > column {
+                    column = v;
+                }
+            }
+            // Negated so that a NaN pivot fails too.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            let bad = !(p.abs() >= PIVOT_THRESHOLD * column) || p == 0.0;
+            if bad {
+                return Err(PivotFailed);
+            }
+            let inv = p.recip();
+            *inv_k = inv;
+            let us = &self.u_slots[self.u_ptr[k] as usize..self.u_ptr[k + 1] as usize];
+            let w = us.len();
+            for &s in ls {
+                let l = a[s as usize] * inv;
+                a[s as usize] = l;
+                for (&u, &d) in us.iter().zip(&self.updates[t..t + w]) {
+                    a[d as usize] -= l * a[u as usize];
+                }
+                t += w;
+            }
+        }
+        Ok(())
+    }
+
+    /// The value of slot `s` of the last factorisation.
+    #[inline]
+    pub(crate) fn value(&self, s: u32) -> f64 {
+        self.a[s as usize]
+    }
+}

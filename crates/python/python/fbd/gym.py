@@ -33,8 +33,8 @@ episodes, bit for bit. Environments pickle (their simulator with it).
   ``2π·t/GAIT_PERIOD`` (``GAIT_PERIOD = 0.8`` s);
 * reward per control period: forward speed (m/s of the body along −Z, the
   robot's forward direction at yaw 0) − ``EFFORT·Σ τ²`` (N·m, the torques of
-  the period's last step, ``EFFORT = 2e-5``) − ``SLIP·Σ |v_slip|`` over the
-  sliding feet (m/s; the exact slip velocity fbd solves, ``SLIP = 0.5``);
+  the period's last step, ``EFFORT = 5e-6``) − ``SLIP·Σ |v_slip|`` over the
+  sliding feet (m/s; the exact slip velocity fbd solves, ``SLIP = 0.1``);
 * terminated when the body touches the ground (``Ry < 0.12`` m or a hip
   contact point touches) or rolls over (the body's up axis more than 60°
   from vertical), or when a step cannot be solved (``info["error"]``);
@@ -161,8 +161,8 @@ class HexapodWalkEnv(_FbdEnv):
 
     ACTION_SCALE = np.array([0.35, 0.35, 0.35] * 6)
     GAIT_PERIOD = 0.8
-    EFFORT = 2e-5
-    SLIP = 0.5
+    EFFORT = 5e-6
+    SLIP = 0.1
     OBSERVATION_NAMES = (
         ["height", "phi_x", "phi_y", "phi_z", "vx", "vy", "vz", "wx", "wy", "wz"]
         + [f"theta{j}_{leg}" for leg in range(1, 7) for j in (1, 2, 3)]

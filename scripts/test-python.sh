@@ -49,6 +49,7 @@ export MPLBACKEND=Agg
 test -s "$WORK/fig7.png"
 "$VPY" examples/python/pd_loop.py --check
 "$VPY" examples/python/threads.py
+"$VPY" examples/python/hexapod_level.py
 # ARS on the vector environment, CI-sized (the full run: README, "Python").
 "$VPY" examples/python/train_ars.py --iterations 2 --directions 2 --eval-envs 1 \
   --episode-seconds 0.2 --plot "$WORK/ars.png"

@@ -272,9 +272,11 @@ pub struct Simulator {
 /// Coordinate names: `trajectory.csv`'s.
 fn coordinate_names(plant: &Plant) -> Vec<String> {
     match plant {
-        Plant::Planar(_) => ["rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4"]
-            .map(String::from)
-            .to_vec(),
+        Plant::Planar(_) => [
+            "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4",
+        ]
+        .map(String::from)
+        .to_vec(),
         Plant::Hexapod(m) => {
             let mut v: Vec<String> = ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
                 .map(String::from)
@@ -342,8 +344,13 @@ impl Simulator {
             ))
         };
         let v: Vec<f64> = if let Ok(a) = v.cast::<PyArray1<f64>>() {
-            a.readonly().as_slice().map(<[f64]>::to_vec).map_err(|_| bad())?
-        } else if v.is_instance_of::<pyo3::types::PyFloat>() || v.is_instance_of::<pyo3::types::PyInt>() {
+            a.readonly()
+                .as_slice()
+                .map(<[f64]>::to_vec)
+                .map_err(|_| bad())?
+        } else if v.is_instance_of::<pyo3::types::PyFloat>()
+            || v.is_instance_of::<pyo3::types::PyInt>()
+        {
             vec![v.extract::<f64>()?; n]
         } else {
             v.extract::<Vec<f64>>().map_err(|_| bad())?
@@ -359,7 +366,13 @@ impl Simulator {
 
     fn fail_error(&self, py: Python<'_>, e: &SimError) -> PyErr {
         let msg = format!("{e} ({})", self.source);
-        simulation_error(py, &msg, e.step(), e.step().map(|k| k as f64 * self.dt_()), None)
+        simulation_error(
+            py,
+            &msg,
+            e.step(),
+            e.step().map(|k| k as f64 * self.dt_()),
+            None,
+        )
     }
 
     /// Runs `steps` steps of `action` on `sim` (no GIL needed); the steps
@@ -397,7 +410,13 @@ impl Simulator {
 
     /// After `done` steps of `action` and maybe an error: the log, the
     /// readouts, the failure.
-    fn finish(&mut self, py: Python<'_>, action: &Logged, done: usize, error: Option<SimError>) -> PyResult<()> {
+    fn finish(
+        &mut self,
+        py: Python<'_>,
+        action: &Logged,
+        done: usize,
+        error: Option<SimError>,
+    ) -> PyResult<()> {
         log_push(&mut self.log, action, done);
         self.refresh();
         match error {
@@ -412,8 +431,17 @@ impl Simulator {
 
     fn check_failed(&self, py: Python<'_>) -> PyResult<()> {
         if let Some(e) = &self.failed {
-            let msg = format!("{e} ({}; call reset() or set_state() to go on)", self.source);
-            return Err(simulation_error(py, &msg, e.step(), e.step().map(|k| k as f64 * self.dt_()), None));
+            let msg = format!(
+                "{e} ({}; call reset() or set_state() to go on)",
+                self.source
+            );
+            return Err(simulation_error(
+                py,
+                &msg,
+                e.step(),
+                e.step().map(|k| k as f64 * self.dt_()),
+                None,
+            ));
         }
         Ok(())
     }
@@ -431,7 +459,10 @@ trait JointNames {
 
 impl<M: fbd_sim::Plant> JointNames for M {
     fn joint_indices_names(&self, coordinates: &[String]) -> Vec<String> {
-        self.joint_indices().iter().map(|&i| coordinates[i].clone()).collect()
+        self.joint_indices()
+            .iter()
+            .map(|&i| coordinates[i].clone())
+            .collect()
     }
 }
 
@@ -497,7 +528,12 @@ impl Simulator {
     /// given, else with the PD targets of `set_pd_targets`, else with the
     /// configured controller.
     #[pyo3(signature = (torques=None, steps=1))]
-    fn step(&mut self, py: Python<'_>, torques: Option<&Bound<'_, PyAny>>, steps: usize) -> PyResult<()> {
+    fn step(
+        &mut self,
+        py: Python<'_>,
+        torques: Option<&Bound<'_, PyAny>>,
+        steps: usize,
+    ) -> PyResult<()> {
         let torques = match torques {
             Some(t) if !t.is_none() => Some(self.vector(t, "torques")?),
             _ => None,
@@ -557,11 +593,15 @@ impl Simulator {
         if let Some(l) = torque_limit
             && !(l.is_finite() && l > 0.0)
         {
-            return Err(PyValueError::new_err(format!("torque_limit: must be positive and finite, got {l}")));
+            return Err(PyValueError::new_err(format!(
+                "torque_limit: must be positive and finite, got {l}"
+            )));
         }
         for (name, v) in [("kp", &kp), ("kd", &kd)] {
             if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
-                return Err(PyValueError::new_err(format!("{name}: must be finite and ≥ 0")));
+                return Err(PyValueError::new_err(format!(
+                    "{name}: must be finite and ≥ 0"
+                )));
             }
         }
         if position.iter().chain(&velocity).any(|x| !x.is_finite()) {
@@ -629,7 +669,9 @@ impl Simulator {
         match &s.saved {
             Some(saved) => {
                 if !self.sim.set_state(saved) {
-                    return Err(PyValueError::new_err("set_state: a state of the other model"));
+                    return Err(PyValueError::new_err(
+                        "set_state: a state of the other model",
+                    ));
                 }
             }
             None => {
@@ -688,15 +730,32 @@ impl Simulator {
         let py = slf.py();
         let s = slf.borrow();
         let f = py.import("fbd._fbd")?.getattr("_simulator_from_state")?;
-        let pd = s.pd.as_ref().map(|p| PyBytes::new(py, &log_bytes(&[LogEntry { action: Logged::Pd(p.clone()), steps: 1 }])));
-        let args = (s.config.clone(), s.source.clone(), Bound::new(py, s.get_state())?, pd);
+        let pd = s.pd.as_ref().map(|p| {
+            PyBytes::new(
+                py,
+                &log_bytes(&[LogEntry {
+                    action: Logged::Pd(p.clone()),
+                    steps: 1,
+                }]),
+            )
+        });
+        let args = (
+            s.config.clone(),
+            s.source.clone(),
+            Bound::new(py, s.get_state())?,
+            pd,
+        );
         (f, args).into_pyobject(py).map(|t| t.into_any())
     }
 
     /// `"planar"` or `"hexapod"`.
     #[getter]
     fn model(&self) -> &'static str {
-        if self.is_planar() { "planar" } else { "hexapod" }
+        if self.is_planar() {
+            "planar"
+        } else {
+            "hexapod"
+        }
     }
 
     /// Time of the current state `q` (s): `k·Δt`.
@@ -775,7 +834,12 @@ impl Simulator {
     /// first step.
     #[getter]
     fn contact_states<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u8>> {
-        let codes: Vec<u8> = self.readout.contacts.iter().map(|c| state_code(c.state)).collect();
+        let codes: Vec<u8> = self
+            .readout
+            .contacts
+            .iter()
+            .map(|c| state_code(c.state))
+            .collect();
         PyArray1::from_vec(py, codes)
     }
 
@@ -829,7 +893,11 @@ impl Simulator {
         }
         let legs = &self.readout.legs;
         let a = Array3::from_shape_fn((legs.len(), 2, 3), |(l, h, i)| {
-            if h == 0 { legs[l].hip_force[i] } else { legs[l].knee_force[i] }
+            if h == 0 {
+                legs[l].hip_force[i]
+            } else {
+                legs[l].knee_force[i]
+            }
         });
         PyArray3::from_owned_array(py, a).into_any()
     }
@@ -858,30 +926,78 @@ impl Simulator {
         d.set_item("q", PyArray1::from_slice(py, &r.q))?;
         d.set_item("qdot", PyArray1::from_slice(py, &r.qdot))?;
         let b = &r.bodies;
-        d.set_item("body_position", self.arr3(py, &b.iter().map(|b| b.position).collect::<Vec<_>>()))?;
+        d.set_item(
+            "body_position",
+            self.arr3(py, &b.iter().map(|b| b.position).collect::<Vec<_>>()),
+        )?;
         let rot = Array3::from_shape_fn((b.len(), 3, 3), |(i, j, k)| b[i].rotation[j][k]);
         d.set_item("body_rotation", PyArray3::from_owned_array(py, rot))?;
-        d.set_item("body_velocity", self.arr3(py, &b.iter().map(|b| b.velocity).collect::<Vec<_>>()))?;
+        d.set_item(
+            "body_velocity",
+            self.arr3(py, &b.iter().map(|b| b.velocity).collect::<Vec<_>>()),
+        )?;
         d.set_item(
             "body_angular_velocity",
-            self.arr3(py, &b.iter().map(|b| b.angular_velocity).collect::<Vec<_>>()),
+            self.arr3(
+                py,
+                &b.iter().map(|b| b.angular_velocity).collect::<Vec<_>>(),
+            ),
         )?;
         let j = &r.joints;
-        d.set_item("joint_angle", PyArray1::from_vec(py, j.iter().map(|j| j.angle).collect()))?;
-        d.set_item("joint_rate", PyArray1::from_vec(py, j.iter().map(|j| j.rate).collect()))?;
-        d.set_item("joint_torque", PyArray1::from_vec(py, j.iter().map(|j| j.torque).collect()))?;
+        d.set_item(
+            "joint_angle",
+            PyArray1::from_vec(py, j.iter().map(|j| j.angle).collect()),
+        )?;
+        d.set_item(
+            "joint_rate",
+            PyArray1::from_vec(py, j.iter().map(|j| j.rate).collect()),
+        )?;
+        d.set_item(
+            "joint_torque",
+            PyArray1::from_vec(py, j.iter().map(|j| j.torque).collect()),
+        )?;
         let l = &r.legs;
-        d.set_item("leg", PyArray1::from_vec(py, l.iter().map(|l| l.leg as i64).collect()))?;
-        d.set_item("hip_force", self.arr3(py, &l.iter().map(|l| l.hip_force).collect::<Vec<_>>()))?;
-        d.set_item("hip_moment", self.arr3(py, &l.iter().map(|l| l.hip_moment).collect::<Vec<_>>()))?;
-        d.set_item("knee_force", self.arr3(py, &l.iter().map(|l| l.knee_force).collect::<Vec<_>>()))?;
-        d.set_item("knee_moment", self.arr3(py, &l.iter().map(|l| l.knee_moment).collect::<Vec<_>>()))?;
+        d.set_item(
+            "leg",
+            PyArray1::from_vec(py, l.iter().map(|l| l.leg as i64).collect()),
+        )?;
+        d.set_item(
+            "hip_force",
+            self.arr3(py, &l.iter().map(|l| l.hip_force).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "hip_moment",
+            self.arr3(py, &l.iter().map(|l| l.hip_moment).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "knee_force",
+            self.arr3(py, &l.iter().map(|l| l.knee_force).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "knee_moment",
+            self.arr3(py, &l.iter().map(|l| l.knee_moment).collect::<Vec<_>>()),
+        )?;
         let c = &r.contacts;
-        d.set_item("contact_position", self.arr3(py, &c.iter().map(|c| c.position).collect::<Vec<_>>()))?;
-        d.set_item("contact_state", PyArray1::from_vec(py, c.iter().map(|c| state_code(c.state)).collect()))?;
-        d.set_item("contact_force", self.arr3(py, &c.iter().map(|c| c.force).collect::<Vec<_>>()))?;
-        d.set_item("contact_normal_force", PyArray1::from_vec(py, c.iter().map(|c| c.normal_force).collect()))?;
-        d.set_item("contact_normal", self.arr3(py, &c.iter().map(|c| c.normal).collect::<Vec<_>>()))?;
+        d.set_item(
+            "contact_position",
+            self.arr3(py, &c.iter().map(|c| c.position).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "contact_state",
+            PyArray1::from_vec(py, c.iter().map(|c| state_code(c.state)).collect()),
+        )?;
+        d.set_item(
+            "contact_force",
+            self.arr3(py, &c.iter().map(|c| c.force).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "contact_normal_force",
+            PyArray1::from_vec(py, c.iter().map(|c| c.normal_force).collect()),
+        )?;
+        d.set_item(
+            "contact_normal",
+            self.arr3(py, &c.iter().map(|c| c.normal).collect::<Vec<_>>()),
+        )?;
         d.set_item(
             "contact_slip_velocity",
             self.arr3(py, &c.iter().map(|c| c.slip_velocity).collect::<Vec<_>>()),
@@ -935,13 +1051,15 @@ pub fn _simulator_from_state(
     sim.source = source;
     sim.set_state(py, state)?;
     if let Some(b) = pd
-        && let Some(LogEntry { action: Logged::Pd(p), .. }) = log_from_bytes(b).and_then(|l| l.into_iter().next())
+        && let Some(LogEntry {
+            action: Logged::Pd(p),
+            ..
+        }) = log_from_bytes(b).and_then(|l| l.into_iter().next())
     {
         sim.pd = Some(p);
     }
     Ok(sim)
 }
-
 
 /// `step_many(sims, torques=None, steps=1)`: steps every simulator of the
 /// list `steps` steps on Rust threads (rayon; the GIL released): with row

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The Python package's tests, in a fresh virtual environment: installs
-# maturin, NumPy, pytest, pandas (Result.to_pandas) and matplotlib (the
-# Fig. 7 example) from PyPI, installs the package with the README's command
+# maturin, NumPy, pytest, pandas (Result.to_pandas), matplotlib (the
+# Fig. 7 example), gymnasium (fbd.gym) and dask[distributed] (the Dask
+# LocalCluster example) from PyPI, installs the package with the README's command
 # (`pip install ./crates/python`, which builds the abi3 wheel with maturin),
 # lints the binding's Rust code, runs the pytest suite against the `fbd`
 # binary built from the same tree, and runs the examples, writing the Fig. 7
@@ -24,7 +25,8 @@ echo "== python: fresh virtual environment ($("$PYTHON" --version))"
 "$PYTHON" -m venv "$WORK/venv"
 VPY="$WORK/venv/bin/python"
 "$VPY" -m pip install --quiet --disable-pip-version-check --upgrade pip
-"$VPY" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas matplotlib
+"$VPY" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas matplotlib \
+  gymnasium "dask[distributed]"
 
 echo "== python: pip install ./crates/python"
 "$VPY" -m pip install --quiet --disable-pip-version-check ./crates/python
@@ -47,4 +49,9 @@ export MPLBACKEND=Agg
 test -s "$WORK/fig7.png"
 "$VPY" examples/python/pd_loop.py --check
 "$VPY" examples/python/threads.py
+"$VPY" examples/python/hexapod_level.py
+# ARS on the vector environment, CI-sized (the full run: README, "Python").
+"$VPY" examples/python/train_ars.py --iterations 2 --directions 2 --eval-envs 1 \
+  --episode-seconds 0.2 --plot "$WORK/ars.png"
+test -s "$WORK/ars.png"
 echo "== python: all passed"

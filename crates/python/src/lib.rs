@@ -34,6 +34,10 @@ fn _fbd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(kinematics::leg_ik, m)?)?;
     m.add_function(wrap_pyfunction!(config::config_toml, m)?)?;
     m.add_class::<simulator::Simulator>()?;
+    m.add_class::<simulator::SimulatorState>()?;
+    m.add_function(wrap_pyfunction!(simulator::step_many, m)?)?;
+    m.add_function(wrap_pyfunction!(simulator::_state_from_log, m)?)?;
+    m.add_function(wrap_pyfunction!(simulator::_simulator_from_state, m)?)?;
     m.add(
         "TRAJECTORY_SPEC_COLUMNS",
         fbd_cli::output::SPEC_COLUMNS.to_vec(),

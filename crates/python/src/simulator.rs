@@ -1,12 +1,19 @@
-//! `Simulator(config)`: the planar model stepped from Python, one Δt at a
-//! time, with the configured controller or the caller's joint torques.
+//! `Simulator(config)`: the planar model or the 24-DOF hexapod stepped
+//! from Python, one Δt at a time, with the configured controller, the
+//! caller's joint torques, or PD targets tracked inside Rust
+//! ([`fbd_sim::simulator`]); its state saved, restored, copied and
+//! pickled; many simulators stepped at once on Rust threads
+//! ([`step_many`]).
 
-use fbd_sim::{Data, Model, SimError, StepRecord};
-use numpy::ndarray::Array2;
-use numpy::{PyArray1, PyArray2, PyArrayMethods};
-use pyo3::exceptions::PyValueError;
+use fbd_sim::simulator::{Action, PdTargets, Readout, SimState, Simulator as Core};
+use fbd_sim::spatial::SpatialModel;
+use fbd_sim::{Model, SimError};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray2};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyBytes, PyDict, PyList, PyString};
+use rayon::prelude::*;
 
 use crate::errors::{config_error, guard, simulation_error};
 
@@ -14,68 +21,475 @@ use crate::errors::{config_error, guard, simulation_error};
 const EXTERNAL_TORQUE_HINT: &str = "; the torques given to step() are applied explicitly: \
      a feedback law with gains kp, kd is stable only while kp·Δt²/I + 2·kd·Δt/I < 4 \
      (I: the effective joint inertia, about 1e-2 kg·m² for the default legs), so lower \
-     the gains or time.dt";
+     the gains or time.dt, or track targets inside the step with set_pd_targets()";
 
-/// The planar model stepped one Δt at a time, for controllers written in
-/// Python. `config` is a configuration as for `fbd.run` (None, a path, TOML
-/// text or a dict).
-///
-/// `step(torques=None, steps=1)` solves steps with the given joint torques
-/// (N·m: hip3, knee3, hip4, knee4, applied as given) or the configured
-/// controller; `q`, `qdot` (the backward difference the built-in PD uses),
-/// `t`, `k` are the current state; `contact_states`, `contact_forces`,
-/// `joint_forces`, `joint_torques` those of the step solved last; `events`,
-/// `reset()`. The GIL is released while stepping.
-///
-/// The configured duration only sets `steps` (what `fbd.run` solves):
-/// `step()` goes on past it, `t` growing, until the caller stops; the
-/// property `past_duration` says whether `k` has reached `steps - 1`.
+/// The stepped model, planar or spatial.
+#[derive(Clone)]
+enum Plant {
+    Planar(Box<Model>),
+    Hexapod(Box<SpatialModel>),
+}
+
+/// A simulator of either model.
+enum Sim {
+    Planar(Core<Model>),
+    Hexapod(Core<SpatialModel>),
+}
+
+/// A saved state of either model.
+#[derive(Clone)]
+enum Saved {
+    Planar(SimState<Model>),
+    Hexapod(SimState<SpatialModel>),
+}
+
+impl Sim {
+    fn new(plant: &Plant) -> Self {
+        match plant {
+            Plant::Planar(m) => Sim::Planar(Core::new((**m).clone())),
+            Plant::Hexapod(m) => Sim::Hexapod(Core::new((**m).clone())),
+        }
+    }
+    fn step(&mut self, action: &Action<'_>) -> Result<(), SimError> {
+        match self {
+            Sim::Planar(s) => s.step(action),
+            Sim::Hexapod(s) => s.step(action),
+        }
+    }
+    fn readout(&self, out: &mut Readout) {
+        match self {
+            Sim::Planar(s) => s.readout_into(out),
+            Sim::Hexapod(s) => s.readout_into(out),
+        }
+    }
+    fn k(&self) -> usize {
+        match self {
+            Sim::Planar(s) => s.k(),
+            Sim::Hexapod(s) => s.k(),
+        }
+    }
+    fn q(&self) -> &[f64] {
+        match self {
+            Sim::Planar(s) => s.q(),
+            Sim::Hexapod(s) => s.q(),
+        }
+    }
+    fn qdot(&self) -> Vec<f64> {
+        let mut v = vec![0.0; self.q().len()];
+        match self {
+            Sim::Planar(s) => s.qdot(&mut v),
+            Sim::Hexapod(s) => s.qdot(&mut v),
+        }
+        v
+    }
+    fn joints(&self) -> usize {
+        match self {
+            Sim::Planar(s) => s.joints(),
+            Sim::Hexapod(s) => s.joints(),
+        }
+    }
+    fn state(&self) -> Saved {
+        match self {
+            Sim::Planar(s) => Saved::Planar(s.state()),
+            Sim::Hexapod(s) => Saved::Hexapod(s.state()),
+        }
+    }
+    fn set_state(&mut self, saved: &Saved) -> bool {
+        match (self, saved) {
+            (Sim::Planar(s), Saved::Planar(v)) => s.set_state(v),
+            (Sim::Hexapod(s), Saved::Hexapod(v)) => s.set_state(v),
+            _ => return false,
+        }
+        true
+    }
+    fn copy(&self, plant: &Plant) -> Self {
+        let mut s = Sim::new(plant);
+        s.set_state(&self.state());
+        s
+    }
+}
+
+/// One entry of the log of what a simulator was stepped with since its
+/// initial state: a pickled state is the configuration and this log,
+/// replayed when it is restored (stepping is deterministic: the replay is
+/// the run, bit for bit).
+#[derive(Clone, Debug, PartialEq)]
+enum Logged {
+    Controller,
+    Torques(Vec<f64>),
+    Pd(PdTargets),
+}
+
+/// The action of one call and how many steps it was held.
+#[derive(Clone, Debug, PartialEq)]
+struct LogEntry {
+    action: Logged,
+    steps: usize,
+}
+
+/// Appends `steps` steps of `action` to `log` (merged with the last entry
+/// when the same).
+fn log_push(log: &mut Vec<LogEntry>, action: &Logged, steps: usize) {
+    if steps == 0 {
+        return;
+    }
+    match log.last_mut() {
+        Some(last) if last.action == *action => last.steps += steps,
+        _ => log.push(LogEntry {
+            action: action.clone(),
+            steps,
+        }),
+    }
+}
+
+/// The log as little-endian f64s: per entry `kind, steps, n` then the
+/// values (torques; or kp, kd, targets, rates and the limit, NaN for none).
+fn log_bytes(log: &[LogEntry]) -> Vec<u8> {
+    let mut v: Vec<f64> = Vec::new();
+    for e in log {
+        match &e.action {
+            Logged::Controller => v.extend([0.0, e.steps as f64, 0.0]),
+            Logged::Torques(t) => {
+                v.extend([1.0, e.steps as f64, t.len() as f64]);
+                v.extend(t);
+            }
+            Logged::Pd(p) => {
+                v.extend([2.0, e.steps as f64, p.kp.len() as f64]);
+                for x in [&p.kp, &p.kd, &p.position, &p.velocity] {
+                    v.extend(x);
+                }
+                v.push(p.torque_limit.unwrap_or(f64::NAN));
+            }
+        }
+    }
+    v.iter().flat_map(|x| x.to_le_bytes()).collect()
+}
+
+/// The inverse of [`log_bytes`].
+fn log_from_bytes(b: &[u8]) -> Option<Vec<LogEntry>> {
+    if !b.len().is_multiple_of(8) {
+        return None;
+    }
+    let v: Vec<f64> = b
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+        .collect();
+    let mut log = Vec::new();
+    let mut i = 0;
+    while i < v.len() {
+        let (kind, steps, n) = (v[i], *v.get(i + 1)? as usize, *v.get(i + 2)? as usize);
+        i += 3;
+        let mut take = |m: usize| -> Option<Vec<f64>> {
+            let s = v.get(i..i + m)?.to_vec();
+            i += m;
+            Some(s)
+        };
+        let action = match kind as u8 {
+            0 => Logged::Controller,
+            1 => Logged::Torques(take(n)?),
+            2 => {
+                let (kp, kd, position, velocity) = (take(n)?, take(n)?, take(n)?, take(n)?);
+                let l = take(1)?[0];
+                Logged::Pd(PdTargets {
+                    kp,
+                    kd,
+                    torque_limit: (!l.is_nan()).then_some(l),
+                    position,
+                    velocity,
+                })
+            }
+            _ => return None,
+        };
+        log.push(LogEntry { action, steps });
+    }
+    Some(log)
+}
+
+/// A saved state of a `Simulator` (`Simulator.get_state()`): restored with
+/// `Simulator.set_state(state)`, bit for bit. Picklable: the pickle holds
+/// the configuration and the actions applied since the initial state,
+/// which `set_state` replays in Rust (the GIL released) when the state
+/// comes from a pickle.
+#[pyclass(module = "fbd._fbd", name = "SimulatorState", frozen)]
+pub struct SimulatorState {
+    /// The complete configuration (TOML).
+    config: String,
+    /// Steps solved at this state.
+    k: usize,
+    /// The in-memory state (`None` after unpickling).
+    saved: Option<Saved>,
+    log: Vec<LogEntry>,
+}
+
+#[pymethods]
+impl SimulatorState {
+    /// Steps solved at this state.
+    #[getter]
+    fn k(&self) -> usize {
+        self.k
+    }
+
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let s = slf.get();
+        let f = py.import("fbd._fbd")?.getattr("_state_from_log")?;
+        let args = (s.config.clone(), s.k, PyBytes::new(py, &log_bytes(&s.log)));
+        (f, args).into_pyobject(py).map(|t| t.into_any())
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<fbd.SimulatorState k={}>", self.k)
+    }
+}
+
+/// Rebuilds a pickled [`SimulatorState`].
+#[pyfunction]
+pub fn _state_from_log(config: String, k: usize, log: &[u8]) -> PyResult<SimulatorState> {
+    let log = log_from_bytes(log).ok_or_else(|| PyValueError::new_err("corrupt SimulatorState"))?;
+    Ok(SimulatorState {
+        config,
+        k,
+        saved: None,
+        log,
+    })
+}
+
+/// The planar model or the 24-DOF hexapod stepped one Δt at a time, for
+/// controllers written in Python. `config` is a configuration as for
+/// `fbd.run` (None, a path, TOML text or a dict). See the reference
+/// (docs/reference.md, "fbd.Simulator") for every attribute.
 #[pyclass(module = "fbd._fbd")]
 pub struct Simulator {
-    model: Model,
-    data: Data,
+    plant: Plant,
+    sim: Sim,
     source: String,
+    /// The complete configuration (TOML), for pickles.
+    config: String,
     contacts: Vec<String>,
-    /// The record of the step solved last (a copy: a failed step's retries
-    /// overwrite `data.record`), `None` before the first or after `reset()`.
-    last: Option<StepRecord>,
+    coordinates: Vec<String>,
+    joint_names: Vec<String>,
+    pd: Option<PdTargets>,
+    log: Vec<LogEntry>,
+    readout: Readout,
     /// The error that stopped the simulation (steps refuse until reset).
     failed: Option<SimError>,
 }
 
+/// Coordinate names: `trajectory.csv`'s.
+fn coordinate_names(plant: &Plant) -> Vec<String> {
+    match plant {
+        Plant::Planar(_) => [
+            "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4",
+        ]
+        .map(String::from)
+        .to_vec(),
+        Plant::Hexapod(m) => {
+            let mut v: Vec<String> = ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
+                .map(String::from)
+                .to_vec();
+            for leg in &m.mech.legs {
+                for j in 1..=3 {
+                    v.push(format!("theta{j}_{leg}"));
+                }
+            }
+            v
+        }
+    }
+}
+
 impl Simulator {
-    /// The record of the step solved last.
-    fn last(&self) -> Option<&StepRecord> {
-        self.last.as_ref()
+    fn build(plant: Plant, source: String, config: String) -> Self {
+        let sim = Sim::new(&plant);
+        let contacts = match &plant {
+            Plant::Planar(m) => m.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+            Plant::Hexapod(m) => m.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+        };
+        let coordinates = coordinate_names(&plant);
+        let joint_names = match &sim {
+            Sim::Planar(s) => s.model().joint_indices_names(&coordinates),
+            Sim::Hexapod(s) => s.model().joint_indices_names(&coordinates),
+        };
+        let mut s = Self {
+            plant,
+            sim,
+            source,
+            config,
+            contacts,
+            coordinates,
+            joint_names,
+            pd: None,
+            log: Vec::new(),
+            readout: Readout::default(),
+            failed: None,
+        };
+        s.refresh();
+        s
     }
 
-    fn torques_from(&self, torques: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-        let n = self.data.fbd.torque.len();
-        let mut tau = vec![0.0; n];
-        let fill = |tau: &mut [f64], v: &[f64]| -> PyResult<()> {
-            if v.len() != n {
-                return Err(PyValueError::new_err(format!(
-                    "torques: expected {n} joint torques (hip3, knee3, hip4, knee4), got {}",
-                    v.len()
-                )));
-            }
-            tau.copy_from_slice(v);
-            Ok(())
+    fn refresh(&mut self) {
+        self.sim.readout(&mut self.readout);
+    }
+
+    fn is_planar(&self) -> bool {
+        matches!(self.plant, Plant::Planar(_))
+    }
+
+    fn dt_(&self) -> f64 {
+        match &self.plant {
+            Plant::Planar(m) => m.dt(),
+            Plant::Hexapod(m) => m.dt(),
+        }
+    }
+
+    fn vector(&self, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+        let n = self.sim.joints();
+        let names = self.joint_names.join(", ");
+        let bad = || {
+            PyValueError::new_err(format!(
+                "{what}: expected {n} numbers, one per joint ({names})"
+            ))
         };
-        if let Ok(a) = torques.cast::<PyArray1<f64>>() {
-            let ro = a.readonly();
-            if let Ok(s) = ro.as_slice() {
-                fill(&mut tau, s)?;
-                return Ok(tau);
+        let v: Vec<f64> = if let Ok(a) = v.cast::<PyArray1<f64>>() {
+            a.readonly()
+                .as_slice()
+                .map(<[f64]>::to_vec)
+                .map_err(|_| bad())?
+        } else if v.is_instance_of::<pyo3::types::PyFloat>()
+            || v.is_instance_of::<pyo3::types::PyInt>()
+        {
+            vec![v.extract::<f64>()?; n]
+        } else {
+            v.extract::<Vec<f64>>().map_err(|_| bad())?
+        };
+        if v.len() != n {
+            return Err(PyValueError::new_err(format!(
+                "{what}: expected {n} numbers, one per joint ({names}), got {}",
+                v.len()
+            )));
+        }
+        Ok(v)
+    }
+
+    fn fail_error(&self, py: Python<'_>, e: &SimError, torques_given: bool) -> PyErr {
+        let hint = if torques_given && matches!(e, SimError::Newton { .. }) {
+            EXTERNAL_TORQUE_HINT
+        } else {
+            ""
+        };
+        let msg = format!("{e} ({}){hint}", self.source);
+        simulation_error(
+            py,
+            &msg,
+            e.step(),
+            e.step().map(|k| k as f64 * self.dt_()),
+            None,
+        )
+    }
+
+    /// Runs `steps` steps of `action` on `sim` (no GIL needed); the steps
+    /// done and the error that stopped them.
+    fn advance(sim: &mut Sim, action: &Action<'_>, steps: usize) -> (usize, Option<SimError>) {
+        for i in 0..steps {
+            match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| sim.step(action))) {
+                Ok(Ok(())) => {}
+                Ok(Err(e)) => return (i, Some(e)),
+                Err(_) => {
+                    let k = sim.k();
+                    return (
+                        i,
+                        Some(SimError::NonFinite {
+                            step: k,
+                            t: f64::NAN,
+                            residual: f64::NAN,
+                        }),
+                    );
+                }
             }
         }
-        let v: Vec<f64> = torques.extract().map_err(|_| {
-            PyValueError::new_err(
-                "torques: expected a sequence of 4 numbers (hip3, knee3, hip4, knee4) or None",
-            )
-        })?;
-        fill(&mut tau, &v)?;
-        Ok(tau)
+        (steps, None)
+    }
+
+    /// The action of a call: torques, else the PD targets, else the
+    /// configured controller.
+    fn action_of(&self, torques: Option<Vec<f64>>) -> Logged {
+        match (torques, &self.pd) {
+            (Some(t), _) => Logged::Torques(t),
+            (None, Some(p)) => Logged::Pd(p.clone()),
+            (None, None) => Logged::Controller,
+        }
+    }
+
+    /// After `done` steps of `action` and maybe an error: the log, the
+    /// readouts, the failure.
+    fn finish(
+        &mut self,
+        py: Python<'_>,
+        action: &Logged,
+        done: usize,
+        error: Option<SimError>,
+    ) -> PyResult<()> {
+        log_push(&mut self.log, action, done);
+        self.refresh();
+        match error {
+            None => Ok(()),
+            Some(e) => {
+                let err = self.fail_error(py, &e, matches!(action, Logged::Torques(_)));
+                self.failed = Some(e);
+                Err(err)
+            }
+        }
+    }
+
+    fn check_failed(&self, py: Python<'_>) -> PyResult<()> {
+        if let Some(e) = &self.failed {
+            let msg = format!(
+                "{e} ({}; call reset() or set_state() to go on)",
+                self.source
+            );
+            return Err(simulation_error(
+                py,
+                &msg,
+                e.step(),
+                e.step().map(|k| k as f64 * self.dt_()),
+                None,
+            ));
+        }
+        Ok(())
+    }
+
+    fn arr3<'py>(&self, py: Python<'py>, rows: &[[f64; 3]]) -> Bound<'py, PyArray2<f64>> {
+        let a = Array2::from_shape_fn((rows.len(), 3), |(i, j)| rows[i][j]);
+        PyArray2::from_owned_array(py, a)
+    }
+}
+
+/// Joint names from the coordinate names.
+trait JointNames {
+    fn joint_indices_names(&self, coordinates: &[String]) -> Vec<String>;
+}
+
+impl<M: fbd_sim::Plant> JointNames for M {
+    fn joint_indices_names(&self, coordinates: &[String]) -> Vec<String> {
+        self.joint_indices()
+            .iter()
+            .map(|&i| coordinates[i].clone())
+            .collect()
+    }
+}
+
+fn action_ref(a: &Logged) -> Action<'_> {
+    match a {
+        Logged::Controller => Action::Controller,
+        Logged::Torques(t) => Action::Torques(t),
+        Logged::Pd(p) => Action::Pd(p),
+    }
+}
+
+fn state_code(c: fbd_contact::StateCode) -> u8 {
+    match c {
+        fbd_contact::StateCode::St1 => 1,
+        fbd_contact::StateCode::St2 => 2,
+        fbd_contact::StateCode::St3 => 3,
     }
 }
 
@@ -86,35 +500,44 @@ impl Simulator {
     fn new(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         guard(|| {
             let loaded = crate::config::load(py, config)?;
-            let model = match &loaded.config {
-                fbd_scenario::Config::Planar(c) => c
-                    .model(&loaded.source)
-                    .map_err(|e| config_error(py, &e, loaded.from_text))?,
-                fbd_scenario::Config::Hexapod(_) => {
-                    return Err(crate::errors::cli_error(
-                        py,
-                        &fbd_cli::CliError::Usage(format!(
-                            "{}: model = \"hexapod\": Simulator steps the planar model only; fbd.run(config) runs the hexapod (its 3D dynamics or its kinematic gait)",
-                            loaded.source
-                        )),
-                        true,
-                    ));
+            let text = loaded.config.to_toml();
+            let plant = match &loaded.config {
+                fbd_scenario::Config::Planar(c) => Plant::Planar(Box::new(
+                    c.model(&loaded.source)
+                        .map_err(|e| config_error(py, &e, loaded.from_text))?,
+                )),
+                fbd_scenario::Config::Hexapod(h) => {
+                    if !h.is_dynamic() {
+                        return Err(crate::errors::cli_error(
+                            py,
+                            &fbd_cli::CliError::Usage(format!(
+                                "{}: model = \"hexapod\" with a kinematic gait (dynamics = \"kinematic\"): Simulator steps the 3D dynamics; fbd.run(config) runs the kinematic gait",
+                                loaded.source
+                            )),
+                            true,
+                        ));
+                    }
+                    let params = h
+                        .spatial_params(&loaded.source)
+                        .map_err(|e| config_error(py, &e, loaded.from_text))?;
+                    let model = SpatialModel::new(&params).map_err(|e| {
+                        crate::errors::cli_error(
+                            py,
+                            &fbd_cli::CliError::Usage(format!("{}: {e}", loaded.source)),
+                            true,
+                        )
+                    })?;
+                    Plant::Hexapod(Box::new(model))
                 }
             };
-            let data = Data::new(&model);
-            let contacts = model.mech.contacts.iter().map(|c| c.name.clone()).collect();
-            Ok(Self {
-                model,
-                data,
-                source: loaded.source,
-                contacts,
-                last: None,
-                failed: None,
-            })
+            Ok(Self::build(plant, loaded.source, text))
         })
     }
 
-    /// Advances `steps` steps (one by default) with the GIL released.
+    /// Advances `steps` steps (one by default) with the GIL released:
+    /// with `torques` (one per joint, held for the `steps` steps) when
+    /// given, else with the PD targets of `set_pd_targets`, else with the
+    /// configured controller.
     #[pyo3(signature = (torques=None, steps=1))]
     fn step(
         &mut self,
@@ -122,100 +545,255 @@ impl Simulator {
         torques: Option<&Bound<'_, PyAny>>,
         steps: usize,
     ) -> PyResult<()> {
-        let external = match torques {
-            Some(t) if !t.is_none() => Some(self.torques_from(t)?),
+        let torques = match torques {
+            Some(t) if !t.is_none() => Some(self.vector(t, "torques")?),
             _ => None,
         };
-        if let Some(e) = &self.failed {
-            return Err(simulation_error(
-                py,
-                &format!("{e} ({}; call reset() to start again)", self.source),
-                e.step(),
-                e.step().map(|k| k as f64 * self.model.dt()),
-                None,
-            ));
-        }
-        let torques_given = external.is_some();
-        self.data.external_torque = external;
-        let (model, data) = (&self.model, &mut self.data);
-        let last = &mut self.last;
-        let result = py.detach(|| {
-            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                for i in 1..=steps {
-                    let r = fbd_sim::step(model, data)?;
-                    match last {
-                        Some(l) => l.clone_from(r),
-                        None => *last = Some(r.clone()),
-                    }
-                    // Ctrl-C between steps of a long call.
-                    if i.is_multiple_of(crate::run::SIGNAL_CHECK)
-                        && i < steps
-                        && let Err(e) = Python::attach(|py| py.check_signals())
-                    {
-                        return Ok(Some(e));
-                    }
+        self.check_failed(py)?;
+        let action = self.action_of(torques);
+        let sim = &mut self.sim;
+        let mut done = 0;
+        let mut error = None;
+        let mut interrupt = None;
+        py.detach(|| {
+            let a = action_ref(&action);
+            while done < steps {
+                let chunk = (steps - done).min(crate::run::SIGNAL_CHECK);
+                let (d, e) = Self::advance(sim, &a, chunk);
+                done += d;
+                if e.is_some() {
+                    error = e;
+                    return;
                 }
-                Ok::<_, SimError>(None)
-            }))
+                if done < steps
+                    && let Err(e) = Python::attach(|py| py.check_signals())
+                {
+                    interrupt = Some(e);
+                    return;
+                }
+            }
         });
-        self.data.external_torque = None;
-        match result {
-            Ok(Ok(None)) => Ok(()),
-            Ok(Ok(Some(interrupt))) => Err(interrupt),
-            Ok(Err(e)) => {
-                let hint = if torques_given && matches!(e, SimError::Newton { .. }) {
-                    EXTERNAL_TORQUE_HINT
-                } else {
-                    ""
-                };
-                let msg = format!("{e} ({}){hint}", self.source);
-                let (k, t) = (e.step(), e.step().map(|k| k as f64 * self.model.dt()));
-                self.failed = Some(e);
-                Err(simulation_error(py, &msg, k, t, None))
-            }
-            Err(_) => {
-                let e = SimError::NonFinite {
-                    step: self.data.k,
-                    t: self.data.time(&self.model),
-                    residual: f64::NAN,
-                };
-                self.failed = Some(e);
-                Err(pyo3::exceptions::PyRuntimeError::new_err(
-                    "fbd internal error during a step (call reset() to start again)",
-                ))
-            }
+        self.finish(py, &action, done, error)?;
+        match interrupt {
+            Some(e) => Err(e),
+            None => Ok(()),
         }
     }
 
-    /// Back to the initial state of the configuration.
+    /// PD targets tracked inside Rust by `step()` without torques:
+    /// `τ = kp·(θ* − θ[k]) + kd·(θ̇* − θ̇[k])`, clamped to `±torque_limit`,
+    /// the law of `[control] kind = "pd"`. `kp`, `kd` are numbers or one
+    /// value per joint; `targets` (rad) and `rates` (rad/s, default 0) one
+    /// per joint (`joint_names`).
+    #[pyo3(signature = (targets, kp, kd, rates=None, torque_limit=None))]
+    fn set_pd_targets(
+        &mut self,
+        targets: &Bound<'_, PyAny>,
+        kp: &Bound<'_, PyAny>,
+        kd: &Bound<'_, PyAny>,
+        rates: Option<&Bound<'_, PyAny>>,
+        torque_limit: Option<f64>,
+    ) -> PyResult<()> {
+        let position = self.vector(targets, "targets")?;
+        let kp = self.vector(kp, "kp")?;
+        let kd = self.vector(kd, "kd")?;
+        let velocity = match rates {
+            Some(r) if !r.is_none() => self.vector(r, "rates")?,
+            _ => vec![0.0; position.len()],
+        };
+        if let Some(l) = torque_limit
+            && !(l.is_finite() && l > 0.0)
+        {
+            return Err(PyValueError::new_err(format!(
+                "torque_limit: must be positive and finite, got {l}"
+            )));
+        }
+        for (name, v) in [("kp", &kp), ("kd", &kd)] {
+            if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+                return Err(PyValueError::new_err(format!(
+                    "{name}: must be finite and ≥ 0"
+                )));
+            }
+        }
+        if position.iter().chain(&velocity).any(|x| !x.is_finite()) {
+            return Err(PyValueError::new_err("targets and rates must be finite"));
+        }
+        self.pd = Some(PdTargets {
+            kp,
+            kd,
+            torque_limit,
+            position,
+            velocity,
+        });
+        Ok(())
+    }
+
+    /// Stops PD tracking: `step()` without torques uses the configured
+    /// controller again.
+    fn clear_pd_targets(&mut self) {
+        self.pd = None;
+    }
+
+    /// The PD targets in use (`targets`, `rates`, `kp`, `kd`,
+    /// `torque_limit`), or None.
+    #[getter]
+    fn pd_targets<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        let Some(p) = &self.pd else { return Ok(None) };
+        let d = PyDict::new(py);
+        d.set_item("targets", PyArray1::from_slice(py, &p.position))?;
+        d.set_item("rates", PyArray1::from_slice(py, &p.velocity))?;
+        d.set_item("kp", PyArray1::from_slice(py, &p.kp))?;
+        d.set_item("kd", PyArray1::from_slice(py, &p.kd))?;
+        d.set_item("torque_limit", p.torque_limit)?;
+        Ok(Some(d))
+    }
+
+    /// Back to the initial state of the configuration (PD targets kept).
     fn reset(&mut self) {
-        self.data = Data::new(&self.model);
-        self.last = None;
+        self.sim = Sim::new(&self.plant);
+        self.log.clear();
         self.failed = None;
+        self.refresh();
+    }
+
+    /// The current state, for `set_state` (bit-identical stepping after
+    /// it); picklable.
+    fn get_state(&self) -> SimulatorState {
+        SimulatorState {
+            config: self.config.clone(),
+            k: self.sim.k(),
+            saved: Some(self.sim.state()),
+            log: self.log.clone(),
+        }
+    }
+
+    /// Back to a state of `get_state()` of a simulator of the same
+    /// configuration (a pickled state is replayed from the initial state
+    /// with the GIL released).
+    fn set_state(&mut self, py: Python<'_>, state: &Bound<'_, SimulatorState>) -> PyResult<()> {
+        let s = state.get();
+        if s.config != self.config {
+            return Err(PyValueError::new_err(
+                "set_state: the state is of a simulator of another configuration",
+            ));
+        }
+        match &s.saved {
+            Some(saved) => {
+                if !self.sim.set_state(saved) {
+                    return Err(PyValueError::new_err(
+                        "set_state: a state of the other model",
+                    ));
+                }
+            }
+            None => {
+                let mut sim = Sim::new(&self.plant);
+                let log = s.log.clone();
+                let error = py.detach(|| {
+                    for e in &log {
+                        let (_, err) = Self::advance(&mut sim, &action_ref(&e.action), e.steps);
+                        if err.is_some() {
+                            return err;
+                        }
+                    }
+                    None
+                });
+                if let Some(e) = error {
+                    return Err(PyRuntimeError::new_err(format!(
+                        "set_state: replaying the pickled state failed: {e}"
+                    )));
+                }
+                self.sim = sim;
+            }
+        }
+        self.log.clone_from(&s.log);
+        self.failed = None;
+        self.refresh();
+        Ok(())
+    }
+
+    /// An independent simulator in the same state (PD targets included).
+    fn copy(&self) -> Self {
+        Self {
+            plant: self.plant.clone(),
+            sim: self.sim.copy(&self.plant),
+            source: self.source.clone(),
+            config: self.config.clone(),
+            contacts: self.contacts.clone(),
+            coordinates: self.coordinates.clone(),
+            joint_names: self.joint_names.clone(),
+            pd: self.pd.clone(),
+            log: self.log.clone(),
+            readout: self.readout.clone(),
+            failed: None,
+        }
+    }
+
+    fn __copy__(&self) -> Self {
+        self.copy()
+    }
+
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.copy()
+    }
+
+    /// Pickles as the configuration, the PD targets and the state.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyAny>> {
+        let py = slf.py();
+        let s = slf.borrow();
+        let f = py.import("fbd._fbd")?.getattr("_simulator_from_state")?;
+        let pd = s.pd.as_ref().map(|p| {
+            PyBytes::new(
+                py,
+                &log_bytes(&[LogEntry {
+                    action: Logged::Pd(p.clone()),
+                    steps: 1,
+                }]),
+            )
+        });
+        let args = (
+            s.config.clone(),
+            s.source.clone(),
+            Bound::new(py, s.get_state())?,
+            pd,
+        );
+        (f, args).into_pyobject(py).map(|t| t.into_any())
+    }
+
+    /// `"planar"` or `"hexapod"`.
+    #[getter]
+    fn model(&self) -> &'static str {
+        if self.is_planar() {
+            "planar"
+        } else {
+            "hexapod"
+        }
     }
 
     /// Time of the current state `q` (s): `k·Δt`.
     #[getter]
     fn t(&self) -> f64 {
-        self.data.time(&self.model)
+        self.sim.k() as f64 * self.dt_()
     }
 
     /// Steps solved so far (`k`; the current state is `q[k]`).
     #[getter]
     fn k(&self) -> usize {
-        self.data.k
+        self.sim.k()
     }
 
     /// Time step Δt (s).
     #[getter]
     fn dt(&self) -> f64 {
-        self.model.dt()
+        self.dt_()
     }
 
     /// Steps of the configured duration: `round(duration/dt) + 1`.
     #[getter]
     fn steps(&self) -> usize {
-        self.model.steps
+        match &self.plant {
+            Plant::Planar(m) => m.steps,
+            Plant::Hexapod(m) => m.steps,
+        }
     }
 
     /// Whether the current state is at or past the configured duration
@@ -223,35 +801,45 @@ impl Simulator {
     /// `fbd.run`.
     #[getter]
     fn past_duration(&self) -> bool {
-        self.data.k + 1 >= self.model.steps
+        self.sim.k() + 1 >= self.steps()
     }
 
-    /// `q[k] = (Rx, Ry, φz, θ2₃, θ3₃, θ2₄, θ3₄)` (m, rad), a new array.
+    /// `q[k]` (m, rad), a new array: the planar model's `(Rx, Ry, φz, θ2₃,
+    /// θ3₃, θ2₄, θ3₄)`, the hexapod's 24 coordinates in the order of
+    /// `fbd.hexapod_fk` (`coordinate_names`).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.data.q)
+        PyArray1::from_slice(py, self.sim.q())
     }
 
     /// The backward difference `(q[k] − q[k−1])/Δt`, the initial velocity
-    /// at `k = 0`: the rate the built-in PD controller uses.
+    /// at `k = 0`: the rate the PD law uses.
     #[getter]
     fn qdot<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        let dt = self.model.dt();
-        let mut v = [0.0; 7];
-        for (i, v) in v.iter_mut().enumerate() {
-            *v = if self.data.k == 0 {
-                self.model.params.qdot0[i]
-            } else {
-                (self.data.q[i] - self.data.q_prev[i]) / dt
-            };
-        }
-        PyArray1::from_slice(py, &v[..self.data.q.len().min(7)])
+        PyArray1::from_vec(py, self.sim.qdot())
     }
 
     /// The initial configuration `q[0]` (m, rad).
     #[getter]
     fn q0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        PyArray1::from_slice(py, &self.model.params.q0)
+        match &self.plant {
+            Plant::Planar(m) => PyArray1::from_slice(py, &m.params.q0),
+            Plant::Hexapod(m) => PyArray1::from_slice(py, &m.params.q0),
+        }
+    }
+
+    /// Names of the coordinates of `q` (`trajectory.csv`'s columns).
+    #[getter]
+    fn coordinate_names(&self) -> Vec<String> {
+        self.coordinates.clone()
+    }
+
+    /// Names of the actuated joints, the order of torques and targets: the
+    /// planar `theta2_3, theta3_3, theta2_4, theta3_4` (hip3, knee3, hip4,
+    /// knee4); the hexapod's `theta1_1, theta2_1, theta3_1, theta1_2, …`.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.joint_names.clone()
     }
 
     /// Names of the contact points, e.g. `["tip3", "tip4", ...]`.
@@ -266,68 +854,176 @@ impl Simulator {
     #[getter]
     fn contact_states<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u8>> {
         let codes: Vec<u8> = self
-            .data
-            .states
+            .readout
+            .contacts
             .iter()
-            .map(|s| match s.code() {
-                fbd_contact::StateCode::St1 => 1,
-                fbd_contact::StateCode::St2 => 2,
-                fbd_contact::StateCode::St3 => 3,
-            })
+            .map(|c| state_code(c.state))
             .collect();
         PyArray1::from_vec(py, codes)
     }
 
-    /// Contact forces `(Fa, N)` of each point at the last solved step (N),
-    /// shape `(points, 2)`: along the terrain tangent and normal; zeros
-    /// before the first step.
+    /// Contact forces at the last solved step (N; zeros before the first):
+    /// the planar model's `(Fa, N)` along the terrain tangent and normal,
+    /// shape `(points, 2)`; the hexapod's force of the ground on each point
+    /// in the inertial frame, shape `(points, 3)`.
     #[getter]
     fn contact_forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let n = self.contacts.len();
-        let a = Array2::from_shape_fn((n, 2), |(c, j)| {
-            self.last()
-                .map_or(0.0, |r| if j == 0 { r.fa[c] } else { r.n[c] })
-        });
-        PyArray2::from_owned_array(py, a)
+        if let Sim::Planar(s) = &self.sim {
+            let r = &s.data().record;
+            let n = self.contacts.len();
+            let a = Array2::from_shape_fn((n, 2), |(c, j)| if j == 0 { r.fa[c] } else { r.n[c] });
+            return PyArray2::from_owned_array(py, a);
+        }
+        let f: Vec<[f64; 3]> = self.readout.contacts.iter().map(|c| c.force).collect();
+        self.arr3(py, &f)
     }
 
-    /// Inertial positions of the contact points at the last solved step
-    /// (m), shape `(points, 2)`; at `q[0]` before the first step.
+    /// Inertial positions of the contact points (m): the planar model's at
+    /// the last solved step (`(points, 2)`; at `q[0]` before the first),
+    /// the hexapod's at `q[k]` (`(points, 3)`).
     #[getter]
     fn contact_positions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let n = self.contacts.len();
-        let a = Array2::from_shape_fn((n, 2), |(c, j)| match self.last() {
-            Some(r) => r.point[c][j],
-            None => self.data.fbd.kin.pos[self.model.mech.contacts[c].point][j],
-        });
-        PyArray2::from_owned_array(py, a)
+        if let Sim::Planar(s) = &self.sim {
+            let n = self.contacts.len();
+            let d = s.data();
+            let a = Array2::from_shape_fn((n, 2), |(c, j)| {
+                if d.k == 0 {
+                    d.fbd.kin.pos[s.model().mech.contacts[c].point][j]
+                } else {
+                    d.record.point[c][j]
+                }
+            });
+            return PyArray2::from_owned_array(py, a);
+        }
+        let p: Vec<[f64; 3]> = self.readout.contacts.iter().map(|c| c.position).collect();
+        self.arr3(py, &p)
     }
 
-    /// Joint forces `(Fx, Fy)` of hip3, knee3, hip4, knee4 at the last
-    /// solved step (N, parent on child, inertial frame), shape `(4, 2)`.
+    /// Joint forces at the last solved step (N, parent on child, inertial
+    /// frame): the planar hip3, knee3, hip4, knee4 `(Fx, Fy)`, shape
+    /// `(4, 2)`; the hexapod's hip and knee of each leg, shape
+    /// `(legs, 2, 3)`.
     #[getter]
-    fn joint_forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let joints = self.data.fbd.torque.len();
-        let a = Array2::from_shape_fn((joints, 2), |(j, i)| {
-            self.last().map_or(0.0, |r| r.joint_force[j][i])
+    fn joint_forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        if let Sim::Planar(s) = &self.sim {
+            let r = &s.data().record;
+            let a = Array2::from_shape_fn((r.joint_force.len(), 2), |(j, i)| r.joint_force[j][i]);
+            return PyArray2::from_owned_array(py, a).into_any();
+        }
+        let legs = &self.readout.legs;
+        let a = Array3::from_shape_fn((legs.len(), 2, 3), |(l, h, i)| {
+            if h == 0 {
+                legs[l].hip_force[i]
+            } else {
+                legs[l].knee_force[i]
+            }
         });
-        PyArray2::from_owned_array(py, a)
+        PyArray3::from_owned_array(py, a).into_any()
     }
 
-    /// Joint torques applied at the last solved step (N·m): hip3, knee3,
-    /// hip4, knee4.
+    /// Joint torques applied at the last solved step (N·m), one per joint
+    /// (`joint_names`).
     #[getter]
     fn joint_torques<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        match self.last() {
-            Some(r) => PyArray1::from_slice(py, &r.torque),
-            None => PyArray1::from_vec(py, vec![0.0; self.data.fbd.torque.len()]),
-        }
+        PyArray1::from_vec(py, self.readout.joints.iter().map(|j| j.torque).collect())
     }
 
-    /// Kinetic and potential energy at the last solved step (J).
+    /// Kinetic and potential energy at the last solved step (J), None
+    /// before the first.
     #[getter]
     fn energy(&self) -> Option<(f64, f64)> {
-        self.last().map(|r| (r.kinetic, r.potential))
+        (self.sim.k() > 0).then_some((self.readout.kinetic, self.readout.potential))
+    }
+
+    /// Every readout as NumPy arrays, a dict (names and layouts in
+    /// docs/reference.md, "fbd.Simulator observations").
+    fn observe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let r = &self.readout;
+        let d = PyDict::new(py);
+        d.set_item("t", r.t)?;
+        d.set_item("k", r.k)?;
+        d.set_item("q", PyArray1::from_slice(py, &r.q))?;
+        d.set_item("qdot", PyArray1::from_slice(py, &r.qdot))?;
+        let b = &r.bodies;
+        d.set_item(
+            "body_position",
+            self.arr3(py, &b.iter().map(|b| b.position).collect::<Vec<_>>()),
+        )?;
+        let rot = Array3::from_shape_fn((b.len(), 3, 3), |(i, j, k)| b[i].rotation[j][k]);
+        d.set_item("body_rotation", PyArray3::from_owned_array(py, rot))?;
+        d.set_item(
+            "body_velocity",
+            self.arr3(py, &b.iter().map(|b| b.velocity).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "body_angular_velocity",
+            self.arr3(
+                py,
+                &b.iter().map(|b| b.angular_velocity).collect::<Vec<_>>(),
+            ),
+        )?;
+        let j = &r.joints;
+        d.set_item(
+            "joint_angle",
+            PyArray1::from_vec(py, j.iter().map(|j| j.angle).collect()),
+        )?;
+        d.set_item(
+            "joint_rate",
+            PyArray1::from_vec(py, j.iter().map(|j| j.rate).collect()),
+        )?;
+        d.set_item(
+            "joint_torque",
+            PyArray1::from_vec(py, j.iter().map(|j| j.torque).collect()),
+        )?;
+        let l = &r.legs;
+        d.set_item(
+            "leg",
+            PyArray1::from_vec(py, l.iter().map(|l| l.leg as i64).collect()),
+        )?;
+        d.set_item(
+            "hip_force",
+            self.arr3(py, &l.iter().map(|l| l.hip_force).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "hip_moment",
+            self.arr3(py, &l.iter().map(|l| l.hip_moment).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "knee_force",
+            self.arr3(py, &l.iter().map(|l| l.knee_force).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "knee_moment",
+            self.arr3(py, &l.iter().map(|l| l.knee_moment).collect::<Vec<_>>()),
+        )?;
+        let c = &r.contacts;
+        d.set_item(
+            "contact_position",
+            self.arr3(py, &c.iter().map(|c| c.position).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "contact_state",
+            PyArray1::from_vec(py, c.iter().map(|c| state_code(c.state)).collect()),
+        )?;
+        d.set_item(
+            "contact_force",
+            self.arr3(py, &c.iter().map(|c| c.force).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "contact_normal_force",
+            PyArray1::from_vec(py, c.iter().map(|c| c.normal_force).collect()),
+        )?;
+        d.set_item(
+            "contact_normal",
+            self.arr3(py, &c.iter().map(|c| c.normal).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "contact_slip_velocity",
+            self.arr3(py, &c.iter().map(|c| c.slip_velocity).collect::<Vec<_>>()),
+        )?;
+        d.set_item("kinetic", r.kinetic)?;
+        d.set_item("potential", r.potential)?;
+        Ok(d)
     }
 
     /// Events so far, as `fbd.run` lists them: contact, joint-limit and
@@ -335,16 +1031,116 @@ impl Simulator {
     /// `to`).
     #[getter]
     fn events<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
-        let d = &self.data;
-        crate::run::events(py, &d.events, &d.limit_events, &d.retries, self.model.dt())
+        let dt = self.dt_();
+        match &self.sim {
+            Sim::Planar(s) => {
+                let d = s.data();
+                crate::run::events(py, &d.events, &d.limit_events, &d.retries, dt)
+            }
+            Sim::Hexapod(s) => {
+                let d = s.data();
+                crate::run::events(py, &d.events, &d.limit_events, &d.retries, dt)
+            }
+        }
     }
 
     fn __repr__(&self) -> String {
         format!(
-            "Simulator({}, k={}, t={})",
+            "Simulator({}, {}, k={}, t={})",
+            self.model(),
             self.source,
-            self.data.k,
-            self.data.time(&self.model)
+            self.sim.k(),
+            self.t()
         )
     }
+}
+
+/// Rebuilds a pickled [`Simulator`].
+#[pyfunction]
+#[pyo3(signature = (config, source, state, pd=None))]
+pub fn _simulator_from_state(
+    py: Python<'_>,
+    config: String,
+    source: String,
+    state: &Bound<'_, SimulatorState>,
+    pd: Option<&[u8]>,
+) -> PyResult<Simulator> {
+    let text = PyString::new(py, &config);
+    let mut sim = Simulator::new(py, Some(text.as_any()))?;
+    sim.source = source;
+    sim.set_state(py, state)?;
+    if let Some(b) = pd
+        && let Some(LogEntry {
+            action: Logged::Pd(p),
+            ..
+        }) = log_from_bytes(b).and_then(|l| l.into_iter().next())
+    {
+        sim.pd = Some(p);
+    }
+    Ok(sim)
+}
+
+/// `step_many(sims, torques=None, steps=1)`: steps every simulator of the
+/// list `steps` steps on Rust threads (rayon; the GIL released): with row
+/// i of `torques` (shape `(len(sims), joints)`) for simulator i when given,
+/// else with its PD targets or its configured controller, exactly as
+/// `sims[i].step(torques[i], steps)` would. Returns one entry per
+/// simulator: None, or the `SimulationError` that stopped it (not
+/// raised).
+#[pyfunction]
+#[pyo3(signature = (sims, torques=None, steps=1))]
+pub fn step_many<'py>(
+    py: Python<'py>,
+    sims: &Bound<'py, PyList>,
+    torques: Option<PyReadonlyArray2<'py, f64>>,
+    steps: usize,
+) -> PyResult<Vec<Option<PyErr>>> {
+    let mut refs: Vec<PyRefMut<'py, Simulator>> = sims
+        .iter()
+        .map(|s| -> PyResult<PyRefMut<'py, Simulator>> {
+            let b = s.cast_into::<Simulator>()?;
+            Ok(b.try_borrow_mut()?)
+        })
+        .collect::<PyResult<_>>()?;
+    let n = refs.len();
+    let mut actions = Vec::with_capacity(n);
+    let tau = torques.as_ref().map(|t| t.as_array());
+    if let Some(t) = &tau
+        && t.nrows() != n
+    {
+        return Err(PyValueError::new_err(format!(
+            "torques: expected {n} rows, one per simulator, got {}",
+            t.nrows()
+        )));
+    }
+    for (i, s) in refs.iter().enumerate() {
+        s.check_failed(py)?;
+        let row = match &tau {
+            Some(t) => {
+                let row: Vec<f64> = t.row(i).to_vec();
+                if row.len() != s.sim.joints() {
+                    return Err(PyValueError::new_err(format!(
+                        "torques: expected {} columns, one per joint",
+                        s.sim.joints()
+                    )));
+                }
+                Some(row)
+            }
+            None => None,
+        };
+        actions.push(s.action_of(row));
+    }
+    let mut cores: Vec<&mut Sim> = refs.iter_mut().map(|r| &mut r.sim).collect();
+    let outcome: Vec<(usize, Option<SimError>)> = py.detach(|| {
+        cores
+            .par_iter_mut()
+            .zip(&actions)
+            .map(|(sim, a)| Simulator::advance(sim, &action_ref(a), steps))
+            .collect()
+    });
+    let mut errors = Vec::with_capacity(n);
+    for ((s, a), (done, e)) in refs.iter_mut().zip(&actions).zip(outcome) {
+        errors.push(s.finish(py, a, done, e).err());
+    }
+    Ok(errors)
 }

@@ -173,6 +173,26 @@ impl Control {
     }
 }
 
+/// The PD law of every controller (planar and spatial, configured or
+/// set through [`crate::simulator`]): `τ = kp·(θ* − θ) + kd·(θ̇* − θ̇)`,
+/// clamped to `±limit`.
+#[inline]
+pub fn pd_torque(
+    kp: f64,
+    kd: f64,
+    limit: Option<f64>,
+    target: f64,
+    target_rate: f64,
+    theta: f64,
+    rate: f64,
+) -> f64 {
+    let tau = kp * (target - theta) + kd * (target_rate - rate);
+    match limit {
+        Some(l) => tau.clamp(-l, l),
+        None => tau,
+    }
+}
+
 /// Stage 2 of [`crate::step()`]: the joint torques of step `data.k` into
 /// `data.fbd.torque`, from `q[k]` and `q[k−1]` (explicit): the external
 /// torques [`Data::external_torque`] as given when set (no saturation),
@@ -208,11 +228,7 @@ pub fn joint_torques(model: &Model, data: &mut Data) {
         } else {
             (data.q[i] - data.q_prev[i]) / dt
         };
-        let mut tau = kp * (target - data.q[i]) - kd * rate;
-        if let Some(l) = limit {
-            tau = tau.clamp(-l, l);
-        }
-        data.fbd.torque[j] = tau;
+        data.fbd.torque[j] = pd_torque(kp, kd, limit, target, 0.0, data.q[i], rate);
     }
 }
 

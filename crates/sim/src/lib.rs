@@ -9,6 +9,8 @@
 //!   contact check → accept), see [`mod@step`]; the step is one generic
 //!   source for the planar and the spatial model ([`engine`]);
 //! * [`run`] — the whole loop with per-row callback and a [`RunSummary`].
+//! * [`simulator`] — the stepping API for controllers outside the
+//!   simulator, every model: actions, state save/restore, readouts.
 //! * [`gait`] — the kinematic gait of the 24-DOF hexapod (gait schedule,
 //!   body path, footholds, swing, IK with rates and accelerations, static
 //!   stability), with its own model/workspace pair and run loop.
@@ -36,6 +38,7 @@ pub mod predictor;
 pub mod record;
 mod rules;
 mod run;
+pub mod simulator;
 pub mod spatial;
 pub mod step;
 mod system;
@@ -50,4 +53,5 @@ pub use params::PlanarParams;
 pub use predictor::Predictor;
 pub use record::{Event, LimitCode, LimitEvent, RetryEvent, StepRecord};
 pub use run::{RunSummary, run, run_collect, run_until};
+pub use simulator::{Action, PdTargets, Plant, Readout, SimState, Simulator};
 pub use step::step;

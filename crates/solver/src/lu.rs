@@ -110,6 +110,7 @@ pub(crate) enum FactorPath {
 /// taken out, see the module docs), the dense slot map, the column
 /// ordering, the eliminated rows, and the bookkeeping of its kept
 /// factorisation.
+#[derive(Clone)]
 pub(crate) struct Pattern {
     /// Index of this pattern in the solver's cache (the owner id of
     /// [`Factors`]).
@@ -324,6 +325,7 @@ impl Pattern {
 /// Numeric LU storage for the reduced patterns of one dimension: faer's
 /// simplicial `L`, `U` and row pivoting of the last factorisation, `U`
 /// scaled for the solves, and the scratch of the solves.
+#[derive(Clone)]
 pub(crate) struct Factors {
     n: usize,
     lu: SimplicialLu<usize, f64>,

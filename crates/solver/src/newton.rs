@@ -163,6 +163,23 @@ struct Workspace {
     lu_fallbacks: u64,
 }
 
+impl Clone for Workspace {
+    /// The buffers' values (scratch; overwritten before use) and a fresh
+    /// scratch arena of the same size (faer's `MemBuffer` is not `Clone`).
+    fn clone(&self) -> Self {
+        Self {
+            values: self.values.clone(),
+            r: self.r.clone(),
+            dx: self.dx.clone(),
+            x_trial: self.x_trial.clone(),
+            r_trial: self.r_trial.clone(),
+            mem: MemBuffer::new(self.mem_req),
+            mem_req: self.mem_req,
+            numeric_factorizations: self.numeric_factorizations,
+        }
+    }
+}
+
 /// Newton solver with a cache of symbolic LU factorisations keyed by
 /// [`NewtonSystem::pattern_key`].
 ///
@@ -170,6 +187,11 @@ struct Workspace {
 /// numerically (reusing the symbolic analysis of its pattern), solves
 /// `J Δx = −r` and takes the step with a backtracking line search on the
 /// scaled residual max-norm (see [`NewtonParams`] for the convergence rule).
+///
+/// A clone carries the kept factorisations and their bookkeeping (what
+/// the chord steps of the next solve use): a clone solves the next system
+/// exactly as the original would (the stepping API's `state()`).
+#[derive(Clone)]
 pub struct NewtonSolver {
     params: NewtonParams,
     /// `(pattern key, pattern)`, in registration order.

@@ -27,13 +27,14 @@ import numpy as _np
 
 from . import _fbd
 from ._errors import ConfigError, SimulationError
-from ._fbd import Simulator
+from ._fbd import Simulator, SimulatorState, step_many
 
 __all__ = [
     "ConfigError",
     "Result",
     "SimulationError",
     "Simulator",
+    "SimulatorState",
     "SweepResult",
     "config_toml",
     "hexapod_fk",
@@ -41,6 +42,7 @@ __all__ = [
     "leg_ik",
     "planar_fk",
     "run",
+    "step_many",
     "sweep",
 ]
 
@@ -309,3 +311,18 @@ def sweep(
         _os.fspath(sweep_config), out, jobs, viewer=viewer, plots=plots
     )
     return SweepResult(out, message, failed)
+
+
+def _register_gym() -> None:
+    """Registers the Gymnasium environments (``fbd.gym``) when gymnasium is
+    installed; ``import fbd`` works without it."""
+    try:
+        import gymnasium  # noqa: F401
+    except ImportError:
+        return
+    from . import gym as _gym
+
+    _gym.register_envs()
+
+
+_register_gym()

@@ -202,6 +202,69 @@ impl<M: Engine> RunData<M> {
     }
 }
 
+/// A clone is the whole state of the run: stepping the clone gives, bit
+/// for bit, what stepping the original would (the solver's kept
+/// factorisations included); the stepping API's `state()`
+/// ([`crate::simulator`]).
+impl<M: Engine> Clone for RunData<M>
+where
+    M::Fbd: Clone,
+    M::Record: Clone,
+    M::Torques: Clone,
+    M::ControlData: Clone,
+{
+    fn clone(&self) -> Self {
+        Self {
+            k: self.k.clone(),
+            q_prev: self.q_prev.clone(),
+            q_prev2: self.q_prev2.clone(),
+            q: self.q.clone(),
+            z: self.z.clone(),
+            states: self.states.clone(),
+            fbd: self.fbd.clone(),
+            solver: self.solver.clone(),
+            events: self.events.clone(),
+            limit_states: self.limit_states.clone(),
+            limit_events: self.limit_events.clone(),
+            retries: self.retries.clone(),
+            newton_iterations: self.newton_iterations.clone(),
+            chord_iterations: self.chord_iterations.clone(),
+            max_step_iterations: self.max_step_iterations.clone(),
+            resolved_cycles: self.resolved_cycles.clone(),
+            enumerated_cycles: self.enumerated_cycles.clone(),
+            external_torque: self.external_torque.clone(),
+            predictor: self.predictor.clone(),
+            record: self.record.clone(),
+            control: self.control.clone(),
+            scales: self.scales.clone(),
+            weights: self.weights.clone(),
+            trial: self.trial.clone(),
+            limit_trial: self.limit_trial.clone(),
+            visited: self.visited.clone(),
+            seen: self.seen.clone(),
+            stick_ft: self.stick_ft.clone(),
+            stick_anchor: self.stick_anchor.clone(),
+            grid_q: self.grid_q.clone(),
+            grid_q_prev: self.grid_q_prev.clone(),
+            grid_q_prev2: self.grid_q_prev2.clone(),
+            grid_states: self.grid_states.clone(),
+            grid_limits: self.grid_limits.clone(),
+            grid_events: self.grid_events.clone(),
+            failed_trial: self.failed_trial.clone(),
+            failed_limits: self.failed_limits.clone(),
+            start_z: self.start_z.clone(),
+            best_violation: self.best_violation.clone(),
+            best_z: self.best_z.clone(),
+            best_trial: self.best_trial.clone(),
+            best_limits: self.best_limits.clone(),
+            checked_trial: self.checked_trial.clone(),
+            checked_limits: self.checked_limits.clone(),
+            last_resort: self.last_resort.clone(),
+            want_record: self.want_record.clone(),
+        }
+    }
+}
+
 impl<M: Engine> std::fmt::Debug for RunData<M>
 where
     M::State: std::fmt::Debug,

@@ -94,11 +94,8 @@ pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(),
         };
         for j in 0..3 {
             let theta = data.q[q_joint(s, j)];
-            let mut tau = kp * (target[j] - theta) + kd * (target_rate[j] - rate[j]);
-            if let Some(l) = limit {
-                tau = tau.clamp(-l, l);
-            }
-            data.fbd.torque[s][j] = tau;
+            data.fbd.torque[s][j] =
+                crate::control::pd_torque(kp, kd, limit, target[j], target_rate[j], theta, rate[j]);
         }
     }
     Ok(())

@@ -1,0 +1,107 @@
+"""fbd.gym: the environments pass Gymnasium's own check_env, are
+deterministic in their seed, and the vector entry point (N simulators on
+Rust threads) equals N serial environments with Gymnasium's NEXT_STEP
+autoreset, bit for bit. Episodes here are short (CI budget)."""
+
+from __future__ import annotations
+
+import pickle
+
+import numpy as np
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium")
+
+import fbd  # noqa: E402  (registers the environments)
+from gymnasium.utils.env_checker import check_env  # noqa: E402
+from gymnasium.vector import AutoresetMode  # noqa: E402
+
+
+@pytest.mark.parametrize("name", ["fbd/HexapodWalk-v0", "fbd/PlanarStand-v0"])
+def test_check_env(name):
+    env = gymnasium.make(name, episode_seconds=0.2)
+    check_env(env.unwrapped, skip_render_check=True)
+    check_env(env, skip_render_check=True)
+
+
+def test_hexapod_walk_layout_and_determinism():
+    env = gymnasium.make("fbd/HexapodWalk-v0", episode_seconds=0.2)
+    obs, _ = env.reset(seed=3)
+    assert obs.shape == (60,) and env.action_space.shape == (18,)
+    assert len(env.unwrapped.OBSERVATION_NAMES) == 60
+    again, _ = env.reset(seed=3)
+    np.testing.assert_array_equal(obs, again)
+    other, _ = env.reset(seed=4)
+    assert not np.array_equal(obs, other)
+    rng = np.random.default_rng(0)
+    actions = rng.uniform(-0.05, 0.05, size=(12, 18))
+
+    def episode(e, seed):
+        out = [e.reset(seed=seed)[0]]
+        for a in actions:
+            o, r, term, trunc, info = e.step(a)
+            out.append(np.concatenate([o, [r, term, trunc]]))
+            if term or trunc:
+                break
+        return out
+
+    a = episode(env, 7)
+    # The feet touch down and carry the robot.
+    assert a[-1][46:52].min() >= 1.0 and a[-1][52:58].sum() > 100.0
+    b = episode(pickle.loads(pickle.dumps(env.unwrapped)), 7)
+    for x, y in zip(a, b):
+        np.testing.assert_array_equal(x, y)
+    assert a[-1][-1] == 1.0, "truncated at the time limit (0.2 s, 10 actions)"
+
+
+def serial_next_step(envs, actions_seq, seed):
+    """N serial environments driven with the NEXT_STEP autoreset rule."""
+    obs = [e.reset(seed=seed + i)[0] for i, e in enumerate(envs)]
+    out = [np.stack(obs)]
+    done = [False] * len(envs)
+    for actions in actions_seq:
+        step = []
+        for i, e in enumerate(envs):
+            if done[i]:
+                o, _ = e.reset()
+                r, te, tr = 0.0, False, False
+            else:
+                o, r, te, tr, _ = e.step(actions[i])
+            done[i] = te or tr
+            step.append(np.concatenate([o, [r, te, tr]]))
+        out.append(np.stack(step))
+    return out
+
+
+@pytest.mark.parametrize("name,steps", [("fbd/HexapodWalk-v0", 9), ("fbd/PlanarStand-v0", 12)])
+def test_vector_env_equals_serial_envs(name, steps):
+    n = 3
+    venv = gymnasium.make_vec(name, num_envs=n, vectorization_mode="vector_entry_point", episode_seconds=0.08)
+    assert venv.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP
+    rng = np.random.default_rng(1)
+    seq = rng.uniform(-1, 1, size=(steps,) + venv.action_space.shape)
+    obs, _ = venv.reset(seed=11)
+    got = [obs]
+    resets = 0
+    for actions in seq:
+        o, r, te, tr, _ = venv.step(actions)
+        got.append(np.column_stack([o, r, te, tr]))
+        resets += int(np.sum(te | tr))
+    assert resets >= n, "episodes ended and were reset within the test"
+    envs = [gymnasium.make(name, episode_seconds=0.08).unwrapped for _ in range(n)]
+    want = serial_next_step(envs, seq, 11)
+    for x, y in zip(got, want):
+        np.testing.assert_array_equal(x, y)
+    venv.close()
+
+
+def test_vector_env_pickles():
+    venv = gymnasium.make_vec("fbd/PlanarStand-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    venv.reset(seed=0)
+    a = np.zeros(venv.action_space.shape)
+    venv.step(a)
+    twin = pickle.loads(pickle.dumps(venv.unwrapped))
+    for _ in range(3):
+        x = venv.step(a)[0]
+        y = twin.step(a)[0]
+        np.testing.assert_array_equal(x, y)

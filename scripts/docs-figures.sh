@@ -3,8 +3,10 @@
 # and energy.svg of the default experiment, the gait diagram and footprints
 # of examples/hexapod_tripod.toml, the feet's normal forces and the joint
 # torques of examples/hexapod_walk.toml, and the sweep plot of
-# examples/sweep_friction_height.toml. (The viewer screenshots docs/viewer.png
-# and docs/viewer_hexapod.png are taken by scripts/test-browser.sh.)
+# examples/sweep_friction_height.toml; then the viewer screenshots
+# docs/viewer.png, docs/viewer_hexapod.png and docs/viewer_hexapod_walk.png
+# (scripts/test-browser.sh with FBD_SCREENSHOT_DIR=docs; SKIP_SHOTS=1 skips
+# them). The test command never writes docs/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -29,3 +31,6 @@ done
   >/dev/null 2>&1
 cp "$runs/sweep/sweep.svg" docs/sweep_friction_height.svg
 echo "docs/: forces.svg joints.svg energy.svg hexapod_tripod_gait.svg hexapod_tripod_footprints.svg hexapod_walk_feet.svg hexapod_walk_torques.svg sweep_friction_height.svg"
+if [ "${SKIP_SHOTS:-0}" != 1 ]; then
+  FBD_SCREENSHOT_DIR="$PWD/docs" bash scripts/test-browser.sh
+fi

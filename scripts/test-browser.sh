@@ -5,8 +5,10 @@
 # playwright-core from npm) and checks what it draws against
 # trajectory.csv (tests/browser/viewer.test.mjs). Installs chromium with
 # apt-get when it is missing (needs root), and the pinned playwright-core
-# with `npm ci`. Saves the screenshots docs/viewer.png,
-# docs/viewer_hexapod.png and docs/viewer_hexapod_walk.png.
+# with `npm ci`. Saves the screenshots viewer.png, viewer_hexapod.png and
+# viewer_hexapod_walk.png in a temporary folder it names (or in
+# $FBD_SCREENSHOT_DIR): the test leaves the checkout as it was.
+# scripts/docs-figures.sh regenerates docs/*.png with FBD_SCREENSHOT_DIR=docs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,12 +30,14 @@ cargo build --release --bin fbd
 fbd="${CARGO_TARGET_DIR:-$PWD/target}/release/fbd"
 runs=$(mktemp -d)
 trap 'rm -rf "$runs"' EXIT
-# The folder names are the viewer's page titles.
 "$fbd" run --out "$runs/paper-fall" >/dev/null
 "$fbd" run examples/hexapod_tripod.toml --out "$runs/hexapod-tripod" >/dev/null
 "$fbd" run examples/hexapod_walk.toml --out "$runs/hexapod-walk" >/dev/null
 
+shots=${FBD_SCREENSHOT_DIR:-$(mktemp -d "${TMPDIR:-/tmp}/fbd-viewer-shots.XXXXXX")}
+shots=$(cd "$shots" && pwd)
 cd tests/browser
 CHROMIUM="$chromium" FBD_PLANAR_DIR="$runs/paper-fall" FBD_HEXAPOD_DIR="$runs/hexapod-tripod" \
   FBD_DYNAMIC_DIR="$runs/hexapod-walk" \
-  FBD_SCREENSHOT_DIR="$PWD/../../docs" node --test
+  FBD_SCREENSHOT_DIR="$shots" node --test
+echo "screenshots: $shots"

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The Python package's tests, in a fresh virtual environment: installs
-# maturin, NumPy, pytest, pandas (Result.to_pandas), matplotlib (the
-# Fig. 7 example), gymnasium (fbd.gym) and dask[distributed] (the Dask
-# LocalCluster example) from PyPI, installs the package with the README's command
+# maturin, NumPy, pytest, pandas (Result.to_pandas), pyarrow (reading
+# trajectory.parquet), matplotlib (the Fig. 7 example), gymnasium (fbd.gym)
+# and dask[distributed] (the Dask LocalCluster example) from PyPI, installs
+# the package with the README's command
 # (`pip install ./crates/python`, which builds the abi3 wheel with maturin),
 # lints the binding's Rust code, runs the pytest suite against the `fbd`
 # binary built from the same tree, and runs the examples, writing the Fig. 7
@@ -25,7 +26,7 @@ echo "== python: fresh virtual environment ($("$PYTHON" --version))"
 "$PYTHON" -m venv "$WORK/venv"
 VPY="$WORK/venv/bin/python"
 "$VPY" -m pip install --quiet --disable-pip-version-check --upgrade pip
-"$VPY" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas matplotlib \
+"$VPY" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas pyarrow matplotlib \
   gymnasium "dask[distributed]"
 
 echo "== python: pip install ./crates/python"

@@ -11,7 +11,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync, existsSync } from 'node:fs';
-import { join } from 'node:path';
+import { join, basename } from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { chromium } from 'playwright-core';
 
@@ -49,11 +49,11 @@ after(async () => {
 
 /** Opens dir/viewer.html; every request other than the page is recorded
  *  and refused, every console error and page error recorded. */
-async function open(dir) {
+async function open(dir, viewport = VIEWPORT) {
   const file = join(dir, 'viewer.html');
   assert.ok(existsSync(file), `${file} was not written`);
   const url = pathToFileURL(file).href;
-  const context = await browser.newContext({ viewport: VIEWPORT, offline: true });
+  const context = await browser.newContext({ viewport, offline: true });
   const page = await context.newPage();
   const requests = [];
   const errors = [];
@@ -65,7 +65,8 @@ async function open(dir) {
   });
   page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
   page.on('pageerror', (e) => errors.push(e.message));
-  await page.goto(url);
+  // (a long run's page takes a while on software WebGL, beside another)
+  await page.goto(url, { timeout: 120000 });
   await page.waitForFunction(() => window.fbdViewer !== undefined, null, { timeout: 30000 });
   return { page, context, requests, errors };
 }
@@ -157,7 +158,10 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
         for (const p of s.screen) {
           assert.ok(p.x >= 0 && p.x <= box.w && p.y >= 0 && p.y <= box.h, `frame ${i} ${p.name} off screen at (${p.x}, ${p.y})`);
         }
+        // (without the leg numbers and the heading arrow, drawn over the links)
+        await page.evaluate(() => window.fbdViewer.annotations(false));
         await snap(page, 'frame');
+        await page.evaluate(() => window.fbdViewer.annotations(true));
         const marked = s.screen.filter((p) => dark.includes(p.name));
         const luma = await darkest(page, 'frame', marked);
         marked.forEach((p, k) => {
@@ -216,9 +220,41 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
         await snap(page, 'with');
         await page.uncheck('#show-joint');
         const d = await difference(page, 'without', 'with');
-        assert.ok(d > 0.0002, `the joint-force arrows changed only ${d}`);
+        // (joint forces are clipped to the longest arrow: a few pixels)
+        assert.ok(d > 0.00005, `the joint-force arrows changed only ${d}`);
       });
     }
+
+    await t.test('the header counts every row of events.csv', async () => {
+      const rows = readCsv(join(dir, 'events.csv')).rows.length;
+      const info = await page.textContent('#info');
+      assert.ok(info.includes(`${rows} events (events.csv`), `header "${info}", events.csv ${rows} rows`);
+    });
+
+    await t.test('the page is titled after the configuration and model, not the folder', async () => {
+      const title = await page.title();
+      assert.ok(!title.includes(basename(dir)), `title "${title}" names the folder ${basename(dir)}`);
+      assert.ok(/planar model|hexapod/.test(title), `title "${title}"`);
+    });
+
+    await t.test('force arrows stay inside the view at every frame (clipped, with the force written)', async () => {
+      const bad = await page.evaluate(() => {
+        const v = window.fbdViewer;
+        const c = document.getElementById('canvas3d');
+        const out = [];
+        let clippedFrames = 0;
+        for (let i = 0; i < v.frameCount; i++) {
+          v.seek(i);
+          for (const p of v.arrowTips()) if (p.x < 0 || p.y < 0 || p.x > c.clientWidth || p.y > c.clientHeight) out.push(`frame ${i}: (${p.x.toFixed(0)}, ${p.y.toFixed(0)})`);
+          if (v.clipped().length) {
+            clippedFrames++;
+            if (!document.getElementById('overlay').textContent.includes(' N')) out.push(`frame ${i}: clipped arrows without their force`);
+          }
+        }
+        return { out, clippedFrames };
+      });
+      assert.deepEqual(bad.out.slice(0, 5), []);
+    });
 
     if (screenshot) {
       await seek(page, shotFrame(v));
@@ -232,6 +268,20 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
   } finally {
     await context.close();
   }
+    await t.test('the page fits a 1366×768 window: view, controls and panels', async () => {
+      const { page: p, context: small } = await open(dir, { width: 1366, height: 768 });
+      try {
+        const box = await p.evaluate(() => {
+          const last = [...document.querySelectorAll('.panel')].map((e) => e.getBoundingClientRect().bottom);
+          return { scroll: document.documentElement.scrollHeight, panels: Math.max(0, ...last) };
+        });
+        assert.ok(box.panels <= 768, `the panels end at ${box.panels} px`);
+        assert.ok(box.scroll <= 768, `the page is ${box.scroll} px high`);
+      } finally {
+        await small.close();
+      }
+    });
+
 }
 
 const num = (row, csv, name) => Number(row[csv.col(name)]);
@@ -251,6 +301,25 @@ test('planar run (the paper\'s fall)', async (t) => {
     screenshot: shots && join(shots, 'viewer.png'),
     // At rest on feet and hips: the weight on the contact-force arrows.
     shotFrame: (v) => v.n - 1,
+  });
+  await t.test('a scale bar and the axes in the side view', async () => {
+    const { page, context } = await open(dir);
+    try {
+      const s = await page.evaluate(() => {
+        const v = window.fbdViewer;
+        v.seek(0);
+        // Pixels per metre from two drawn points.
+        const w = v.worldPoints(), sc = v.screenPoints();
+        const a = w.findIndex((p) => p.name === 'tip3'), b = w.findIndex((p) => p.name === 'body');
+        const perM = Math.hypot(sc[a].x - sc[b].x, sc[a].y - sc[b].y) / Math.hypot(w[a].x - w[b].x, w[a].y - w[b].y);
+        return { bar: v.scaleBar(), perM, text: document.getElementById('overlay').textContent };
+      });
+      assert.ok(s.bar.metres > 0, 'no scale bar');
+      assert.ok(Math.abs(s.bar.px - s.bar.metres * s.perM) < 0.02 * s.bar.px, `bar ${s.bar.px} px for ${s.bar.metres} m, view ${s.perM} px/m`);
+      assert.ok(s.text.includes(`${s.bar.metres} m`) && s.text.includes('X') && s.text.includes('Y'), s.text);
+    } finally {
+      await context.close();
+    }
   });
   await t.test('every contact event is marked', async () => {
     // The events are read back in the test's own browser page below.
@@ -279,7 +348,41 @@ test('hexapod run', async (t) => {
     screenshot: shots && join(shots, 'viewer_hexapod.png'),
     shotFrame: (v) => Math.floor(v.n / 3),
   });
+  await checkLegsAndHeading(t, dir);
 });
+
+/** Leg numbers beside the hips and a heading arrow towards the body's
+ *  front vertex (corner2, between legs 1 and 2). */
+async function checkLegsAndHeading(t, dir) {
+  const { page, context } = await open(dir);
+  try {
+    await t.test('leg numbers beside the hips, a heading arrow along the body\'s front', async () => {
+      const n = await page.evaluate(() => window.fbdViewer.frameCount);
+      for (const i of [0, Math.floor(n / 2), n - 1]) {
+        const s = await page.evaluate((i) => {
+          const v = window.fbdViewer;
+          v.seek(i);
+          return { labels: v.legLabels(), screen: v.screenPoints(), world: v.worldPoints(), heading: v.heading() };
+        }, i);
+        const hips = s.screen.filter((p) => /^hip\d$/.test(p.name));
+        assert.equal(s.labels.length, hips.length, `frame ${i}: ${s.labels.length} labels for ${hips.length} hips`);
+        for (const l of s.labels) {
+          const h = hips.find((p) => p.name === `hip${l.leg}`);
+          assert.ok(Math.hypot(l.x - h.x, l.y - h.y) < 60, `frame ${i}: label ${l.leg} ${Math.hypot(l.x - h.x, l.y - h.y).toFixed(0)} px from its hip`);
+        }
+        const w = new Map(s.world.map((p) => [p.name, p]));
+        const b = w.get('body'), c = w.get('corner2');
+        const d = [c.x - b.x, c.y - b.y, c.z - b.z];
+        const len = Math.hypot(...d);
+        assert.ok(s.heading, 'no heading arrow');
+        const dot = (d[0] * s.heading[0] + d[1] * s.heading[1] + d[2] * s.heading[2]) / len;
+        assert.ok(dot > 0.9999, `frame ${i}: heading arrow off the body's front (cos ${dot})`);
+      }
+    });
+  } finally {
+    await context.close();
+  }
+}
 
 test('dynamic hexapod run (3D FBD)', async (t) => {
   const dir = process.env.FBD_DYNAMIC_DIR;
@@ -297,6 +400,18 @@ test('dynamic hexapod run (3D FBD)', async (t) => {
     dark: [1, 2, 3, 4, 5, 6].map((k) => `corner${k}`),
     screenshot: shots && join(shots, 'viewer_hexapod_walk.png'),
     shotFrame: (v) => Math.floor(v.n / 3),
+  });
+  await checkLegsAndHeading(t, dir);
+  await t.test('the slope of the ground is drawn and named', async () => {
+    const { page, context } = await open(dir);
+    try {
+      const note = await page.evaluate(() => window.fbdViewer.slopeNote);
+      const text = await page.textContent('#overlay');
+      assert.ok(/3\.5° slope, rising towards \+X/.test(note), `slope note "${note}"`);
+      assert.ok(text.includes(note), text);
+    } finally {
+      await context.close();
+    }
   });
   const { page, context, errors } = await open(dir);
   try {

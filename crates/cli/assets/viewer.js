@@ -48,13 +48,16 @@
     robot = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 0.1);
   }
   // Force arrows: the 90th percentile of the contact forces' magnitudes is
-  // 0.6 of the robot's size (impact peaks would make the rest
-  // invisible); arrows are at most 1.5 robot sizes long.
+  // 0.3 (side view) or 0.4 (3D) of the robot's size (impact peaks would
+  // make the rest invisible); longer arrows are clipped (MAX_ARROW).
   const mags = [];
   for (const f of S.fc) for (let i = 0; i < f.length; i += 3) { const m = Math.hypot(f[i], f[i + 1], f[i + 2]); if (m > 0) mags.push(m); }
   mags.sort((a, b) => a - b);
   const fref = mags.length ? mags[Math.floor(0.9 * (mags.length - 1))] : 0;
-  const forceScale = fref > 0 ? 0.6 * robot / fref : 0; // m per N
+  const forceScale = fref > 0 ? (planar ? 0.3 : 0.4) * robot / fref : 0; // m per N
+  // Longest arrow (m): an impact's force is clipped to it, so that the
+  // arrow stays in the view, and its magnitude written beside the view.
+  const MAX_ARROW = (planar ? 0.45 : 0.6) * robot;
   const radius = (planar ? 0.022 : 0.012) * robot;
 
   // ---- three.js scene ------------------------------------------------
@@ -283,11 +286,15 @@
   const showTrails = document.getElementById('show-trails');
   const P = (f, i) => new THREE.Vector3(S.p[f][3 * i], S.p[f][3 * i + 1], S.p[f][3 * i + 2]);
 
-  function setArrow(a, at, f, k, visible) {
+  // The arrows clipped at the frame drawn: [name, magnitude (N)].
+  let clipped = [];
+  function setArrow(a, at, f, k, visible, name) {
     const v = new THREE.Vector3(f[3 * k], f[3 * k + 1], f[3 * k + 2]);
-    const len = Math.min(v.length() * forceScale, 1.5 * robot);
+    const full = v.length() * forceScale;
+    const len = Math.min(full, MAX_ARROW);
     a.visible = visible && len > 1e-4;
     if (!a.visible) return;
+    if (full > MAX_ARROW) clipped.push([name, v.length()]);
     a.position.copy(at);
     a.setDirection(v.normalize());
     a.setLength(len, Math.min(0.25 * len, 0.06 * robot), Math.min(0.15 * len, 0.035 * robot));
@@ -299,11 +306,13 @@
     for (const m of links) setCylinder(m, P(f, m.userData.line.a), P(f, m.userData.line.b), m.userData.r);
     dots.forEach((m, i) => m.position.copy(P(f, i)));
     const st = S.state[f];
+    clipped = [];
     S.contacts.forEach((c, k) => {
       dots[c.point].material.color.setHex(STATE[st[k]] || STATE['1']);
-      setArrow(contactArrows[k], P(f, c.point), S.fc[f], k, showContact.checked);
+      setArrow(contactArrows[k], P(f, c.point), S.fc[f], k, showContact.checked, S.points[c.point]);
     });
-    S.joints.forEach((j, k) => setArrow(jointArrows[k], P(f, j.point), S.fj[f], k, showJoint.checked));
+    S.joints.forEach((j, k) => setArrow(jointArrows[k], P(f, j.point), S.fj[f], k, showJoint.checked, S.points[j.point] + ' joint'));
+    updateLabels(f);
     if (plate) {
       const a = plate.geometry.attributes.position;
       const cs = plate.userData.corners;
@@ -348,6 +357,113 @@
     return xy[xy.length - 1];
   }
 
+  // ---- hexapod: leg numbers and the heading arrow ---------------------------
+  // A number beside each hip (sprites that face the camera), and an arrow
+  // from the body centre towards the front vertex of the body hexagon
+  // (corner2, between legs 1 and 2: the body's forward −z).
+  const pointIndex = new Map(S.points.map((n, i) => [n, i]));
+  const legLabels = [];
+  let headingArrow = null;
+  if (!planar) {
+    for (let n = 1; n <= 6; n++) {
+      const hip = pointIndex.get('hip' + n);
+      if (hip === undefined) continue;
+      const c = document.createElement('canvas');
+      c.width = c.height = 64;
+      const g = c.getContext('2d');
+      g.fillStyle = '#ffffff'; g.beginPath(); g.arc(32, 32, 28, 0, 2 * Math.PI); g.fill();
+      g.strokeStyle = css(LEGS[(n - 1) % LEGS.length]); g.lineWidth = 6; g.stroke();
+      g.fillStyle = '#263238'; g.font = 'bold 40px sans-serif'; g.textAlign = 'center'; g.textBaseline = 'middle';
+      g.fillText(String(n), 32, 34);
+      const sp = new THREE.Sprite(new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(c), depthTest: false }));
+      sp.renderOrder = 11;
+      sp.scale.setScalar(0.07 * robot);
+      scene.add(sp);
+      legLabels.push({ leg: n, hip, sprite: sp });
+    }
+    if (pointIndex.has('corner2') && pointIndex.has('body')) {
+      headingArrow = new THREE.ArrowHelper(Y, new THREE.Vector3(), 0.1, 0xff6f00);
+      for (const part of [headingArrow.line, headingArrow.cone]) { part.material.depthTest = false; part.renderOrder = 10; }
+      scene.add(headingArrow);
+    }
+  }
+  function updateLabels(f) {
+    // A quarter of the way from the hip to the body centre, above it:
+    // clear of the body's corners and the knees.
+    const b = P(f, pointIndex.get('body') ?? 0);
+    for (const l of legLabels) {
+      const p = P(f, l.hip).lerp(b, 0.3);
+      l.sprite.position.set(p.x, p.y + 0.1 * robot, p.z);
+    }
+    if (headingArrow) {
+      const b = P(f, pointIndex.get('body'));
+      const d = P(f, pointIndex.get('corner2')).sub(b);
+      headingArrow.position.copy(b);
+      headingArrow.setDirection(d.normalize());
+      headingArrow.setLength(0.45 * robot, 0.08 * robot, 0.04 * robot);
+    }
+  }
+
+  // ---- overlay: scale bar and axes (side view), slope, clipped arrows --------
+  const overlay = document.getElementById('overlay');
+  // The terrain's slope when its profile is one straight line (°).
+  let slopeNote = '';
+  const riseNote = (deg, dir) => 'ground: ' + deg.toFixed(1) + '° slope, rising towards ' + dir;
+  if (S.terrain.kind === 'grid' && S.terrain.n >= 2) {
+    // A plane y = y00 + gx·(x − x0) + gz·(z − z0) through three corners,
+    // when every sample lies on it.
+    const { x0, x1, z0, z1, n, y } = S.terrain;
+    const gx = (y[n - 1] - y[0]) / (x1 - x0), gz = (y[(n - 1) * n] - y[0]) / (z1 - z0);
+    let plane = true;
+    for (let j = 0; j < n && plane; j++) {
+      for (let i = 0; i < n; i++) {
+        const want = y[0] + gx * (x1 - x0) * i / (n - 1) + gz * (z1 - z0) * j / (n - 1);
+        if (Math.abs(want - y[j * n + i]) > 1e-5) { plane = false; break; }
+      }
+    }
+    const g = Math.hypot(gx, gz);
+    if (plane && g > 1e-9) {
+      const dir = Math.abs(gx) >= Math.abs(gz) ? (gx > 0 ? '+X' : '−X') : (gz > 0 ? '+Z' : '−Z');
+      slopeNote = riseNote(Math.atan(g) * 180 / Math.PI, Math.abs(gx) > 1e-9 && Math.abs(gz) > 1e-9 ? dir + ' (mostly)' : dir);
+    }
+  } else if (S.terrain.kind === 'profile' && S.terrain.xy.length >= 4) {
+    const xy = S.terrain.xy, m = xy.length / 2;
+    const k = (xy[2 * m - 1] - xy[1]) / (xy[2 * m - 2] - xy[0]);
+    let straight = true;
+    for (let i = 1; i < m - 1; i++) if (Math.abs(xy[1] + k * (xy[2 * i] - xy[0]) - xy[2 * i + 1]) > 1e-6) straight = false;
+    if (straight && Math.abs(k) > 1e-9) {
+      slopeNote = riseNote(Math.atan(Math.abs(k)) * 180 / Math.PI, k > 0 ? '+X' : '−X');
+    }
+  }
+  let scaleBar = { metres: 0, px: 0 };
+  function drawOverlay() {
+    const parts = [];
+    if (planar) {
+      const perM = (canvas.clientHeight || 1) / (camera.top - camera.bottom);
+      const want = 110 / perM;
+      const e = Math.pow(10, Math.floor(Math.log10(want)));
+      const metres = [5, 2, 1].map((x) => x * e).find((x) => x <= want) || e;
+      scaleBar = { metres, px: metres * perM };
+      parts.push('<span class="bar" style="width:' + scaleBar.px.toFixed(1) + 'px"></span> ' +
+        Number(metres.toPrecision(2)) + ' m', '<span class="axes">↑ Y (up) → X</span>');
+    } else {
+      parts.push('<span class="axes">axes: <b style="color:#e53935">X</b> <b style="color:#43a047">Y up</b> <b style="color:#1e88e5">Z</b>; <b style="color:#ff6f00">→</b> heading</span>');
+    }
+    if (slopeNote) parts.push(slopeNote);
+    if (clipped.length) {
+      parts.push('<span class="clip">arrows clipped at ' + Number(MAX_ARROW.toPrecision(2)) + ' m: ' +
+        clipped.map(([n, v]) => n + ' ' + v.toFixed(0) + ' N').join(', ') + '</span>');
+    }
+    overlay.innerHTML = parts.join('<br>');
+  }
+  if (!planar) {
+    // Inertial axes at the ground below the first frame's body.
+    const axes = new THREE.AxesHelper(0.35 * robot);
+    const c0 = N ? S.com[0] : [0, 0, 0];
+    axes.position.set(c0[0], groundBelow(c0[0], c0[2]) + 1e-3, c0[2]);
+    scene.add(axes);
+  }
+
   // ---- controls --------------------------------------------------------
   const slider = document.getElementById('slider');
   const timeLabel = document.getElementById('time');
@@ -360,6 +476,7 @@
     placeCamera();
     update();
     renderer.render(scene, camera);
+    drawOverlay();
     slider.value = String(frame);
     timeLabel.textContent = N ? 't = ' + S.t[frame].toFixed(4) + ' s  (' + (frame + 1) + '/' + N + ')' : 'no frames';
     drawPanels();
@@ -502,7 +619,8 @@
   // ---- header and legend -------------------------------------------------
   document.getElementById('title').textContent = 'fbd viewer — ' + S.title;
   document.getElementById('info').textContent = (planar ? 'planar model, side view' : S.dynamic ? 'hexapod, 3D dynamics' : 'hexapod, 3D') + ' · ' + N + ' frames of ' + S.rows + ' rows' +
-    (N < S.rows ? ' (decimated, every event kept)' : '') + ' · ' + S.events.length + ' events' +
+    (N < S.rows ? ' (decimated, every event kept)' : '') + ' · ' + (S.event_rows || S.events.length) + ' events (events.csv' +
+    (S.event_rows > S.events.length ? '; ' + S.events.length + ' contact changes marked' : '') + ')' +
     (forceScale > 0 ? ' · arrows: ' + Number((0.1 / forceScale).toPrecision(2)) + ' N per 0.1 m' : '');
   const legend = document.getElementById('legend');
   const states = forces ? ['1', '2', '3'] : ['1', '2'];
@@ -550,6 +668,34 @@
     dynamic: !!S.dynamic,
     contactForces() { return N ? S.fc[frame].slice() : []; },
     arrowsShown() { return contactArrows.filter((a) => a.visible).length; },
+    /** Screen positions of the visible arrows' tips (contact and joint). */
+    arrowTips() {
+      const w = canvas.clientWidth, h = canvas.clientHeight;
+      return contactArrows.concat(jointArrows).filter((a) => a.visible).map((a) => {
+        a.updateMatrixWorld(true);
+        const v = new THREE.Vector3(0, 1, 0).applyMatrix4(a.cone.matrixWorld).project(camera);
+        return { x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h };
+      });
+    },
+    clipped() { return clipped.slice(); },
+    /** Shows or hides the leg numbers and the heading arrow (redraws). */
+    annotations(on) {
+      for (const l of legLabels) l.sprite.visible = on;
+      if (headingArrow) headingArrow.visible = on;
+      renderer.render(scene, camera);
+    },
+    scaleBar() { return Object.assign({}, scaleBar); },
+    slopeNote,
+    /** Leg numbers: leg and screen position of each label. */
+    legLabels() {
+      const w = canvas.clientWidth, h = canvas.clientHeight;
+      return legLabels.map((l) => {
+        const v = l.sprite.position.clone().project(camera);
+        return { leg: l.leg, x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h, visible: l.sprite.visible };
+      });
+    },
+    /** The heading arrow's direction (world), or null. */
+    heading() { return headingArrow && headingArrow.visible ? (() => { const d = new THREE.Vector3(0, 1, 0).applyQuaternion(headingArrow.quaternion); return [d.x, d.y, d.z]; })() : null; },
   };
   seek(0);
 })();

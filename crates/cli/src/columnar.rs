@@ -6,8 +6,8 @@
 //! numbers and times as `DOUBLE` (float64; a time is the double nearest to
 //! the decimal `trajectory.csv` writes, [`StepTimes::value`]), contact
 //! states as `BYTE_ARRAY` strings (`ST1`, `ST2`, `ST3`), counts
-//! (`newton_iterations`) as `INT64`, the kinematic gait's stance flags as
-//! `DOUBLE` 1.0 / 0.0. Every column is required (no nulls); a NaN stays a
+//! (`newton_iterations`) and the kinematic gait's stance flags (1 / 0) as
+//! `INT64`: the types pandas gives the CSV's columns. Every column is required (no nulls); a NaN stays a
 //! NaN. The types are learnt from the first row (a run of no row writes
 //! every column as `DOUBLE`). Rows are buffered and written as row groups
 //! of about [`GROUP_BYTES`]; the file is written to a temporary file and
@@ -288,6 +288,9 @@ impl RowSink for ParquetTable {
     }
     fn count(&mut self, n: usize) {
         self.push(Value::Int(i64::try_from(n).unwrap_or(i64::MAX)));
+    }
+    fn flag(&mut self, on: bool) {
+        self.push(Value::Int(i64::from(on)));
     }
 }
 

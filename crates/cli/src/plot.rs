@@ -558,8 +558,13 @@ fn draw_trace<'a, DB: DrawingBackend + 'a>(
     Ok(())
 }
 
+/// Events closer than this (pixels) share one label: a rotated label of
+/// the 11 px font is about 13 px wide.
+const EVENT_GROUP_PX: i32 = 14;
+
 /// Draws the event lines and their labels (rotated, at the top; events
-/// within 8 px share one label).
+/// within [`EVENT_GROUP_PX`] share one label, the first event's followed
+/// by `+N` for the N others, as the legend says).
 fn draw_events<'a, DB: DrawingBackend + 'a>(
     chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
     events: &[EventMark],
@@ -573,7 +578,7 @@ fn draw_events<'a, DB: DrawingBackend + 'a>(
     for e in events.iter().filter(|e| e.t >= x0 && e.t <= x1) {
         let px = chart.backend_coord(&(e.t, y.1)).0;
         match groups.last_mut() {
-            Some(g) if (px - g.0).abs() < 8 => {
+            Some(g) if (px - g.0).abs() < EVENT_GROUP_PX => {
                 if !g.2.contains(&e.label.as_str()) {
                     g.2.push(&e.label);
                 }
@@ -594,8 +599,7 @@ fn draw_events<'a, DB: DrawingBackend + 'a>(
             .map_err(err)?;
         let text = match labels.as_slice() {
             [a] => (*a).to_owned(),
-            [a, b] => format!("{a}, {b}"),
-            [a, b, rest @ ..] => format!("{a}, {b} +{}", rest.len()),
+            [a, rest @ ..] => format!("{a} +{}", rest.len()),
             [] => String::new(),
         };
         let (px, py) = chart.backend_coord(&(*t, y.1));
@@ -683,7 +687,15 @@ pub(crate) fn stacked_time_chart(
         }
         if !events.is_empty() {
             entries.push(Entry {
-                label: "contact event".into(),
+                label: "contact event (label +N:".into(),
+                style: Style {
+                    color: EVENT,
+                    width: 1,
+                    dashed: true,
+                },
+            });
+            entries.push(Entry {
+                label: "  N more at that instant)".into(),
                 style: Style {
                     color: EVENT,
                     width: 1,
@@ -859,13 +871,63 @@ pub fn forces_svg(d: &PlotData) -> PlotResult<String> {
             },
         ));
     }
-    time_chart(
-        "Contact forces: normal n (solid), tangential fa (dashed)",
-        "force (N)",
-        &series,
-        &d.events,
-        time_range(d),
-    )
+    // An impact's peak would flatten every other force: the axis is
+    // clipped at three times the 95th percentile of the forces (rounded
+    // up to 1, 2 or 5 × 10ⁿ N) when the peak is beyond 1.5 times that, and
+    // the title gives the peak.
+    let mut mags: Vec<f64> = series
+        .iter()
+        .flat_map(|(t, _)| t.pts.iter().map(|p| p.1.abs()))
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .collect();
+    mags.sort_by(f64::total_cmp);
+    let peak = series
+        .iter()
+        .flat_map(|(t, _)| t.pts.iter().map(move |p| (p.1.abs(), p.0, &t.label)))
+        .filter(|p| p.0.is_finite())
+        .max_by(|a, b| a.0.total_cmp(&b.0));
+    let clip = mags
+        .get((mags.len().saturating_sub(1) * 95) / 100)
+        .map(|q| round_up_125(3.0 * q));
+    let title = "Contact forces: normal n (solid), tangential fa (dashed)";
+    match (clip, peak) {
+        (Some(clip), Some((p, t, label))) if p > 1.5 * clip => {
+            let clipped: Vec<Trace> = series
+                .iter()
+                .map(|(tr, _)| Trace {
+                    label: tr.label.clone(),
+                    pts: tr
+                        .pts
+                        .iter()
+                        .map(|&(x, v)| (x, v.clamp(-clip, clip)))
+                        .collect(),
+                })
+                .collect();
+            let styled: Vec<(&Trace, Style)> =
+                clipped.iter().zip(series.iter().map(|s| s.1)).collect();
+            time_chart(
+                &format!(
+                    "{title}; axis clipped at ±{clip} N: peak {p:.0} N ({label}, t = {})",
+                    tick(&t)
+                ),
+                "force (N)",
+                &styled,
+                &d.events,
+                time_range(d),
+            )
+        }
+        _ => time_chart(title, "force (N)", &series, &d.events, time_range(d)),
+    }
+}
+
+/// The smallest 1, 2 or 5 × 10ⁿ at or above `x` (> 0).
+fn round_up_125(x: f64) -> f64 {
+    let e = 10f64.powf(x.log10().floor());
+    [1.0, 2.0, 5.0, 10.0]
+        .into_iter()
+        .map(|m| m * e)
+        .find(|v| *v >= x * (1.0 - 1e-12))
+        .unwrap_or(10.0 * e)
 }
 
 /// `joints.svg`: the joint angles of legs 3 and 4.
@@ -968,9 +1030,10 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
 
     let n = d.stances.len().max(2) - 1;
     // From light to dark as time goes on.
+    // (the first at 75 % white, never white itself)
     let mix = |i: usize, c: RGBColor| {
         let f = i as f64 / n as f64;
-        lighter(c, 1.0 - f)
+        lighter(c, 0.75 * (1.0 - f))
     };
     let mut buf = String::new();
     {

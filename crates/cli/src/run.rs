@@ -389,7 +389,9 @@ pub fn simulate(
         );
     }
     if let Some(v) = view {
-        keep(viewer::write(out_dir, &v.finish(&run.events)));
+        let mut scene = v.finish(&run.events);
+        scene.event_rows = output::run_events(&run, &StepTimes::new(model.dt())).len();
+        keep(viewer::write(out_dir, &scene));
     }
     let mut files = output::selected(
         output::files_as(&output::FILES, planar.output.format),

@@ -425,7 +425,9 @@ pub fn simulate(
         }
     }
     if let Some(view) = view {
-        keep(crate::viewer::write(out_dir, &view.finish()));
+        let mut scene = view.finish();
+        scene.event_rows = run.events.len();
+        keep(crate::viewer::write(out_dir, &scene));
     }
     Ok(HexapodRun {
         run,

@@ -354,7 +354,9 @@ impl Outputs {
             }
         }
         if let Some(view) = self.view {
-            keep(crate::viewer::write(&out_dir, &view.finish()));
+            let mut scene = view.finish();
+            scene.event_rows = output::run_events(&run, &StepTimes::new(params.dt)).len();
+            keep(crate::viewer::write(&out_dir, &scene));
         }
         let files = output::selected(output::files_as(&FILES, self.output.format), &self.output);
         if io_error.is_none()

@@ -6,7 +6,8 @@
 //!   the height of the terrain under it (`ϱ(x, z)` at the foot, dashed);
 //! * `torques.svg` — the actuator torques τ1, τ2, τ3 of every leg, one
 //!   chart per joint;
-//! * `body.svg` — the body height `Ry`, and the body angles φx, φy, φz;
+//! * `body.svg` — the forward position, the body height `Ry`, roll and
+//!   pitch, and the heading (the attitude derived from φ);
 //! * `energy.svg` — kinetic, potential and total energy (as the planar
 //!   run draws it).
 
@@ -39,6 +40,10 @@ pub struct Recorder {
     surface: Option<Surface>,
     torque: Vec<[MinMax; 3]>,
     body: [MinMax; 4],
+    /// Forward position (m), roll, pitch, heading (°).
+    attitude: [MinMax; 4],
+    /// The first step's position and horizontal forward direction.
+    origin: Option<([f64; 3], [f64; 2])>,
     energy: [MinMax; 3],
 }
 
@@ -62,6 +67,8 @@ impl Recorder {
                 .map(|_| std::array::from_fn(|_| m()))
                 .collect(),
             body: std::array::from_fn(|_| m()),
+            attitude: std::array::from_fn(|_| m()),
+            origin: None,
             energy: std::array::from_fn(|_| m()),
         }
     }
@@ -98,6 +105,21 @@ impl Recorder {
             }
         }
         self.body[0].push_at(col, t, r.q[1]);
+        let pose =
+            fbd_kinematics::pose::BodyPose::new([r.q[0], r.q[1], r.q[2]], [r.q[3], r.q[4], r.q[5]]);
+        let [roll, pitch, heading] = pose.attitude();
+        let (o, f) = *self
+            .origin
+            .get_or_insert_with(|| ([r.q[0], r.q[1], r.q[2]], [-heading.sin(), -heading.cos()]));
+        let forward = (r.q[0] - o[0]) * f[0] + (r.q[2] - o[2]) * f[1];
+        for (m, v) in self.attitude.iter_mut().zip([
+            forward,
+            roll.to_degrees(),
+            pitch.to_degrees(),
+            heading.to_degrees(),
+        ]) {
+            m.push_at(col, t, v);
+        }
         for k in 0..3 {
             self.body[1 + k].push_at(col, t, r.q[3 + k].to_degrees());
         }
@@ -119,6 +141,7 @@ impl Recorder {
             }
         }
         let [height, phi_x, phi_y, phi_z] = self.body;
+        let [forward, roll, pitch, heading] = self.attitude;
         let [kinetic, potential, total] = self.energy;
         let mut heights = Vec::new();
         if self.surface.is_some() {
@@ -137,6 +160,9 @@ impl Recorder {
                 .collect(),
             torques,
             height: trace("Ry".into(), height),
+            forward: trace("forward".into(), forward),
+            attitude: vec![trace("roll".into(), roll), trace("pitch".into(), pitch)],
+            heading: trace("heading".into(), heading),
             angles: vec![
                 trace("φx".into(), phi_x),
                 trace("φy".into(), phi_y),
@@ -170,6 +196,13 @@ pub struct SpatialPlotData {
     pub height: Trace,
     /// Body angles φx, φy, φz (degrees).
     pub angles: Vec<Trace>,
+    /// Body centre's horizontal distance along the first step's heading
+    /// (m).
+    pub forward: Trace,
+    /// Roll and pitch (degrees; `trajectory.csv`'s `roll`, `pitch`).
+    pub attitude: Vec<Trace>,
+    /// Heading, yaw about the vertical (degrees).
+    pub heading: Trace,
     /// Kinetic, potential and total energy (J).
     pub energy: Vec<Trace>,
     /// Contact events.
@@ -278,17 +311,29 @@ pub fn body_svg(d: &SpatialPlotData) -> PlotResult<String> {
         dashed: false,
     };
     let height = [(&d.height, style(0))];
-    let angles: Vec<(&Trace, Style)> = d
-        .angles
+    let forward = [(&d.forward, style(4))];
+    let attitude: Vec<(&Trace, Style)> = d
+        .attitude
         .iter()
         .enumerate()
         .map(|(k, t)| (t, style(k + 1)))
         .collect();
+    let heading = [(&d.heading, style(3))];
     stacked_time_chart(
         Some("Body pose"),
         &[
+            (
+                "Forward position (along the initial heading)",
+                "distance (m)",
+                &forward,
+            ),
             ("Body height Ry", "height (m)", &height),
-            ("Body angles (Rx(φx)·Rz(φz)·Ry(φy))", "angle (°)", &angles),
+            (
+                "Roll (right side down +) and pitch (nose up +)",
+                "angle (°)",
+                &attitude,
+            ),
+            ("Heading (yaw about the vertical +Y)", "angle (°)", &heading),
         ],
         &d.events,
         d.t_range(),

@@ -184,6 +184,10 @@ pub struct Scene {
     pub com: Vec<[f64; 3]>,
     /// Contact events.
     pub events: Vec<EventMark>,
+    /// Rows of the run's `events.csv` (contact, joint-limit, retried-step
+    /// and t = 0 events: the header's count; `events` marks the contact
+    /// changes among them).
+    pub event_rows: usize,
     /// Time-series panels.
     pub panels: Vec<Panel>,
     /// A dynamic hexapod run: contact states ST1/ST2/ST3 and force arrows
@@ -390,7 +394,7 @@ pub fn render(scene: &Scene) -> Result<String, CliError> {
 /// The page's markup: the 3D view, the controls, the panels.
 const BODY_HTML: &str = r#"<header><h1 id="title">fbd viewer</h1><span id="info"></span></header>
 <main>
-<div id="view"><canvas id="canvas3d"></canvas><div id="legend"></div></div>
+<div id="view"><canvas id="canvas3d"></canvas><div id="legend"></div><div id="overlay"></div></div>
 <div id="controls">
 <button id="play" title="play / pause (space)">▶ play</button>
 <button id="step-back" title="previous frame (←)">◀|</button>

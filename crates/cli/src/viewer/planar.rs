@@ -138,6 +138,7 @@ impl<'a> PlanarScene<'a> {
             fj: Vec::new(),
             com: Vec::new(),
             events: Vec::new(),
+            event_rows: 0,
             panels: Vec::new(),
         };
         Self {

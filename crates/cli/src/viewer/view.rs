@@ -446,6 +446,10 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
             scene.finish()
         }
     };
+    let mut scene = scene;
+    // The header counts the rows of events.csv.
+    scene.event_rows = std::fs::read_to_string(dir.join("events.csv"))
+        .map_or(scene.events.len(), |t| t.lines().count().saturating_sub(1));
     super::write(dir, &scene)
 }
 

@@ -1,5 +1,6 @@
 //! Walking on uneven ground: every stance foot stands on the terrain
-//! (`y = ϱ(x, z)`), for the shipped slope example and on a sine terrain.
+//! (`y = ϱ(x, z)`), for the shipped slope example, on a sine terrain and on
+//! the random height map of examples/hexapod_rough.toml.
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
@@ -50,4 +51,21 @@ fn stance_feet_stand_on_a_sine_terrain() {
         Override::parse("gait.walk_time=4.0").unwrap(),
     ];
     assert!(check(&p, &o) > 1500);
+}
+
+#[test]
+fn stance_feet_stand_on_a_random_height_map() {
+    // examples/hexapod_rough.toml's ground under the kinematic tripod gait.
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/hexapod_rough.toml"),
+    )
+    .unwrap();
+    let kinematic = text[..text.find("[control]").unwrap()].replace("dt = 0.001", "dt = 0.01");
+    let dir = std::env::temp_dir().join(format!("fbd_gait_terrain_{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join("rough.toml");
+    std::fs::write(&p, kinematic).unwrap();
+    let n = check(&p, &[]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(n > 3000, "{n} stance rows checked");
 }

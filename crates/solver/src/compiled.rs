@@ -55,7 +55,7 @@ pub const PIVOT_THRESHOLD: f64 = 0.01;
 pub const ROW_CHOICE_THRESHOLD: f64 = 0.1;
 
 /// A compiled numeric LU of one reduced pattern with a fixed row order.
-#[derive(Default)]
+#[derive(Clone, Default)]
 pub(crate) struct CompiledLu {
     /// Dimension.
     m: usize,
@@ -90,7 +90,7 @@ pub(crate) struct CompiledLu {
 }
 
 /// Scratch of [`CompiledLu::compile`].
-#[derive(Default)]
+#[derive(Clone, Default)]
 struct Scratch {
     row_pos: Vec<usize>,
     col_pos: Vec<usize>,

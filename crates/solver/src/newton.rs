@@ -176,6 +176,8 @@ impl Clone for Workspace {
             mem: MemBuffer::new(self.mem_req),
             mem_req: self.mem_req,
             numeric_factorizations: self.numeric_factorizations,
+            compiled_factorizations: self.compiled_factorizations,
+            lu_fallbacks: self.lu_fallbacks,
         }
     }
 }

@@ -144,6 +144,10 @@ pub struct SpatialFbdData {
     /// (the planar rule, used when the implicit direction has no solution:
     /// a slide about to stop), instead of following the step's slip.
     pub fixed_direction: Vec<bool>,
+    /// Per contact: its fixed direction was released to the implicit law
+    /// once in this step's search (`fbd_sim`'s direction refinement does
+    /// it at most once a step).
+    pub released_direction: Vec<bool>,
     /// Per contact, `max(|w|, ε)` of [`slip_direction`] at the last
     /// evaluated iterate (m).
     pub slip_len: Vec<f64>,
@@ -213,6 +217,7 @@ impl SpatialFbdData {
             slip_hat: vec![[0.0; 2]; mech.contacts.len()],
             slip_len: vec![1.0; mech.contacts.len()],
             fixed_direction: vec![false; mech.contacts.len()],
+            released_direction: vec![false; mech.contacts.len()],
             slip_n: vec![0.0; mech.contacts.len()],
             wrench: vec![Wrench::default(); nb],
             rot_d: vec![Matrix3::zeros(); nb],

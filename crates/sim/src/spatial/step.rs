@@ -132,6 +132,7 @@ impl Engine for SpatialModel {
     fn kinematics(&self, data: &mut SpatialData, history: History<'_>, h: f64) {
         prepare_step(&self.mech, &mut data.fbd, history, h);
         data.fbd.fixed_direction.fill(false);
+        data.fbd.released_direction.fill(false);
     }
     fn torques(&self, data: &mut SpatialData) -> Result<(), SimError> {
         joint_torques(self, data)
@@ -397,9 +398,11 @@ fn refine_directions(model: &SpatialModel, data: &mut SpatialData) -> bool {
             data.trial[c] = SpatialState::Slide { dir: u };
             // Close to the slip: the implicit law again, from this
             // solution (Newton's quadratic convergence instead of the
-            // fixed point's linear one; a failure fixes it again).
-            if change < 0.1 {
+            // fixed point's linear one), once a step: a failure fixes it
+            // again for good.
+            if change < 0.1 && !data.fbd.released_direction[c] {
                 data.fbd.fixed_direction[c] = false;
+                data.fbd.released_direction[c] = true;
             }
             any = true;
         }

@@ -5,6 +5,12 @@
 //! engines, written apart, check each other: the rotation scheme reduces
 //! to the paper's central difference about Z, the 3D contact rules to the
 //! planar ones.
+//!
+//! Up to the first step the 3D engine's law audit rejects (a solution the
+//! planar engine accepts although it breaks a law, e.g. a slide locked in
+//! ST3 creeping backwards with its friction along the slip: the spatial
+//! engine solves that step again in substeps, exactly; the planar engine is
+//! not audited): from there the two runs differ by design.
 
 use fbd_sim::spatial::{SpatialModel, SpatialParams, run_collect as run3};
 use fbd_sim::{Control, Model, PlanarParams, run_collect};
@@ -18,9 +24,16 @@ fn compare(p: &PlanarParams) {
     let (rows3, summary3) = run3(&model3);
     assert!(summary3.error.is_none(), "spatial: {:?}", summary3.error);
     assert_eq!(rows.len(), rows3.len());
+    let cut = summary3
+        .retries
+        .iter()
+        .filter(|r| r.cause == "inexact")
+        .map(|r| r.step)
+        .min()
+        .unwrap_or(usize::MAX);
     let map = [(0, 0), (1, 1), (2, 5), (3, 7), (4, 8), (5, 10), (6, 11)];
     let mut worst: f64 = 0.0;
-    for (a, b) in rows.iter().zip(&rows3) {
+    for (a, b) in rows.iter().zip(&rows3).take_while(|(a, _)| a.step <= cut) {
         for (i, j) in map {
             let d = (a.q[i] - b.q[j]).abs();
             worst = worst.max(d);
@@ -43,18 +56,40 @@ fn compare(p: &PlanarParams) {
         }
     }
     let ev = |e: &fbd_sim::Event| (e.step, e.leg, e.point, e.from, e.to);
-    let planar: Vec<_> = summary.events.iter().map(ev).collect();
-    let spatial: Vec<_> = summary3.events.iter().map(ev).collect();
+    let planar: Vec<_> = summary
+        .events
+        .iter()
+        .filter(|e| e.step < cut)
+        .map(ev)
+        .collect();
+    let spatial: Vec<_> = summary3
+        .events
+        .iter()
+        .filter(|e| e.step < cut)
+        .map(ev)
+        .collect();
     assert_eq!(planar, spatial, "contact events differ");
     let lev = |e: &fbd_sim::LimitEvent| (e.step, e.leg, e.joint, e.from, e.to);
+    let before = |e: &&fbd_sim::LimitEvent| e.step < cut;
     assert_eq!(
-        summary.limit_events.iter().map(lev).collect::<Vec<_>>(),
-        summary3.limit_events.iter().map(lev).collect::<Vec<_>>(),
+        summary
+            .limit_events
+            .iter()
+            .filter(before)
+            .map(lev)
+            .collect::<Vec<_>>(),
+        summary3
+            .limit_events
+            .iter()
+            .filter(before)
+            .map(lev)
+            .collect::<Vec<_>>(),
         "limit events differ"
     );
     println!(
-        "{} rows, {} events, max |Δq| = {worst:.2e}",
+        "{} rows ({} compared), {} events, max |Δq| = {worst:.2e}",
         rows.len(),
+        rows.iter().take_while(|a| a.step <= cut).count(),
         planar.len()
     );
 }

@@ -124,12 +124,26 @@ pub fn standing_q(p: &PlanarParams, theta3_deg: f64) -> [f64; 7] {
 /// the worst imbalance in newtons (moments divided by the model's length
 /// scale).
 pub fn worst_body_imbalance(model: &Model, rows: &[StepRecord]) -> (f64, String) {
+    worst_body_imbalance_except(model, rows, &[])
+}
+
+/// [`worst_body_imbalance`] without the rows of the steps in `skip`: the
+/// steps solved in substeps, whose recorded forces are their first
+/// substep's (at `t_k`, over `Δt/n`), not a whole step's.
+pub fn worst_body_imbalance_except(
+    model: &Model,
+    rows: &[StepRecord],
+    skip: &[usize],
+) -> (f64, String) {
     let mech = &model.mech;
     let dt = model.params.dt;
     let mut worst = (0.0f64, String::new());
     for w in rows.windows(3) {
         let (prev, cur, next) = (&w[0], &w[1], &w[2]);
         assert_eq!(cur.step, prev.step + 1, "force balance needs stride 1");
+        if skip.contains(&cur.step) {
+            continue;
+        }
         let (xp, xk, xn) = (
             body_coords(model, &prev.q),
             body_coords(model, &cur.q),

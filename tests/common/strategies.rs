@@ -163,3 +163,43 @@ pub fn gait_params() -> impl Strategy<Value = fbd_sim::gait::GaitParams> {
             },
         )
 }
+
+/// A throw of the PD-held 3D stance onto the ground (tests of sliding
+/// friction): the body's horizontal velocity (direction any, 0.05–1.5 m/s),
+/// its spin about the vertical (±3 rad/s), the drop (0–3 cm), the body's
+/// mass (3–12 kg: the normal loads), μD (0.1–0.6) and μS/μD (1–1.5).
+#[derive(Clone, Copy, Debug)]
+pub struct SlideThrow {
+    pub heading: f64,
+    pub speed: f64,
+    pub spin: f64,
+    pub drop: f64,
+    pub body_mass: f64,
+    pub mu_dynamic: f64,
+    pub mu_ratio: f64,
+}
+
+/// A [`SlideThrow`] within the bounds above.
+#[allow(dead_code)]
+pub fn slide_throw() -> impl Strategy<Value = SlideThrow> {
+    (
+        0.0..TAU,
+        0.05..1.5f64,
+        -3.0..3.0f64,
+        0.0..0.03f64,
+        3.0..12.0f64,
+        0.1..0.6f64,
+        1.0..1.5f64,
+    )
+        .prop_map(
+            |(heading, speed, spin, drop, body_mass, mu_dynamic, mu_ratio)| SlideThrow {
+                heading,
+                speed,
+                spin,
+                drop,
+                body_mass,
+                mu_dynamic,
+                mu_ratio,
+            },
+        )
+}

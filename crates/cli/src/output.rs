@@ -532,7 +532,7 @@ pub enum Table {
         error: Option<io::Error>,
     },
     /// `trajectory.parquet` ([`crate::columnar`]).
-    Parquet(crate::columnar::ParquetTable),
+    Parquet(Box<crate::columnar::ParquetTable>),
 }
 
 impl Table {
@@ -559,9 +559,9 @@ impl Table {
                     error: None,
                 })
             }
-            fbd_scenario::OutputFormat::Parquet => Ok(Self::Parquet(
+            fbd_scenario::OutputFormat::Parquet => Ok(Self::Parquet(Box::new(
                 crate::columnar::ParquetTable::create(dir, columns, dt)?,
-            )),
+            ))),
         }
     }
 
@@ -594,7 +594,7 @@ impl Table {
                 }
             }
             Self::Parquet(p) => {
-                fill(p);
+                fill(&mut **p);
                 p.end_row();
             }
         }
@@ -873,6 +873,29 @@ pub struct Summary {
     /// State searches that found no consistent combination and were closed
     /// by the combination that violates the contact and limit laws least.
     pub resolved_cycles: usize,
+    /// State searches closed by a consistent combination found by trying
+    /// every combination of the few points involved.
+    pub enumerated_cycles: usize,
+    /// Solutions consistent by the switching rules that broke a contact or
+    /// limit law (the law audit) and were solved again in substeps.
+    pub rejected_solutions: usize,
+    /// Failed Newton solves the state search recovered from by sticking
+    /// its slowest slide.
+    pub newton_fallbacks: usize,
+    /// Substeps solved in retries, failed attempts included.
+    pub substeps: usize,
+    /// Re-solves that moved a fixed friction direction to the step's own
+    /// slip (slides Newton could not solve with the implicit direction).
+    pub direction_refinements: usize,
+    /// Accepted slides whose slip ran against their reference direction:
+    /// in 3D a slide turning back (its friction follows the slip: lawful);
+    /// in the plane a slide kept in ST3 running backwards (the planar
+    /// model is not audited: its friction then pushes along the slip).
+    pub backward_slides: usize,
+    /// The largest violation of a contact or joint-limit law over the
+    /// written rows (N); never above 1e-7 of the weight: a step that cannot
+    /// be solved that exactly ends the run with an error instead.
+    pub max_law_violation: f64,
     /// `"planar"`.
     pub model: &'static str,
     /// Time step (s).

@@ -25,9 +25,10 @@
 //! `speed_tol` and [`STOP_SPEED`], 1e-9 m/s, below which the friction
 //! direction is regularised) or turned back (by more than 90° in one
 //! step) — the planar rule, the sliding velocity reversing or vanishing;
-//! the point is anchored under `p[k]`. (A slide about to stop whose
-//! implicit direction has no solution keeps `û` for that step, the planar
-//! rule exactly: `fbd_sim::spatial::step`.)
+//! the point is anchored under `p[k]`. (When Newton cannot solve a
+//! slide's implicit direction, `fbd_sim::spatial::step` fixes it at `û`
+//! and moves it onto the slip found until the two agree: no written slide
+//! keeps an earlier step's direction.)
 //!
 //! With motion in the X–Y plane every vector has a zero `t2` component, û
 //! is `(±1, 0)` and each rule is the planar one: the planar engine and this

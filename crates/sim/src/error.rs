@@ -65,6 +65,28 @@ pub enum SimError {
         /// What failed.
         message: String,
     },
+    /// No state combination of the step, down to its finest substeps,
+    /// obeys every contact and joint-limit law: the step is not written
+    /// rather than written inexactly.
+    #[error(
+        "step {step} (t = {t:.6} s): no exact solution down to Δt/{substeps}: {point} breaks {law} by {amount:.3e} N (states [{states}])"
+    )]
+    Inexact {
+        /// Step index k.
+        step: usize,
+        /// Time k·Δt (s).
+        t: f64,
+        /// The finest subdivision tried.
+        substeps: usize,
+        /// The contact point (e.g. `tip5`) or joint (e.g. `theta2_3`).
+        point: String,
+        /// The law it breaks, e.g. `N ≥ 0`.
+        law: String,
+        /// By how much, as a force (N).
+        amount: f64,
+        /// The state combination of the best solution.
+        states: String,
+    },
     /// The state became NaN or infinite.
     #[error("step {step} (t = {t:.6} s): the state is not finite (residual {residual:.3e})")]
     NonFinite {
@@ -85,6 +107,7 @@ impl SimError {
             SimError::Newton { step, .. }
             | SimError::Cycling { step, .. }
             | SimError::NonFinite { step, .. }
+            | SimError::Inexact { step, .. }
             | SimError::Control { step, .. } => Some(*step),
             _ => None,
         }

@@ -197,8 +197,21 @@ impl JacobianSink for Sink<'_, '_> {
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Failure {
     Newton(fbd_solver::SolverError),
-    Cycle { residual: f64 },
-    NonFinite { residual: f64 },
+    Cycle {
+        residual: f64,
+    },
+    NonFinite {
+        residual: f64,
+    },
+    /// The best solution found breaks a law (the law audit of
+    /// [`crate::engine::search`]) at contact point (or, when `limit`, joint
+    /// limit) `index` by `amount` newtons.
+    Inexact {
+        index: usize,
+        limit: bool,
+        law: crate::engine::Law,
+        amount: f64,
+    },
 }
 
 impl Failure {
@@ -208,13 +221,38 @@ impl Failure {
             Failure::Newton(_) => "newton",
             Failure::Cycle { .. } => "cycle",
             Failure::NonFinite { .. } => "non-finite",
+            Failure::Inexact { .. } => "inexact",
         }
     }
 
-    /// The run's error for step `step` at `t`; `states` names the state
-    /// combination of a cycle (called only then).
-    pub(crate) fn error(self, step: usize, t: f64, states: impl FnOnce() -> String) -> SimError {
+    /// The run's error for step `step` at `t`, after trying down to
+    /// `substeps` substeps; `states` names the state combination of a cycle
+    /// and `name` a contact point or (`true`) joint limit (called only
+    /// then).
+    pub(crate) fn error(
+        self,
+        step: usize,
+        t: f64,
+        substeps: usize,
+        states: impl FnOnce() -> String,
+        name: impl FnOnce(usize, bool) -> String,
+    ) -> SimError {
         match self {
+            Failure::Inexact {
+                index,
+                limit,
+                law,
+                amount,
+                ..
+            } => SimError::Inexact {
+                step,
+                t,
+                substeps,
+                point: name(index, limit),
+                law: law.describe().into(),
+                amount,
+                states: states(),
+            },
             Failure::Newton(source) => SimError::Newton { step, t, source },
             Failure::Cycle { residual } => SimError::Cycling {
                 step,

@@ -35,6 +35,30 @@ pub struct RunSummary {
     /// State searches that cycled and were closed by their least
     /// inconsistent combination (see [`crate::step`]).
     pub resolved_cycles: usize,
+    /// State searches that cycled and were closed by a consistent
+    /// combination found by trying every combination of the points
+    /// involved.
+    pub enumerated_cycles: usize,
+    /// Solutions consistent by the switching rules that broke a law (the
+    /// law audit) and were solved again in substeps.
+    pub rejected_solutions: usize,
+    /// Failed Newton solves the state search recovered from by changing
+    /// the trial states.
+    pub newton_fallbacks: usize,
+    /// Substeps solved in retries, failed attempts included.
+    pub substeps: usize,
+    /// Re-solves that moved a fixed friction direction to the step's own
+    /// slip (a slide Newton could not solve with the implicit direction).
+    pub direction_refinements: usize,
+    /// Accepted slides whose slip ran against their reference direction:
+    /// in 3D a slide turning back (its friction follows the slip: lawful);
+    /// in the plane a slide kept in ST3 running backwards (the planar
+    /// model is not audited: its friction then pushes along the slip).
+    pub backward_slides: usize,
+    /// The largest violation of a contact or joint-limit law (N) over the
+    /// written solutions: at most the model's cycle tolerance (1e-7 of the
+    /// weight).
+    pub max_law_violation: f64,
     /// `true` when the `stop` flag of [`run_until`] ended the run before
     /// its last step (the steps solved so far are valid).
     pub interrupted: bool,

@@ -15,7 +15,7 @@
 //! pull it there instead of pushing it away.
 
 use crate::energy;
-use crate::engine::{Engine, LimitInfo, Settings};
+use crate::engine::{Engine, Law, LimitInfo, Settings};
 use crate::record::{LimitCode, StepRecord};
 use crate::rules::regularization;
 pub use crate::system::StepSystem;
@@ -52,6 +52,7 @@ impl Engine for Model {
             dt: Model::dt(self),
             max_substeps: self.max_substeps,
             cycle_tolerance: self.cycle_tolerance,
+            exact: false,
             qdot0: &self.params.qdot0,
             steps: self.steps,
             stride: self.params.stride,
@@ -110,16 +111,37 @@ impl Engine for Model {
     fn friction_at(&self, at: [f64; 2]) -> Friction {
         friction_at(&self.params.patches, &self.params.friction, at[0], at[1])
     }
-    fn contact_violation(&self, data: &Data, state: &ContactState, t: &Trial) -> f64 {
+    fn contact_violation(&self, data: &Data, state: &ContactState, t: &Trial) -> (f64, Law) {
+        // The planar model keeps its search's measure (its outputs are
+        // unchanged; it is not audited, see `Settings::exact`).
         let k = data.fbd.position_gain;
         let mu = self.friction_at([t.p_k[0], 0.0]).mu_static;
         match *state {
-            ContactState::Free => k * (-self.params.terrain.clearance(t.p_next)).max(0.0),
-            ContactState::Stick { .. } => (-t.n).max(0.0) + (t.fa.abs() - mu * t.n).max(0.0),
+            ContactState::Free => (
+                k * (-self.params.terrain.clearance(t.p_next)).max(0.0),
+                Law::Penetration,
+            ),
+            ContactState::Stick { .. } => {
+                let (pull, cone) = ((-t.n).max(0.0), (t.fa.abs() - mu * t.n).max(0.0));
+                (
+                    pull + cone,
+                    if pull >= cone {
+                        Law::Pull
+                    } else {
+                        Law::StaticCone
+                    },
+                )
+            }
             ContactState::Slide { dir } => {
                 let along = (t.p_next[0] - t.p_k[0]) * t.tangent[0]
                     + (t.p_next[1] - t.p_k[1]) * t.tangent[1];
-                (-t.n).max(0.0) + k * (-along * dir).max(0.0)
+                let (pull, back) = ((-t.n).max(0.0), k * (-along * dir).max(0.0));
+                let law = if pull >= back {
+                    Law::Pull
+                } else {
+                    Law::SlideBackwards
+                };
+                (pull + back, law)
             }
         }
     }

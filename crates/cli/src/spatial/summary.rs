@@ -76,6 +76,29 @@ pub struct SpatialSummary {
     pub retried_steps: usize,
     /// State searches closed by their least inconsistent combination.
     pub resolved_cycles: usize,
+    /// State searches closed by a consistent combination found by trying
+    /// every combination of the few points involved.
+    pub enumerated_cycles: usize,
+    /// Solutions consistent by the switching rules that broke a contact or
+    /// limit law (the law audit) and were solved again in substeps.
+    pub rejected_solutions: usize,
+    /// Failed Newton solves the state search recovered from by sticking
+    /// its slowest slide.
+    pub newton_fallbacks: usize,
+    /// Substeps solved in retries, failed attempts included.
+    pub substeps: usize,
+    /// Re-solves that moved a fixed friction direction to the step's own
+    /// slip (slides Newton could not solve with the implicit direction).
+    pub direction_refinements: usize,
+    /// Accepted slides whose slip ran against their reference direction:
+    /// in 3D a slide turning back (its friction follows the slip: lawful);
+    /// in the plane a slide kept in ST3 running backwards (the planar
+    /// model is not audited: its friction then pushes along the slip).
+    pub backward_slides: usize,
+    /// The largest violation of a contact or joint-limit law over the
+    /// written rows (N); never above 1e-7 of the weight: a step that cannot
+    /// be solved that exactly ends the run with an error instead.
+    pub max_law_violation: f64,
     /// `"hexapod"`.
     pub model: &'static str,
     /// `"dynamic"` (the 3D FBD dynamics; a kinematic run says `walking` or
@@ -288,6 +311,13 @@ impl Collector {
                 .collect(),
             retried_steps: run.retries.len(),
             resolved_cycles: run.resolved_cycles,
+            enumerated_cycles: run.enumerated_cycles,
+            rejected_solutions: run.rejected_solutions,
+            newton_fallbacks: run.newton_fallbacks,
+            substeps: run.substeps,
+            direction_refinements: run.direction_refinements,
+            backward_slides: run.backward_slides,
+            max_law_violation: run.max_law_violation,
             model: "hexapod",
             run: "dynamic",
             control: match params.control {

@@ -144,6 +144,10 @@ pub struct SpatialFbdData {
     /// (the planar rule, used when the implicit direction has no solution:
     /// a slide about to stop), instead of following the step's slip.
     pub fixed_direction: Vec<bool>,
+    /// Per contact: its fixed direction was released to the implicit law
+    /// once in this step's search (`fbd_sim`'s direction refinement does
+    /// it at most once a step).
+    pub released_direction: Vec<bool>,
     /// Per contact, `max(|w|, ε)` of [`slip_direction`] at the last
     /// evaluated iterate (m).
     pub slip_len: Vec<f64>,
@@ -159,8 +163,15 @@ pub struct SpatialFbdData {
 /// state machine switches such a slide to ST2.
 pub use fbd_contact::spatial::STOP_SPEED;
 
+/// The bias of [`slip_direction`] as a fraction of `ε`: `w = s + b·ε·u`.
+/// Small enough that the direction of every slip faster than the stop
+/// speed (`|s| > ε`) is the slip's own to `b` rad (1e-9), far below the
+/// friction law's tolerance; nonzero, so that a slip that has not started
+/// yet still has a direction.
+pub const SLIP_BIAS: f64 = 1e-9;
+
 /// The direction of a sliding point's friction over the step (`(t1, t2)`
-/// components): `ŝ = w/max(|w|, ε)`, `w = s + ½ε·u`, with `s` the slip
+/// components): `ŝ = w/max(|w|, ε)`, `w = s + b·ε·u` ([`SLIP_BIAS`]), with `s` the slip
 /// from `p[k]` to `p[k+1]` in the tangent plane, `u` the slide's reference
 /// direction (the last step's slip, or at the start of a slide the
 /// opposite of the force sticking needed) and `ε = STOP_SPEED·Δt`.
@@ -168,12 +179,13 @@ pub use fbd_contact::spatial::STOP_SPEED;
 /// everything at k+1) — exactly Coulomb's `s/|s|` for every slip faster
 /// than 1e-9 m/s; slower, it is regularised (linear in `w`), so that the
 /// equations always have a solution, and the slide counts as stopped. The
-/// bias `½ε·u` only picks the direction of a slip that has not started yet
-/// and turns a real slip's direction by at most `ε/(2|s|)` (5e-8 rad at
-/// 1 cm/s at Δt = 1 ms). Returns `(ŝ, max(|w|, ε))`.
+/// bias `b·ε·u` only picks the direction of a slip that has not started yet
+/// and turns a real slip's direction by at most `b·ε/|s|` ≤ 1e-9 rad.
+/// Returns `(ŝ, max(|w|, ε))`.
 #[inline]
 pub fn slip_direction(s: [f64; 2], u: [f64; 2], eps: f64) -> ([f64; 2], f64) {
-    let w = [s[0] + 0.5 * eps * u[0], s[1] + 0.5 * eps * u[1]];
+    let b = SLIP_BIAS * eps;
+    let w = [s[0] + b * u[0], s[1] + b * u[1]];
     let len = w[0].hypot(w[1]).max(eps);
     ([w[0] / len, w[1] / len], len)
 }
@@ -205,6 +217,7 @@ impl SpatialFbdData {
             slip_hat: vec![[0.0; 2]; mech.contacts.len()],
             slip_len: vec![1.0; mech.contacts.len()],
             fixed_direction: vec![false; mech.contacts.len()],
+            released_direction: vec![false; mech.contacts.len()],
             slip_n: vec![0.0; mech.contacts.len()],
             wrench: vec![Wrench::default(); nb],
             rot_d: vec![Matrix3::zeros(); nb],

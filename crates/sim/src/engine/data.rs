@@ -55,6 +55,26 @@ pub struct RunData<M: Engine> {
     /// combination found by trying every combination of the points and
     /// joint limits involved (see [`super::search`]).
     pub enumerated_cycles: usize,
+    /// Solutions consistent by the switching rules that the law audit
+    /// rejected ([`super::search`]): the step was retried.
+    pub rejected_solutions: usize,
+    /// Failed Newton solves after which the search changed the trial
+    /// states and went on ([`Engine::newton_fallback`]).
+    pub newton_fallbacks: usize,
+    /// Re-solves that moved a fixed friction direction to the step's slip
+    /// ([`Engine::refine_directions`]).
+    pub direction_refinements: usize,
+    /// Accepted slides whose slip ran against their reference direction:
+    /// in 3D a slide turning back (its friction follows the slip: lawful);
+    /// in the plane a slide kept in ST3 running backwards (the planar
+    /// model is not audited: its friction then pushes along the slip).
+    pub backward_slides: usize,
+    /// Substeps solved over all retries (all attempts, failed ones
+    /// included).
+    pub substeps: usize,
+    /// The largest law violation (N) of the accepted solutions (at most the
+    /// model's cycle tolerance).
+    pub max_law_violation: f64,
     /// Joint torques applied at the next step instead of the controller's,
     /// when `Some`; kept until changed. For controllers outside the
     /// simulator.
@@ -106,7 +126,9 @@ pub struct RunData<M: Engine> {
     /// change the trial ones.
     pub(crate) checked_trial: Vec<M::State>,
     pub(crate) checked_limits: Vec<LimitState>,
-    /// Set while solving the finest substeps of a retried step.
+    /// Set while solving the finest substeps of a retried step (a model
+    /// without [`super::Settings::exact`] then closes a cycling search by
+    /// its least inconsistent trial).
     pub(crate) last_resort: bool,
     /// Whether the next step's record is made (`true` unless a run skips
     /// the rows it does not hand out, [`super::run::run_until`]).
@@ -164,6 +186,12 @@ impl<M: Engine> RunData<M> {
             max_step_iterations: 0,
             resolved_cycles: 0,
             enumerated_cycles: 0,
+            rejected_solutions: 0,
+            newton_fallbacks: 0,
+            substeps: 0,
+            direction_refinements: 0,
+            backward_slides: 0,
+            max_law_violation: 0.0,
             external_torque: None,
             record,
             control,
@@ -215,7 +243,7 @@ where
 {
     fn clone(&self) -> Self {
         Self {
-            k: self.k.clone(),
+            k: self.k,
             q_prev: self.q_prev.clone(),
             q_prev2: self.q_prev2.clone(),
             q: self.q.clone(),
@@ -227,11 +255,17 @@ where
             limit_states: self.limit_states.clone(),
             limit_events: self.limit_events.clone(),
             retries: self.retries.clone(),
-            newton_iterations: self.newton_iterations.clone(),
-            chord_iterations: self.chord_iterations.clone(),
-            max_step_iterations: self.max_step_iterations.clone(),
-            resolved_cycles: self.resolved_cycles.clone(),
-            enumerated_cycles: self.enumerated_cycles.clone(),
+            newton_iterations: self.newton_iterations,
+            chord_iterations: self.chord_iterations,
+            max_step_iterations: self.max_step_iterations,
+            resolved_cycles: self.resolved_cycles,
+            enumerated_cycles: self.enumerated_cycles,
+            rejected_solutions: self.rejected_solutions,
+            newton_fallbacks: self.newton_fallbacks,
+            direction_refinements: self.direction_refinements,
+            backward_slides: self.backward_slides,
+            substeps: self.substeps,
+            max_law_violation: self.max_law_violation,
             external_torque: self.external_torque.clone(),
             predictor: self.predictor.clone(),
             record: self.record.clone(),
@@ -249,18 +283,18 @@ where
             grid_q_prev2: self.grid_q_prev2.clone(),
             grid_states: self.grid_states.clone(),
             grid_limits: self.grid_limits.clone(),
-            grid_events: self.grid_events.clone(),
+            grid_events: self.grid_events,
             failed_trial: self.failed_trial.clone(),
             failed_limits: self.failed_limits.clone(),
             start_z: self.start_z.clone(),
-            best_violation: self.best_violation.clone(),
+            best_violation: self.best_violation,
             best_z: self.best_z.clone(),
             best_trial: self.best_trial.clone(),
             best_limits: self.best_limits.clone(),
             checked_trial: self.checked_trial.clone(),
             checked_limits: self.checked_limits.clone(),
-            last_resort: self.last_resort.clone(),
-            want_record: self.want_record.clone(),
+            last_resort: self.last_resort,
+            want_record: self.want_record,
         }
     }
 }

@@ -39,6 +39,56 @@ use fbd_dynamics::{ContactSpec, History, PointKind};
 use fbd_kinematics::{Joint, JointLimits};
 use fbd_solver::{NewtonReport, SolverError};
 
+/// The law a trial solution breaks ([`Engine::contact_violation`],
+/// [`search::worst_violation`]), named in the error of a step that cannot
+/// be closed exactly.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Law {
+    /// Every law holds.
+    None,
+    /// A free point ends the step below the ground.
+    Penetration,
+    /// A contact pulls on the ground (`N < 0`).
+    Pull,
+    /// A sticking point needs more than `μS·N`.
+    StaticCone,
+    /// A sliding point slips backwards against its slide.
+    SlideBackwards,
+    /// A sliding point's friction is not `μD·N`.
+    SlideMagnitude,
+    /// A sliding point's friction does not oppose the step's slip.
+    SlideDirection,
+    /// A free joint ends the step beyond an end of its range.
+    LimitCrossing,
+    /// A joint stop pulls its joint towards the end.
+    LimitPull,
+}
+
+impl Law {
+    /// The law, as the error message names it.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Law::None => "no law",
+            Law::Penetration => "no penetration of a free point (ST1)",
+            Law::Pull => "N ≥ 0",
+            Law::StaticCone => "|Ft| ≤ μS·N of a sticking point (ST2)",
+            Law::SlideBackwards => "a slide (ST3) moves forwards",
+            Law::SlideMagnitude => "|Ft| = μD·N of a sliding point (ST3)",
+            Law::SlideDirection => "Ft = −μD·N·ŝ opposing the slip (ST3)",
+            Law::LimitCrossing => "a free joint stays within its range",
+            Law::LimitPull => "a joint stop pushes (never pulls)",
+        }
+    }
+}
+
+/// The largest of some `(violation, law)` pairs (the first of equals).
+#[inline]
+pub fn worst<const N: usize>(parts: [(f64, Law); N]) -> (f64, Law) {
+    parts
+        .into_iter()
+        .fold((0.0, Law::None), |w, p| if p.0 > w.0 { p } else { w })
+}
+
 /// A joint limit's identity.
 #[derive(Clone, Copy, Debug)]
 pub struct LimitInfo {
@@ -60,8 +110,18 @@ pub struct Settings<'a, G: ?Sized> {
     /// Finest subdivision of a step that cannot be solved whole.
     pub max_substeps: usize,
     /// A cycling state search is closed by its least inconsistent trial
-    /// when that trial violates the laws by at most this force (N).
+    /// when that trial violates the laws by at most this force (N); every
+    /// accepted solution obeys every law to this force (the law audit of
+    /// [`search`]), or the step is retried in substeps and finally fails.
     pub cycle_tolerance: f64,
+    /// Whether every written row must obey the laws (the spatial model):
+    /// the law audit of [`search`] checks every accepted solution and a
+    /// step that cannot be solved exactly fails instead of being closed by
+    /// its least inconsistent trial at the finest substeps. `false` (the
+    /// planar model) keeps the earlier rule: no audit, and at the finest
+    /// substeps a cycling search is closed by its least inconsistent
+    /// trial whatever its violation.
+    pub exact: bool,
     /// Initial generalised velocities (one per coordinate of `q`).
     pub qdot0: &'a [f64],
     /// Steps of a run.
@@ -116,6 +176,10 @@ pub trait Engine: Sized {
     /// Largest violation a cycling search may close with (N).
     fn cycle_tolerance(&self) -> f64 {
         self.settings().cycle_tolerance
+    }
+    /// Whether rows must be exact ([`Settings::exact`]).
+    fn exact(&self) -> bool {
+        self.settings().exact
     }
     /// Initial generalised velocities.
     fn qdot0(&self) -> &[f64] {
@@ -197,13 +261,13 @@ pub trait Engine: Sized {
     /// Point `c`'s view of the last solution.
     fn trial(&self, data: &RunData<Self>, c: usize) -> Self::Trial;
     /// How far a point's trial is from the law of `state`, the state it
-    /// was solved in (N).
+    /// was solved in (N), and the law it breaks most.
     fn contact_violation(
         &self,
         data: &RunData<Self>,
         state: &Self::State,
         trial: &Self::Trial,
-    ) -> f64;
+    ) -> (f64, Law);
     /// The position gain of the stop rows over the length scale (N/rad),
     /// which turns a joint's overshoot into a force.
     fn limit_gain(&self, data: &RunData<Self>) -> f64;
@@ -223,6 +287,14 @@ pub trait Engine: Sized {
     /// After a failed Newton solve: changes the trial states so that the
     /// search may go on (`true`), or gives up (`false`, the default).
     fn newton_fallback(&self, _data: &mut RunData<Self>) -> bool {
+        false
+    }
+    /// After a converged solve: moves the fixed friction directions of
+    /// slides that keep one ([`Engine::newton_fallback`]) to the slip the
+    /// solution found, when they differ (`true`: solve again). Iterated,
+    /// the fixed direction converges to the step's own slip direction, the
+    /// solution of the implicit law that Newton could not reach directly.
+    fn refine_directions(&self, _data: &mut RunData<Self>) -> bool {
         false
     }
     /// The kinematics at `q[k−1]` from `data.q_prev`.

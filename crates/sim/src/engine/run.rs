@@ -71,6 +71,13 @@ fn summary<M: Engine>(
         limit_events: data.limit_events,
         retries: data.retries,
         resolved_cycles: data.resolved_cycles,
+        enumerated_cycles: data.enumerated_cycles,
+        rejected_solutions: data.rejected_solutions,
+        newton_fallbacks: data.newton_fallbacks,
+        substeps: data.substeps,
+        direction_refinements: data.direction_refinements,
+        backward_slides: data.backward_slides,
+        max_law_violation: data.max_law_violation,
         interrupted,
     }
 }

@@ -24,15 +24,32 @@
 //! switches away (a foot that slides *and* a knee that leaves its stop).
 //! Then the least inconsistent trial of the search is accepted when its
 //! violation of the contact and limit laws ([`violation`]) is negligible
-//! (or at the finest substeps); otherwise the step is retried in substeps.
+//! (at most the model's cycle tolerance, 1e-7 of the weight); otherwise the
+//! step is retried in substeps, and at the finest substeps the run stops
+//! with an error naming the point and the law ([`Failure::Inexact`]):
+//! an inexact trial is never accepted. (The planar model, whose
+//! [`super::Settings::exact`] is `false`, keeps the earlier rule: at the
+//! finest substeps the least inconsistent trial is accepted.)
+//!
+//! **Law audit** (models with [`super::Settings::exact`]: the spatial
+//! one). Every solution the search accepts — consistent by the
+//! switching rules, or closed as above — is checked against every law of
+//! the states it was solved in ([`worst_violation`]): no penetration of a
+//! free point beyond the penetration tolerance, `N ≥ 0`, `|Ft| ≤ μS·N`
+//! when sticking, and when sliding `Ft = −μD·N·ŝ` with `ŝ` the unit slip
+//! of the step itself (magnitude *and* direction), every joint within its
+//! range and every stop pushing. A solution that breaks one by more than
+//! 1e-6 of the weight ([`LAW_TOLERANCE`]) is rejected like an unclosable cycle (counted in
+//! [`RunData::rejected_solutions`]); the largest violation of the accepted
+//! ones is [`RunData::max_law_violation`].
 //!
 //! **Joint limits** are one-sided, plastic stops: a free joint whose trial
 //! angle crosses an end of its range is held at that end; a joint at an
 //! end is released when the stop's moment would pull it there instead of
 //! pushing it away ([`crate::rules`]).
 
-use super::{Engine, RunData};
-use crate::rules::{Failure, MAX_STATE_TRIALS, limit_arrival, limit_release};
+use super::{Engine, Law, RunData};
+use crate::rules::{Failure, LIMIT_ANGLE_TOL, MAX_STATE_TRIALS, limit_arrival, limit_release};
 use fbd_contact::{ContactMode, ContactTrial, StateCode, switch};
 use fbd_dynamics::LimitState;
 
@@ -57,6 +74,7 @@ pub(crate) fn solve<M: Engine>(
     data: &mut RunData<M>,
 ) -> Result<(usize, usize), Failure> {
     let mut fallback_used = false;
+    let mut refinements = 0;
     let mut newton_iterations = 0;
     let mut trials = 0;
     loop {
@@ -65,6 +83,7 @@ pub(crate) fn solve<M: Engine>(
             Ok(report) => report,
             Err(e) => {
                 if trials < MAX_STATE_TRIALS && model.newton_fallback(data) {
+                    data.newton_fallbacks += 1;
                     data.z.copy_from_slice(&data.start_z);
                     continue;
                 }
@@ -79,9 +98,25 @@ pub(crate) fn solve<M: Engine>(
             });
         }
         model.evaluate_next(data);
+        if refinements < MAX_DIRECTION_REFINEMENTS && model.refine_directions(data) {
+            refinements += 1;
+            data.direction_refinements += 1;
+            continue;
+        }
         data.checked_trial.copy_from_slice(&data.trial);
         data.checked_limits.copy_from_slice(&data.limit_trial);
         if !check_states(model, data) {
+            // Consistent by the switching rules: the law audit.
+            if !model.exact() {
+                break;
+            }
+            let worst = worst_violation(model, data, &data.trial, &data.limit_trial);
+            if worst.amount > LAW_TOLERANCE * model.cycle_tolerance() {
+                data.rejected_solutions += 1;
+                return Err(worst.failure());
+            }
+            data.max_law_violation = data.max_law_violation.max(worst.amount);
+            count_backward(model, data);
             break;
         }
         // An inconsistent solution: kept if it is the least inconsistent
@@ -105,8 +140,17 @@ pub(crate) fn solve<M: Engine>(
                 data.trial.copy_from_slice(&data.best_trial);
                 data.limit_trial.copy_from_slice(&data.best_limits);
                 model.evaluate_next(data);
+                data.max_law_violation = data.max_law_violation.max(data.best_violation);
+                count_backward(model, data);
                 data.resolved_cycles += 1;
                 break;
+            }
+            if data.best_violation.is_finite() {
+                // Name the point and the law of the least inconsistent trial.
+                data.z.copy_from_slice(&data.best_z);
+                model.evaluate_next(data);
+                let worst = worst_violation(model, data, &data.best_trial, &data.best_limits);
+                return Err(worst.failure());
             }
             return Err(Failure::Cycle {
                 residual: report.residual,
@@ -117,6 +161,30 @@ pub(crate) fn solve<M: Engine>(
     data.newton_iterations += newton_iterations;
     Ok((newton_iterations, trials))
 }
+
+/// Counts the accepted slides whose slip runs against their reference
+/// direction ([`RunData::backward_slides`]).
+fn count_backward<M: Engine>(model: &M, data: &mut RunData<M>) {
+    for c in 0..data.trial.len() {
+        if data.trial[c].code() == StateCode::St3 {
+            let trial = model.trial(data, c);
+            if trial.slip_speed(&data.trial[c]) < 0.0 {
+                data.backward_slides += 1;
+            }
+        }
+    }
+}
+
+/// The law audit's tolerance in units of the cycle tolerance: 10, i.e.
+/// 1e-6 of the robot's weight (0.18 mN on the default hexapod). The
+/// solver's convergence scale of a friction row grows with the position
+/// gain at small substeps (a few 1e-5 N at Δt/64), above the cycle
+/// tolerance, far below any physical force.
+const LAW_TOLERANCE: f64 = 10.0;
+
+/// Most re-solves of one search that move fixed friction directions to
+/// the slip found ([`Engine::refine_directions`]).
+const MAX_DIRECTION_REFINEMENTS: usize = 40;
 
 /// Keeps the solution in `data.z`, solved in the states
 /// `data.checked_trial` and `data.checked_limits`, as the search's least
@@ -385,40 +453,96 @@ fn enumerate_states<M: Engine>(
     false
 }
 
+/// The worst law violation of a trial solution: how much (N), which law,
+/// and where (a contact point, or a joint limit when `limit`).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Worst {
+    pub amount: f64,
+    pub law: Law,
+    pub index: usize,
+    pub limit: bool,
+}
+
+impl Worst {
+    /// The failure of a step whose best solution breaks this law.
+    pub(crate) fn failure(self) -> Failure {
+        Failure::Inexact {
+            index: self.index,
+            limit: self.limit,
+            law: self.law,
+            amount: self.amount,
+        }
+    }
+}
+
 /// How far the trial solution is from satisfying the law of the state it
 /// was solved in, as a force (N): penetration of a free point or crossing
-/// of a free joint (times the position gain), a pulling contact or stop,
-/// friction beyond μS·N when sticking, a slide running backwards
+/// of a free joint beyond the switching tolerances (times the position
+/// gain), a pulling contact or stop, friction beyond μS·N when sticking, a
+/// slide running backwards or whose friction is not `−μD·N·ŝ`
 /// ([`Engine::contact_violation`]). The largest over all points and
-/// limits; 0 for a consistent solution.
-pub(crate) fn violation<M: Engine>(
+/// limits, with its law and place; 0 for a consistent solution.
+pub(crate) fn worst_violation<M: Engine>(
     model: &M,
     data: &RunData<M>,
     states: &[M::State],
     limits: &[LimitState],
-) -> f64 {
-    let mut worst: f64 = 0.0;
+) -> Worst {
+    let mut worst = Worst {
+        amount: 0.0,
+        law: Law::None,
+        index: 0,
+        limit: false,
+    };
     for (c, state) in states.iter().enumerate() {
         let trial = model.trial(data, c);
-        worst = worst.max(model.contact_violation(data, state, &trial));
+        let (v, law) = model.contact_violation(data, state, &trial);
+        if v > worst.amount {
+            worst = Worst {
+                amount: v,
+                law,
+                index: c,
+                limit: false,
+            };
+        }
     }
     let length = model.length_scale(data);
     let gain = model.limit_gain(data);
     for (l, state) in limits.iter().enumerate() {
         let info = model.limit(l);
         let angle = data.z[info.q_index];
-        let v = match *state {
+        let (v, law) = match *state {
             LimitState::Free => {
                 let [lo, hi] = model.joint_limits().range(info.joint);
-                gain / length * (lo - angle).max(angle - hi).max(0.0)
+                let tol = if model.exact() { LIMIT_ANGLE_TOL } else { 0.0 };
+                let beyond = (lo - angle).max(angle - hi) - tol;
+                (gain / length * beyond.max(0.0), Law::LimitCrossing)
             }
-            LimitState::At { side, .. } => {
-                (-side.sign() * data.z[model.limit_moment_index(l)] / length).max(0.0)
-            }
+            LimitState::At { side, .. } => (
+                (-side.sign() * data.z[model.limit_moment_index(l)] / length).max(0.0),
+                Law::LimitPull,
+            ),
         };
-        worst = worst.max(v);
+        if v > worst.amount {
+            worst = Worst {
+                amount: v,
+                law,
+                index: l,
+                limit: true,
+            };
+        }
     }
     worst
+}
+
+/// The amount of [`worst_violation`] (N).
+pub(crate) fn violation<M: Engine>(
+    model: &M,
+    data: &RunData<M>,
+    states: &[M::State],
+    limits: &[LimitState],
+) -> f64 {
+    worst_violation(model, data, states, limits).amount
 }
 
 /// `true` when every value is finite: one pass without an exit per value

@@ -9,7 +9,10 @@
 //! torques, and the next full step continues from `q[k]` and `q[k+1]`: rows
 //! stay on the Δt grid. Each retried step is a [`RetryEvent`]; its record
 //! is the first substep's (forces at `t_k`) with the iterations and solves
-//! of all of them.
+//! of all of them. A step that cannot be solved exactly even at
+//! `Δt/max_substeps` (its best solution breaks a contact or limit law,
+//! [`super::search`]) ends the run with [`SimError::Inexact`], naming the
+//! point and the law; the rows before it are kept.
 
 use super::search::{describe_states, solve, start_search};
 use super::{Engine, RunData};
@@ -48,12 +51,17 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
     data.failed_trial.copy_from_slice(&data.trial);
     data.failed_limits.copy_from_slice(&data.limit_trial);
     let mut n = 2;
+    let mut last = first;
+    let mut finest = 1;
     while n <= model.max_substeps() {
-        // At the finest subdivision a cycling state search is closed by
-        // its least inconsistent trial, whatever its violation.
-        data.last_resort = n == model.max_substeps();
+        // Without exact rows, at the finest subdivision a cycling state
+        // search is closed by its least inconsistent trial, whatever its
+        // violation.
+        data.last_resort = !model.exact() && n == model.max_substeps();
         let result = substeps(model, data, n);
         data.last_resort = false;
+        finest = n;
+        data.substeps += n;
         match result {
             Ok(iterations) => {
                 data.max_step_iterations = data.max_step_iterations.max(iterations);
@@ -66,15 +74,32 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
                 data.k += 1;
                 return Ok(());
             }
-            Err(_) => {
+            Err(f) => {
+                last = f;
                 restore_grid(model, data);
                 n *= 2;
             }
         }
     }
-    Err(first.error(k, t, || {
-        describe_states(model, &data.failed_trial, &data.failed_limits)
-    }))
+    // A step with no exact solution names the law its finest attempt
+    // breaks; otherwise the whole step's failure is the error.
+    let (failure, states, limits) = match last {
+        Failure::Inexact { .. } => (last, &data.best_trial, &data.best_limits),
+        _ => (first, &data.failed_trial, &data.failed_limits),
+    };
+    Err(failure.error(
+        k,
+        t,
+        finest,
+        || describe_states(model, states, limits),
+        |i, limit| {
+            if limit {
+                model.limit_name(i)
+            } else {
+                model.contact_name(i).to_string()
+            }
+        },
+    ))
 }
 
 /// Stages 1–3 of [`step`]: the constants of step `data.k`, the joint

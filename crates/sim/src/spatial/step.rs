@@ -10,11 +10,18 @@
 //! placement of anchors on one body in 3D, the record with its momenta.
 //! Two things only a 3D slide needs:
 //!
-//! * a slide about to stop can leave the implicit friction direction
-//!   without a solution (the direction of a vanishing slip is undefined):
-//!   when Newton fails, the slides keep their reference direction (the
-//!   planar rule); if that fails too, the slowest sliding point sticks
-//!   under `p[k]` and the search goes on ([`Engine::newton_fallback`]);
+//! * Newton may fail on the implicit friction direction (a slide about to
+//!   stop or turning fast: the direction's derivative is `μD·N/|s|`).
+//!   Then the slides' directions are fixed at their reference directions
+//!   and solved, and each fixed direction is moved to the slip the
+//!   solution found and solved again, until the two agree to 1e-10 rad
+//!   ([`Engine::refine_directions`]: a fixed-point iteration that reaches
+//!   the implicit law's solution); if Newton fails even so, the slowest
+//!   sliding point sticks under `p[k]` and the search goes on
+//!   ([`Engine::newton_fallback`]). A slide never keeps an earlier step's
+//!   direction: every written ST3 row has `Ft = −μD·N·ŝ` with `ŝ` the
+//!   step's own unit slip (the law audit of [`crate::engine::search`]
+//!   checks it, and rejects a solution whose refinement did not converge);
 //! * on acceptance a sliding point's reference direction becomes the
 //!   step's slip direction.
 
@@ -22,10 +29,10 @@ use super::control::{joint_rates, joint_torques};
 use super::data::SpatialData;
 use super::model::SpatialModel;
 use crate::SimError;
-use crate::engine::{Engine, LimitInfo, Settings};
+use crate::engine::{Engine, Law, LimitInfo, Settings, worst};
 use crate::record::LimitCode;
 use crate::rules::{Sink, regularization};
-use fbd_contact::spatial::{clearance, frame, point_at_distance, project};
+use fbd_contact::spatial::{STOP_SPEED, clearance, frame, point_at_distance, project};
 use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
@@ -88,6 +95,7 @@ impl Engine for SpatialModel {
             dt: SpatialModel::dt(self),
             max_substeps: self.max_substeps,
             cycle_tolerance: self.cycle_tolerance,
+            exact: true,
             qdot0: &self.params.qdot0,
             steps: self.steps,
             stride: self.params.stride,
@@ -124,6 +132,7 @@ impl Engine for SpatialModel {
     fn kinematics(&self, data: &mut SpatialData, history: History<'_>, h: f64) {
         prepare_step(&self.mech, &mut data.fbd, history, h);
         data.fbd.fixed_direction.fill(false);
+        data.fbd.released_direction.fill(false);
     }
     fn torques(&self, data: &mut SpatialData) -> Result<(), SimError> {
         joint_torques(self, data)
@@ -144,21 +153,55 @@ impl Engine for SpatialModel {
             .terrain
             .friction_at(&self.params.friction, at[0], at[1])
     }
-    fn contact_violation(&self, data: &SpatialData, state: &SpatialState, t: &SpatialTrial) -> f64 {
+    fn contact_violation(
+        &self,
+        data: &SpatialData,
+        state: &SpatialState,
+        t: &SpatialTrial,
+    ) -> (f64, Law) {
         let k = data.fbd.position_gain;
         let friction = self.friction_at([t.p_k[0], t.p_k[2]]);
-        let mu = friction.mu_static;
+        let (mu_s, mu_d) = (friction.mu_static, friction.mu_dynamic);
+        let pull = (-t.n).max(0.0);
+        let ft = t.ft[0].hypot(t.ft[1]);
         match *state {
-            SpatialState::Free => k * (-clearance(&self.params.terrain, t.p_next)).max(0.0),
-            SpatialState::Stick { .. } => {
-                (-t.n).max(0.0) + (t.ft[0].hypot(t.ft[1]) - mu * t.n).max(0.0)
+            SpatialState::Free => {
+                let depth = -clearance(&self.params.terrain, t.p_next)
+                    - self.params.contact.penetration_tol;
+                (k * depth.max(0.0), Law::Penetration)
             }
+            SpatialState::Stick { .. } => worst([
+                (pull, Law::Pull),
+                ((ft - mu_s * t.n).max(0.0), Law::StaticCone),
+            ]),
             SpatialState::Slide { dir } => {
-                // A slide slower than the stop speed carries less than μD·N
-                // (regularised direction): that deficit is a violation too.
+                // Coulomb's sliding law with the step's own slip s:
+                // Ft = −μD·N·s/|s|, whatever the reference direction `dir`
+                // (a slide may turn, even back). A slip slower than the
+                // stop speed has no direction: its slide has stopped, and
+                // the deficit of |Ft| below μD·N (regularised direction)
+                // and the turn back are the violation.
                 let s = t.slip();
-                let deficit = friction.mu_dynamic * t.n - t.ft[0].hypot(t.ft[1]);
-                (-t.n).max(0.0) + k * (-(s[0] * dir[0] + s[1] * dir[1])).max(0.0) + deficit.max(0.0)
+                let len = s[0].hypot(s[1]);
+                let mdn = mu_d * t.n;
+                let backwards = if len > STOP_SPEED * t.dt {
+                    0.0
+                } else {
+                    k * (-(s[0] * dir[0] + s[1] * dir[1])).max(0.0)
+                };
+                let law = if len > STOP_SPEED * t.dt {
+                    let e = [t.ft[0] + mdn * s[0] / len, t.ft[1] + mdn * s[1] / len];
+                    let along = (ft - mdn).abs();
+                    let off = e[0].hypot(e[1]);
+                    if off > along {
+                        (off, Law::SlideDirection)
+                    } else {
+                        (along, Law::SlideMagnitude)
+                    }
+                } else {
+                    ((ft - mdn).abs(), Law::SlideMagnitude)
+                };
+                worst([(pull, Law::Pull), (backwards, Law::SlideBackwards), law])
             }
         }
     }
@@ -194,6 +237,9 @@ impl Engine for SpatialModel {
     }
     fn newton_fallback(&self, data: &mut SpatialData) -> bool {
         fix_slides(data) || stop_slowest_slide(self, data)
+    }
+    fn refine_directions(&self, data: &mut SpatialData) -> bool {
+        refine_directions(self, data)
     }
     fn set_previous(&self, data: &mut SpatialData) {
         set_previous(&self.mech, &mut data.fbd, &data.q_prev);
@@ -312,12 +358,55 @@ fn row_scales(model: &SpatialModel, data: &mut SpatialData) {
 }
 
 /// Fixes the friction direction of every sliding point of the trial at
-/// its reference direction; `false` if there was none to fix.
+/// its reference direction; `false` if there was none to fix. The fixed
+/// direction is then moved to the solution's slip until the two agree
+/// ([`refine_directions`]): no row keeps a direction that is not its own.
 fn fix_slides(data: &mut SpatialData) -> bool {
     let mut any = false;
     for (c, state) in data.trial.iter().enumerate() {
         if matches!(state, SpatialState::Slide { .. }) && !data.fbd.fixed_direction[c] {
             data.fbd.fixed_direction[c] = true;
+            any = true;
+        }
+    }
+    any
+}
+
+/// A fixed friction direction agrees with the slip when they differ by
+/// less than this angle (rad): the force error `μD·N·angle` is then far
+/// below the law tolerance for any load the robot carries.
+const DIRECTION_TOL: f64 = 1e-10;
+
+/// [`Engine::refine_directions`]: every sliding point whose friction
+/// direction is fixed and whose slip (faster than the stop speed, not
+/// turned back by 90° or more — the state machine stops those) points
+/// elsewhere takes the slip's direction; `true` if any did.
+fn refine_directions(model: &SpatialModel, data: &mut SpatialData) -> bool {
+    let mut any = false;
+    for c in 0..data.trial.len() {
+        let SpatialState::Slide { dir } = data.trial[c] else {
+            continue;
+        };
+        if !data.fbd.fixed_direction[c] {
+            continue;
+        }
+        let s = trial_of(model, data, c).slip();
+        let len = s[0].hypot(s[1]);
+        if len <= STOP_SPEED * data.fbd.dt || s[0] * dir[0] + s[1] * dir[1] <= 0.0 {
+            continue;
+        }
+        let u = [s[0] / len, s[1] / len];
+        let change = (u[0] - dir[0]).hypot(u[1] - dir[1]);
+        if change > DIRECTION_TOL {
+            data.trial[c] = SpatialState::Slide { dir: u };
+            // Close to the slip: the implicit law again, from this
+            // solution (Newton's quadratic convergence instead of the
+            // fixed point's linear one), once a step: a failure fixes it
+            // again for good.
+            if change < 0.1 && !data.fbd.released_direction[c] {
+                data.fbd.fixed_direction[c] = false;
+                data.fbd.released_direction[c] = true;
+            }
             any = true;
         }
     }

@@ -13,12 +13,17 @@
 #   bash bench/scaling.sh                  # 1, 2, 4, … nproc
 #   THREADS="1 2 8 16" bash bench/scaling.sh
 #   PROFILE=quick bash bench/scaling.sh    # the quick profile's binary
+#   FBD=path/to/fbd bash bench/scaling.sh  # a binary built elsewhere (no cargo)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/.." && pwd)"
 profile="${PROFILE:-release}"
-(cd "$root" && cargo build -q --profile "$profile" --bin fbd)
-fbd="${CARGO_TARGET_DIR:-$root/target}/$profile/fbd"
+if [ -n "${FBD:-}" ]; then
+    fbd=$(cd "$(dirname "$FBD")" && pwd)/$(basename "$FBD")
+else
+    (cd "$root" && cargo build -q --profile "$profile" --bin fbd)
+    fbd="${CARGO_TARGET_DIR:-$root/target}/$profile/fbd"
+fi
 sweep="$here/scaling_walk.toml"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT

@@ -281,6 +281,7 @@ fn two_runs_are_byte_identical() {
                 let mut j: serde_json::Value = serde_json::from_slice(v).unwrap();
                 j["wall_seconds"] = serde_json::Value::Null;
                 j["steps_per_second"] = serde_json::Value::Null;
+                j["stability_check_seconds"] = serde_json::Value::Null;
                 j
             };
             assert_eq!(strip(&x), strip(&y), "{f} differs");

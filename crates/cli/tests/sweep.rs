@@ -211,6 +211,7 @@ fn assert_same_run(a: &Path, b: &Path) {
                 .unwrap();
         j["wall_seconds"] = serde_json::Value::Null;
         j["steps_per_second"] = serde_json::Value::Null;
+        j["stability_check_seconds"] = serde_json::Value::Null;
         j
     };
     assert_eq!(strip(a), strip(b));

@@ -42,6 +42,7 @@ def without_timings(summary: dict) -> dict:
     s = dict(summary)
     for k in ("wall_seconds", "steps_per_second"):
         s.pop(k)
+    s.pop("stability_check_seconds", None)
     return s
 
 

@@ -907,7 +907,7 @@ pub fn forces_svg(d: &PlotData) -> PlotResult<String> {
                 clipped.iter().zip(series.iter().map(|s| s.1)).collect();
             time_chart(
                 &format!(
-                    "{title}; axis clipped at ±{clip} N: peak {p:.0} N ({label}, t = {})",
+                    "{title}; axis clipped at ±{clip} N: peak {p:.0} N ({label}, t = {} s)",
                     tick(&t)
                 ),
                 "force (N)",

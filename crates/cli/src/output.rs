@@ -532,7 +532,7 @@ pub enum Table {
         error: Option<io::Error>,
     },
     /// `trajectory.parquet` ([`crate::columnar`]).
-    Parquet(crate::columnar::ParquetTable),
+    Parquet(Box<crate::columnar::ParquetTable>),
 }
 
 impl Table {
@@ -559,9 +559,9 @@ impl Table {
                     error: None,
                 })
             }
-            fbd_scenario::OutputFormat::Parquet => Ok(Self::Parquet(
+            fbd_scenario::OutputFormat::Parquet => Ok(Self::Parquet(Box::new(
                 crate::columnar::ParquetTable::create(dir, columns, dt)?,
-            )),
+            ))),
         }
     }
 
@@ -594,7 +594,7 @@ impl Table {
                 }
             }
             Self::Parquet(p) => {
-                fill(p);
+                fill(&mut **p);
                 p.end_row();
             }
         }
@@ -615,7 +615,7 @@ impl Table {
                 persist(tmp, &dest)?;
                 Ok(dest)
             }
-            Self::Parquet(p) => p.finish(),
+            Self::Parquet(p) => (*p).finish(),
         }
     }
 }

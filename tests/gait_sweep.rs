@@ -63,5 +63,7 @@ fn a_hexapod_sweep_writes_the_walk_columns() {
     let margin = |i: usize| rows[i][col("min_margin")].parse::<f64>().unwrap();
     assert!(margin(1) > margin(0) && margin(3) > margin(2));
     assert!(out.join("sweep.svg").is_file());
-    assert!(out.join("runs/3/gait.svg").is_file());
+    // Per-run plots only with `plots: true` (`--plots`).
+    assert!(out.join("runs/3/trajectory.csv").is_file());
+    assert!(!out.join("runs/3/gait.svg").exists());
 }

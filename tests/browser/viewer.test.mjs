@@ -231,7 +231,7 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
       assert.ok(info.includes(`${rows} events (events.csv`), `header "${info}", events.csv ${rows} rows`);
     });
 
-    await t.test('the page is titled after the configuration and model, not the folder', async () => {
+    await t.test('the page is titled after the model, not the output folder', async () => {
       const title = await page.title();
       assert.ok(!title.includes(basename(dir)), `title "${title}" names the folder ${basename(dir)}`);
       assert.ok(/planar model|hexapod/.test(title), `title "${title}"`);

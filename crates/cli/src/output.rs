@@ -615,7 +615,7 @@ impl Table {
                 persist(tmp, &dest)?;
                 Ok(dest)
             }
-            Self::Parquet(p) => p.finish(),
+            Self::Parquet(p) => (*p).finish(),
         }
     }
 }

@@ -687,15 +687,7 @@ pub(crate) fn stacked_time_chart(
         }
         if !events.is_empty() {
             entries.push(Entry {
-                label: "contact event (label +N:".into(),
-                style: Style {
-                    color: EVENT,
-                    width: 1,
-                    dashed: true,
-                },
-            });
-            entries.push(Entry {
-                label: "  N more at that instant)".into(),
+                label: "event (+N: N more there)".into(),
                 style: Style {
                     color: EVENT,
                     width: 1,
@@ -907,7 +899,7 @@ pub fn forces_svg(d: &PlotData) -> PlotResult<String> {
                 clipped.iter().zip(series.iter().map(|s| s.1)).collect();
             time_chart(
                 &format!(
-                    "{title}; axis clipped at ±{clip} N: peak {p:.0} N ({label}, t = {})",
+                    "{title}; axis clipped at ±{clip} N: peak {p:.0} N ({label}, t = {} s)",
                     tick(&t)
                 ),
                 "force (N)",
@@ -1137,6 +1129,58 @@ pub fn stance_svg(d: &PlotData) -> PlotResult<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn trace(label: &str, pts: Vec<(f64, f64)>) -> Trace {
+        Trace {
+            label: label.into(),
+            pts,
+        }
+    }
+
+    #[test]
+    fn an_impact_clips_the_force_axis_and_the_title_gives_the_peak() {
+        // 50 N at rest for 100 samples, a 1780 N spike at 0.36 s.
+        let n: Vec<(f64, f64)> = (0..100)
+            .map(|k| (k as f64 * 0.01, if k == 36 { 1780.0 } else { 50.0 }))
+            .collect();
+        let d = PlotData {
+            normal: vec![trace("n hip4", n.clone())],
+            tangential: vec![trace("fa hip4", n.iter().map(|p| (p.0, 0.0)).collect())],
+            tips: vec![trace("tip", n.iter().map(|p| (p.0, 0.0)).collect())],
+            points: vec![(4, PointKind::Hip)],
+            ..PlotData::default()
+        };
+        let svg = forces_svg(&d).unwrap();
+        assert!(
+            svg.contains("axis clipped at ±200 N: peak 1780 N (n hip4, t = 0.36 s)"),
+            "{}",
+            &svg[..svg.len().min(2000)]
+        );
+        // The y axis ends near the clip, not at the peak: no 1500 tick.
+        assert!(!svg.contains(">1500<"), "the axis still reaches the peak");
+    }
+
+    #[test]
+    fn close_events_share_one_label_with_a_count() {
+        let events: Vec<EventMark> = (0..9)
+            .map(|k| EventMark {
+                t: 0.5 + 1e-4 * k as f64,
+                label: format!("{} tip ST2", k + 1),
+            })
+            .collect();
+        let d = PlotData {
+            tips: vec![trace("tip", vec![(0.0, 0.0), (1.0, 1.0)])],
+            events,
+            ..PlotData::default()
+        };
+        let svg = tips_svg(&d).unwrap();
+        assert!(svg.contains("1 tip ST2 +8"), "no grouped label");
+        assert!(!svg.contains("2 tip ST2"), "a second label drawn");
+        assert!(
+            svg.contains("event (+N: N more there)"),
+            "the legend does not explain +N"
+        );
+    }
 
     #[test]
     fn min_max_keeps_the_extremes_of_every_column() {

@@ -68,12 +68,12 @@ fn what_cannot_be_exported_is_a_one_line_error() {
     let slope = write(
         dir.path(),
         "slope.toml",
-        &format!("{HEXAPOD}[terrain]\nkind = \"slope\"\nangle_deg = 10.0\n"),
+        &format!("{HEXAPOD}[terrain]\nkind = \"sine\"\namplitude = 0.01\nwavelength = 1.0\n"),
     );
     one_line_error(
         &fbd(&["export", "mjcf", s(&slope)]),
         2,
-        &["slope.toml", "terrain.kind", "\"slope\""],
+        &["slope.toml", "terrain.kind", "\"sine\""],
     );
     let cfg = write(dir.path(), "robot.toml", HEXAPOD);
     let missing = dir.path().join("no/such/dir/robot.xml");

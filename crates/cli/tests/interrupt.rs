@@ -154,7 +154,16 @@ fn sigint_stops_a_sweep_and_the_index_says_which_runs() {
         "base = \"long.toml\"\n[vary]\n\"terrain.mu_static\" = [0.4, 0.5, 0.6]\n",
     );
     let out = dir.path().join("sweep");
-    let child = spawn(&["sweep", s(&sweep), "--out", s(&out), "--jobs", "1"]);
+    let child = spawn(&[
+        "sweep",
+        s(&sweep),
+        "--out",
+        s(&out),
+        "--jobs",
+        "1",
+        "--viewer",
+        "--plots",
+    ]);
     let run0 = out.join("runs/0");
     let o = {
         let run0 = run0.clone();

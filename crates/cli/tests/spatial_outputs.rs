@@ -134,6 +134,7 @@ fn expected_columns(legs: &[usize], knees: bool, hips: bool) -> Vec<String> {
         }
     }
     c.extend(["kinetic", "potential", "newton_iterations"].map(str::to_owned));
+    c.extend(["roll", "pitch", "heading"].map(str::to_owned));
     c
 }
 
@@ -142,7 +143,7 @@ fn columns_of_six_legs_in_order() {
     let p = SpatialParams::default();
     let c = columns(&Layout::of(&p));
     assert_eq!(c, expected_columns(&[1, 2, 3, 4, 5, 6], true, true));
-    assert_eq!(c.len(), 7 + 18 + 6 * 23 + 6 * 2 * 5 + 3);
+    assert_eq!(c.len(), 7 + 18 + 6 * 23 + 6 * 2 * 5 + 3 + 3);
 }
 
 #[test]

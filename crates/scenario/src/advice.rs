@@ -9,9 +9,9 @@ use crate::{ConfigFile, PlanarConfig};
 pub const STEPS_PER_TIME_SCALE: f64 = 20.0;
 
 /// Steps per time scale below which a run gets a warning before it
-/// starts (`Δt > τ/WARN_STEPS_PER_TIME_SCALE`: four times the step the
-/// advice asks for, 0.04 s for the built-in robot).
-pub const WARN_STEPS_PER_TIME_SCALE: f64 = 5.0;
+/// starts (`Δt > τ/WARN_STEPS_PER_TIME_SCALE`: ten times the step the
+/// advice asks for, 0.1 s for the built-in robot).
+pub const WARN_STEPS_PER_TIME_SCALE: f64 = 2.0;
 
 impl<I> ConfigFile<I> {
     /// The robot's shortest natural time scale `τ = √(c/g)` (s): how fast
@@ -37,7 +37,7 @@ impl<I> ConfigFile<I> {
     }
 
     /// A warning before a dynamic run whose Δt is far too large for the
-    /// robot's motion (`Δt > τ/5`, [`WARN_STEPS_PER_TIME_SCALE`]): the
+    /// robot's motion (`Δt > τ/2`, [`WARN_STEPS_PER_TIME_SCALE`]): the
     /// steps would not resolve a swing or a touchdown. Names the value to
     /// use ([`ConfigFile::suggested_dt`]).
     pub fn dt_warning(&self) -> Option<String> {

@@ -411,26 +411,12 @@ const BODY_HTML: &str = r#"<header><h1 id="title">fbd viewer</h1><span id="info"
 </main>
 "#;
 
-/// The page title of a run of the configuration `source` (a path, or the
-/// built-in default's description) of `model` (e.g. `hexapod, 3D
-/// dynamics`): the file's name without `.toml` (`hexapod_walk`), with its
-/// folder for a sweep run's `runs/12/config.toml` (`12/config`), then the
-/// model.
-pub fn title_of(source: &str, model: &str) -> String {
-    let path = Path::new(source);
-    let name = match (path.extension(), path.file_stem()) {
-        (Some(ext), Some(stem)) if ext == "toml" => {
-            let stem = stem.to_string_lossy();
-            match path.parent().and_then(Path::file_name) {
-                Some(parent) if stem == "config" => {
-                    format!("{}/{stem}", parent.to_string_lossy())
-                }
-                _ => stem.into_owned(),
-            }
-        }
-        _ => source.to_owned(),
-    };
-    format!("{name} · {model}")
+/// The page title of a run of `model` (e.g. `hexapod, 3D dynamics`): the
+/// model, never the output folder, and the same for `fbd run` and `fbd
+/// view` of its folder (which repeats the page byte for byte); `_source`
+/// (the configuration's name) is not in it for that reason.
+pub fn title_of(_source: &str, model: &str) -> String {
+    model.to_owned()
 }
 
 /// Writes `dir/viewer.html` all-or-nothing.

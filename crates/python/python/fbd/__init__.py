@@ -55,7 +55,7 @@ def __dir__() -> List[str]:
 
 #: What a configuration may be: None (the built-in default experiment), a
 #: path, TOML text, or a dict with the keys of the files.
-ConfigLike = Union[None, str, "_os.PathLike[str]", Mapping[str, Any]]
+ConfigLike = Union[None, str, "_os.PathLike[str]", _Mapping[str, Any]]
 
 
 class Result(_Mapping):

@@ -337,10 +337,20 @@ impl Simulator {
 
     fn vector(&self, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
         let n = self.sim.joints();
-        let names = self.joint_names.join(", ");
+        let names = if self.is_planar() {
+            "hip3, knee3, hip4, knee4".to_owned()
+        } else {
+            "θ1, θ2, θ3 of leg 1, then leg 2, …".to_owned()
+        };
+        let kind = if what == "torques" {
+            "joint torques"
+        } else {
+            "values, one per joint"
+        };
         let bad = || {
             PyValueError::new_err(format!(
-                "{what}: expected {n} numbers, one per joint ({names})"
+                "{what}: expected a sequence of {n} numbers ({names}){}",
+                if what == "torques" { " or None" } else { "" }
             ))
         };
         let v: Vec<f64> = if let Ok(a) = v.cast::<PyArray1<f64>>() {
@@ -348,8 +358,9 @@ impl Simulator {
                 .as_slice()
                 .map(<[f64]>::to_vec)
                 .map_err(|_| bad())?
-        } else if v.is_instance_of::<pyo3::types::PyFloat>()
-            || v.is_instance_of::<pyo3::types::PyInt>()
+        } else if what != "torques"
+            && (v.is_instance_of::<pyo3::types::PyFloat>()
+                || v.is_instance_of::<pyo3::types::PyInt>())
         {
             vec![v.extract::<f64>()?; n]
         } else {
@@ -357,7 +368,7 @@ impl Simulator {
         };
         if v.len() != n {
             return Err(PyValueError::new_err(format!(
-                "{what}: expected {n} numbers, one per joint ({names}), got {}",
+                "{what}: expected {n} {kind} ({names}), got {}",
                 v.len()
             )));
         }

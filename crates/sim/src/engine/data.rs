@@ -215,7 +215,7 @@ where
 {
     fn clone(&self) -> Self {
         Self {
-            k: self.k.clone(),
+            k: self.k,
             q_prev: self.q_prev.clone(),
             q_prev2: self.q_prev2.clone(),
             q: self.q.clone(),
@@ -227,11 +227,11 @@ where
             limit_states: self.limit_states.clone(),
             limit_events: self.limit_events.clone(),
             retries: self.retries.clone(),
-            newton_iterations: self.newton_iterations.clone(),
-            chord_iterations: self.chord_iterations.clone(),
-            max_step_iterations: self.max_step_iterations.clone(),
-            resolved_cycles: self.resolved_cycles.clone(),
-            enumerated_cycles: self.enumerated_cycles.clone(),
+            newton_iterations: self.newton_iterations,
+            chord_iterations: self.chord_iterations,
+            max_step_iterations: self.max_step_iterations,
+            resolved_cycles: self.resolved_cycles,
+            enumerated_cycles: self.enumerated_cycles,
             external_torque: self.external_torque.clone(),
             predictor: self.predictor.clone(),
             record: self.record.clone(),
@@ -249,18 +249,18 @@ where
             grid_q_prev2: self.grid_q_prev2.clone(),
             grid_states: self.grid_states.clone(),
             grid_limits: self.grid_limits.clone(),
-            grid_events: self.grid_events.clone(),
+            grid_events: self.grid_events,
             failed_trial: self.failed_trial.clone(),
             failed_limits: self.failed_limits.clone(),
             start_z: self.start_z.clone(),
-            best_violation: self.best_violation.clone(),
+            best_violation: self.best_violation,
             best_z: self.best_z.clone(),
             best_trial: self.best_trial.clone(),
             best_limits: self.best_limits.clone(),
             checked_trial: self.checked_trial.clone(),
             checked_limits: self.checked_limits.clone(),
-            last_resort: self.last_resort.clone(),
-            want_record: self.want_record.clone(),
+            last_resort: self.last_resort,
+            want_record: self.want_record,
         }
     }
 }

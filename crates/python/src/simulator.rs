@@ -26,22 +26,22 @@ enum Plant {
 
 /// A simulator of either model.
 enum Sim {
-    Planar(Core<Model>),
-    Hexapod(Core<SpatialModel>),
+    Planar(Box<Core<Model>>),
+    Hexapod(Box<Core<SpatialModel>>),
 }
 
 /// A saved state of either model.
 #[derive(Clone)]
 enum Saved {
-    Planar(SimState<Model>),
-    Hexapod(SimState<SpatialModel>),
+    Planar(Box<SimState<Model>>),
+    Hexapod(Box<SimState<SpatialModel>>),
 }
 
 impl Sim {
     fn new(plant: &Plant) -> Self {
         match plant {
-            Plant::Planar(m) => Sim::Planar(Core::new((**m).clone())),
-            Plant::Hexapod(m) => Sim::Hexapod(Core::new((**m).clone())),
+            Plant::Planar(m) => Sim::Planar(Box::new(Core::new((**m).clone()))),
+            Plant::Hexapod(m) => Sim::Hexapod(Box::new(Core::new((**m).clone()))),
         }
     }
     fn step(&mut self, action: &Action<'_>) -> Result<(), SimError> {
@@ -84,8 +84,8 @@ impl Sim {
     }
     fn state(&self) -> Saved {
         match self {
-            Sim::Planar(s) => Saved::Planar(s.state()),
-            Sim::Hexapod(s) => Saved::Hexapod(s.state()),
+            Sim::Planar(s) => Saved::Planar(Box::new(s.state())),
+            Sim::Hexapod(s) => Saved::Hexapod(Box::new(s.state())),
         }
     }
     fn set_state(&mut self, saved: &Saved) -> bool {

@@ -32,22 +32,22 @@ enum Plant {
 
 /// A simulator of either model.
 enum Sim {
-    Planar(Core<Model>),
-    Hexapod(Core<SpatialModel>),
+    Planar(Box<Core<Model>>),
+    Hexapod(Box<Core<SpatialModel>>),
 }
 
 /// A saved state of either model.
 #[derive(Clone)]
 enum Saved {
-    Planar(SimState<Model>),
-    Hexapod(SimState<SpatialModel>),
+    Planar(Box<SimState<Model>>),
+    Hexapod(Box<SimState<SpatialModel>>),
 }
 
 impl Sim {
     fn new(plant: &Plant) -> Self {
         match plant {
-            Plant::Planar(m) => Sim::Planar(Core::new((**m).clone())),
-            Plant::Hexapod(m) => Sim::Hexapod(Core::new((**m).clone())),
+            Plant::Planar(m) => Sim::Planar(Box::new(Core::new((**m).clone()))),
+            Plant::Hexapod(m) => Sim::Hexapod(Box::new(Core::new((**m).clone()))),
         }
     }
     fn step(&mut self, action: &Action<'_>) -> Result<(), SimError> {
@@ -90,8 +90,8 @@ impl Sim {
     }
     fn state(&self) -> Saved {
         match self {
-            Sim::Planar(s) => Saved::Planar(s.state()),
-            Sim::Hexapod(s) => Saved::Hexapod(s.state()),
+            Sim::Planar(s) => Saved::Planar(Box::new(s.state())),
+            Sim::Hexapod(s) => Saved::Hexapod(Box::new(s.state())),
         }
     }
     fn set_state(&mut self, saved: &Saved) -> bool {
@@ -343,10 +343,20 @@ impl Simulator {
 
     fn vector(&self, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
         let n = self.sim.joints();
-        let names = self.joint_names.join(", ");
+        let names = if self.is_planar() {
+            "hip3, knee3, hip4, knee4".to_owned()
+        } else {
+            "θ1, θ2, θ3 of leg 1, then leg 2, …".to_owned()
+        };
+        let kind = if what == "torques" {
+            "joint torques"
+        } else {
+            "values, one per joint"
+        };
         let bad = || {
             PyValueError::new_err(format!(
-                "{what}: expected {n} numbers, one per joint ({names})"
+                "{what}: expected a sequence of {n} numbers ({names}){}",
+                if what == "torques" { " or None" } else { "" }
             ))
         };
         let v: Vec<f64> = if let Ok(a) = v.cast::<PyArray1<f64>>() {
@@ -354,8 +364,9 @@ impl Simulator {
                 .as_slice()
                 .map(<[f64]>::to_vec)
                 .map_err(|_| bad())?
-        } else if v.is_instance_of::<pyo3::types::PyFloat>()
-            || v.is_instance_of::<pyo3::types::PyInt>()
+        } else if what != "torques"
+            && (v.is_instance_of::<pyo3::types::PyFloat>()
+                || v.is_instance_of::<pyo3::types::PyInt>())
         {
             vec![v.extract::<f64>()?; n]
         } else {
@@ -363,7 +374,7 @@ impl Simulator {
         };
         if v.len() != n {
             return Err(PyValueError::new_err(format!(
-                "{what}: expected {n} numbers, one per joint ({names}), got {}",
+                "{what}: expected {n} {kind} ({names}), got {}",
                 v.len()
             )));
         }

@@ -109,13 +109,14 @@ def test_unconvertible_dict_value_is_a_type_error():
         fbd.run({"time": {"dt": object()}})
 
 
-def test_hexapod_simulator_is_a_config_error_naming_model(examples):
+def test_kinematic_hexapod_simulator_is_a_config_error_naming_model(examples):
     # fbd.run runs the hexapod (test_hexapod.py: the kinematic gait,
-    # test_spatial.py: the 3D dynamics); the step-wise Simulator is the
-    # planar dynamics only, and says so.
-    with pytest.raises(fbd.ConfigError, match="planar model only") as info:
-        fbd.Simulator(examples / "hexapod_pose.toml")
+    # test_spatial.py: the 3D dynamics); the step-wise Simulator steps the
+    # dynamics (test_hexapod_simulator.py) and says so for a kinematic gait.
+    with pytest.raises(fbd.ConfigError, match="kinematic") as info:
+        fbd.Simulator(examples / "hexapod_tripod.toml")
     assert info.value.key == "model"
+    assert fbd.Simulator(examples / "hexapod_stand.toml").model == "hexapod"
 
 
 def test_simulator_config_errors():

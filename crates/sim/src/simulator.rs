@@ -246,6 +246,9 @@ pub struct Simulator<M: Plant> {
     data: RunData<M>,
     joints: Vec<usize>,
     tau: Vec<f64>,
+    /// The record before the step being solved (a failed step's retries
+    /// overwrite `data.record`; it is put back).
+    kept: M::Record,
 }
 
 impl<M: Plant> Simulator<M> {
@@ -254,11 +257,13 @@ impl<M: Plant> Simulator<M> {
         let data = model.fresh();
         let joints = model.joint_indices();
         let tau = vec![0.0; joints.len()];
+        let kept = data.record.clone();
         Self {
             model,
             data,
             joints,
             tau,
+            kept,
         }
     }
 
@@ -314,8 +319,8 @@ impl<M: Plant> Simulator<M> {
     /// Solves one step with `action`.
     ///
     /// # Errors
-    /// The step's [`SimError`]; the state is then that before the step was
-    /// tried (except events), and the simulator may be restored.
+    /// The step's [`SimError`]; the state and the readouts are then those
+    /// before the step was tried, and the simulator may be restored.
     ///
     /// # Panics
     /// When the torques or targets do not have one value per joint.
@@ -331,10 +336,13 @@ impl<M: Plant> Simulator<M> {
                 self.model.set_torques(&mut self.data, &self.tau);
             }
         }
+        self.kept.clone_from(&self.data.record);
         let result = crate::engine::step::step(&self.model, &mut self.data);
         self.data.external_torque = None;
-        result?;
-        Ok(())
+        if result.is_err() {
+            std::mem::swap(&mut self.data.record, &mut self.kept);
+        }
+        result
     }
 
     /// The PD torques of `pd` at the current state into `self.tau`.

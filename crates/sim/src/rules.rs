@@ -357,6 +357,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.starts_with("control.kp: "), "{e}");
-        assert!(e.contains("below 40000.0000 N·m/rad"), "{e}");
+        assert!(e.contains("control.kp < 40000.0000 N·m/rad"), "{e}");
+        assert!(e.contains("set control.kp below that"), "{e}");
     }
 }

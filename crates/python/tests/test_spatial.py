@@ -147,15 +147,13 @@ def test_a_two_legged_dynamic_hexapod(tmp):
     assert np.allclose(r["ry"][free], 0.6 - 0.5 * G * t[free] ** 2, atol=1e-9)
 
 
-def test_ctrl_c_interrupts_a_dynamic_run(ctrl_c):
-    # Long enough to outlast the timer at any speed (a robot at rest
+def test_ctrl_c_interrupts_a_dynamic_run(ctrl_c, examples):
+    # Long enough to outlast the timer at any speed (the PD stand at rest
     # steps fastest: 2e5 steps, a row every 10; the signals are looked at
     # every 4096 rows).
-    long = {
-        "model": "hexapod",
-        "time": {"dt": 0.001, "duration": 200.0},
-        "output": {"stride": 10},
-    }
+    text = (examples / "hexapod_stand.toml").read_text()
+    long = text.replace("duration = 1.0", "duration = 200.0") + "\n[output]\nstride = 10\n"
+    assert "duration = 200.0" in long
     with ctrl_c(), pytest.raises(KeyboardInterrupt, match="interrupted after"):
         fbd.run(long)
 

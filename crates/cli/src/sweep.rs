@@ -274,23 +274,6 @@ impl Vary {
     }
 }
 
-/// splitmix64: a tiny deterministic PRNG.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 fn as_f64(v: &toml::Value) -> Option<f64> {
     match v {
         toml::Value::Float(f) => Some(*f),
@@ -443,7 +426,7 @@ fn expand_vary(s: &SweepFile, file: &str) -> Result<Vec<Vec<toml::Value>>, Strin
                     }
                 }
             }
-            let mut rng = SplitMix64(s.seed.unwrap_or(0));
+            let mut rng = fbd_contact::SplitMix(s.seed.unwrap_or(0));
             Ok((0..samples)
                 .map(|_| {
                     ranges

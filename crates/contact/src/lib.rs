@@ -21,7 +21,7 @@ pub mod surface;
 pub mod terrain;
 
 pub use error::ContactError;
-pub use generate::{Generator, Sampling};
+pub use generate::{Generator, Sampling, SplitMix};
 pub use grid::{GridIssue, HeightGrid};
 pub use machine::{ContactMode, ContactTrial, switch};
 pub use mode::{ContactParams, ContactState, Friction, StateCode, Trial, transition};

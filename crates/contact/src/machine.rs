@@ -255,7 +255,7 @@ impl ContactTrial for SpatialTrial {
         spatial::crossing(surface, self.p_k, self.p_next)
     }
     fn under_start(&self, surface: &Surface) -> [f64; 3] {
-        spatial::project(surface, self.p_k)
+        spatial::under_along_normal(surface, self.p_k)
     }
     fn slip_speed(&self, state: &SpatialState) -> f64 {
         match *state {

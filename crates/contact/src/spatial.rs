@@ -98,6 +98,19 @@ pub fn project(surface: &Surface, p: [f64; 3]) -> [f64; 3] {
     [p[0], surface.height(p[0], p[2]), p[2]]
 }
 
+/// The point of the surface under `p` along the surface's normal there:
+/// `p − c·n_y·n` with `c` the vertical clearance (exactly the foot of the
+/// normal on a plane). Its tangential components in the contact frame at
+/// `p` are `p`'s: a point anchored there where it stopped carries no
+/// tangential preload (the vertical projection of [`project`] would shift
+/// it along a slope's tangent by `c·sin`).
+pub fn under_along_normal(surface: &Surface, p: [f64; 3]) -> [f64; 3] {
+    let c = clearance(surface, p);
+    let n = surface.normal(p[0], p[2]);
+    let d = c * n[1];
+    [p[0] - d * n[0], p[1] - d * n[1], p[2] - d * n[2]]
+}
+
 /// The contact frame `(t1, n, t2)` at `(x, z)` (see the module docs).
 pub fn frame(surface: &Surface, x: f64, z: f64) -> [[f64; 3]; 3] {
     let n = surface.normal(x, z);

@@ -278,11 +278,11 @@ pub fn advance(_mech: &Mechanism, data: &mut FbdData) {
 }
 
 /// A key identifying the sparsity pattern: the contact states' codes in
-/// base 3 (the slide direction changes values, not structure), then one
+/// base 4 (the slide direction changes values, not structure), then one
 /// bit per joint limit (free or at an end).
 pub fn pattern_key(data: &FbdData) -> u64 {
     rows::pattern_key(
-        data.contact.iter().map(|c| c.state.code()),
+        data.contact.iter().map(|c| Some(c.state.code())),
         data.limit.iter().map(|l| l.state.is_at()),
     )
 }

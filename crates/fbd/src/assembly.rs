@@ -120,6 +120,19 @@ pub enum RowState<'a> {
     /// ST3: on the surface, sliding along the reference direction given by
     /// its tangential components (the plane: ±1).
     Slide(&'a [f64]),
+    /// In contact, stick or slip and lift-off solved in the step
+    /// ([`rows::complementarity_rows`], 3D): the friction coefficient `μ`
+    /// and, for a sticking point, its anchor (inertial; the gap is measured
+    /// along the frame's normal from it); `None` for a sliding point,
+    /// referred to its own position at `k` (the gap is its clearance).
+    Contact {
+        /// The anchor of a point that sticks at the start of the search.
+        anchor: Option<&'a [f64]>,
+        /// μS with an anchor, μD without.
+        mu: f64,
+        /// Branches fixed for this solve (`None`: chosen by the iterate).
+        frozen: Option<rows::Frozen>,
+    },
 }
 
 /// A contact point's equations in a step.
@@ -245,6 +258,13 @@ pub trait FbdModel {
     ) -> [f64; 2];
     /// The slip kept by the last [`Self::slide_direction`] of point `c`.
     fn slip(&self, data: &Self::Data, c: usize) -> Slip;
+    /// Keeps the branch of complementarity point `c` at the iterate
+    /// ([`RowState::Contact`]; models without them ignore it).
+    fn set_branch(&self, _data: &mut Self::Data, _c: usize, _branch: rows::Branch) {}
+    /// The branch kept by [`Self::set_branch`].
+    fn branch(&self, _data: &Self::Data, _c: usize) -> rows::Branch {
+        rows::Branch::default()
+    }
     /// The clearance `y − ϱ(x[, z])` of a point.
     fn clearance(&self, ground: &Self::Ground, p: &<Self::S as Space>::Lin) -> f64;
     /// The terrain's slope `(∂ϱ/∂x, ∂ϱ/∂z)` under a point.
@@ -470,7 +490,92 @@ fn contact_rows<M: FbdModel>(
                 let clearance = model.clearance(ground, &p);
                 rows::slide_rows(fl, &u[..M::S::LIN - 1], mu, k, clearance, beta, out);
             }
+            RowState::Contact { anchor, mu, frozen } => {
+                let (t, gap) = contact_offsets::<M>(model, ground, data, c, &view, &p, anchor);
+                let t = [k * t[0], k * t[1]];
+                let beta = view.regularization;
+                let branch = rows::complementarity_rows(fl, t, gap, mu, k, beta, frozen, out);
+                model.set_branch(data, c, branch);
+            }
         }
+    }
+}
+
+/// A complementarity point's tangential offsets `(p[k+1] − r)·t_j` from
+/// its reference `r` (the anchor, or the point at `k`) and its normal gap:
+/// `(p[k+1] − a)·n` from an anchor, the clearance otherwise (m).
+fn contact_offsets<M: FbdModel>(
+    model: &M,
+    ground: &M::Ground,
+    data: &M::Data,
+    c: usize,
+    view: &ContactView<'_, M::S>,
+    p: &<M::S as Space>::Lin,
+    anchor: Option<&[f64]>,
+) -> ([f64; 2], f64) {
+    let frame = view.frame;
+    let frame = frame.as_ref();
+    let p = p.as_ref();
+    let now = model.contact_point(data, c, At::Now);
+    let reference = anchor.unwrap_or(now.as_ref());
+    let mut t = [0.0; 2];
+    let mut gap = 0.0;
+    let mut j = 0;
+    for (m, e) in frame.iter().enumerate() {
+        let e = e.as_ref();
+        let mut d = 0.0;
+        for a in 0..M::S::LIN {
+            d += (p[a] - reference[a]) * e[a];
+        }
+        if m == NORMAL {
+            gap = d;
+        } else if j < 2 {
+            t[j] = d;
+            j += 1;
+        }
+    }
+    if anchor.is_none() {
+        gap = model.clearance(ground, &{
+            let mut q = <M::S as Space>::Lin::default();
+            q.as_mut().copy_from_slice(p);
+            q
+        });
+    }
+    (t, gap)
+}
+
+/// A complementarity point's entries in its force column `m`
+/// ([`rows::complementarity_rows`]): every structural entry of either
+/// branch is written (zero where the branch has none), so that the
+/// sparsity pattern does not depend on the branch.
+fn contact_force_entries<J: JacobianSink>(
+    jac: &mut J,
+    crow: usize,
+    col: usize,
+    m: usize,
+    beta: f64,
+    b: rows::Branch,
+) {
+    // Tangential rows in the order of the frame, skipping the normal.
+    const T: [usize; 2] = [0, 2];
+    if m == NORMAL {
+        jac.add(crow + NORMAL, col, if b.unloaded { 1.0 } else { beta });
+        for (j, &t) in T.iter().enumerate() {
+            let v = if b.sliding { -b.drho * b.dir[j] } else { 0.0 };
+            jac.add(crow + t, col, v);
+        }
+        return;
+    }
+    let l = usize::from(m != 0);
+    jac.add(crow + NORMAL, col, 0.0);
+    for (j, &t) in T.iter().enumerate() {
+        let delta = if j == l { 1.0 } else { 0.0 };
+        let v = if b.sliding {
+            delta - b.ratio * (delta - b.dir[j] * b.dir[l]) * (1.0 - beta)
+        } else {
+            beta * delta
+        };
+        jac.add(crow + t, col, v);
     }
 }
 
@@ -543,6 +648,9 @@ fn force_entries<M: FbdModel, J: JacobianSink>(
                     }
                 }
                 RowState::Slide(_) => jac.add(crow + m, col, 1.0),
+                RowState::Contact { .. } => {
+                    contact_force_entries(jac, crow, col, m, beta, model.branch(data, c));
+                }
             }
         }
     }
@@ -598,6 +706,9 @@ fn position_entries<M: FbdModel, J: JacobianSink>(
                     jac.add(row + a, i, k * v.as_ref()[a]);
                 }
             }),
+            RowState::Contact { anchor, .. } => {
+                contact_position_entries(model, ground, data, c, row, k, anchor.is_some(), jac);
+            }
             RowState::Slide(_) => {
                 let p = model.contact_point(data, c, At::Next);
                 let slope = model.slope(ground, &p);
@@ -657,4 +768,53 @@ fn position_entries<M: FbdModel, J: JacobianSink>(
             jac.add(dims.limit_row(l), stop.q_index, limit_gain);
         }
     }
+}
+
+/// A complementarity point's entries in the `q[k+1]` columns
+/// ([`rows::complementarity_rows`]; every structural entry of either
+/// branch, as [`contact_force_entries`]).
+#[allow(clippy::too_many_arguments)]
+fn contact_position_entries<M: FbdModel, J: JacobianSink>(
+    model: &M,
+    ground: &M::Ground,
+    data: &M::Data,
+    c: usize,
+    row: usize,
+    k: f64,
+    anchored: bool,
+    jac: &mut J,
+) {
+    let view = model.contact(data, c);
+    let frame = view.frame;
+    let frame = frame.as_ref();
+    let b = model.branch(data, c);
+    let p = model.contact_point(data, c, At::Next);
+    let slope = model.slope(ground, &p);
+    let lin = M::S::LIN;
+    model.contact_columns(data, c, |i, v| {
+        let mut d = [0.0; 3];
+        for (m, e) in frame.iter().enumerate().take(3) {
+            let e = e.as_ref();
+            d[m] = v.as_ref().iter().zip(e).take(lin).map(|(x, y)| x * y).sum();
+        }
+        let normal = if b.unloaded {
+            0.0
+        } else if anchored {
+            k * d[NORMAL]
+        } else {
+            k * M::S::clearance_rate(v, slope)
+        };
+        jac.add(row + NORMAL, i, normal);
+        let dt = [d[0], d[2]];
+        for (j, &t) in [0usize, 2].iter().enumerate() {
+            let value = if b.sliding {
+                b.ratio
+                    * k
+                    * ((1.0 - b.dir[j] * b.dir[j]) * dt[j] - b.dir[j] * b.dir[1 - j] * dt[1 - j])
+            } else {
+                k * dt[j]
+            };
+            jac.add(row + t, i, value);
+        }
+    });
 }

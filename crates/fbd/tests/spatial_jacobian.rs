@@ -74,6 +74,13 @@ fn q_at(mech: &SpatialMechanism, shift: f64) -> Vec<f64> {
 }
 
 fn check(surface: &Surface, first_step: bool, limits_at: bool) {
+    check_rows(surface, first_step, limits_at, false);
+}
+
+/// `complementarity`: ST2 and ST3 as complementarity rows, in either
+/// branch (a huge μS keeps some points inside their disc, the others
+/// slide; a negative `N` unloads).
+fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementarity: bool) {
     let mech = mechanism(&[1, 2, 3, 4, 5, 6]);
     let lay = mech.layout();
     let n = lay.dim();
@@ -104,8 +111,15 @@ fn check(surface: &Surface, first_step: bool, limits_at: bool) {
         *eq = SpatialContactEquation {
             state,
             frame: frame(surface, 0.05 * c as f64, -0.1),
-            mu_dynamic: 0.3,
+            mu_dynamic: if complementarity && c % 3 == 0 {
+                1e9
+            } else {
+                0.3
+            },
             regularization: 1e-3,
+            mu_static: if c % 3 == 1 { 1e9 } else { 0.4 },
+            complementarity,
+            frozen: None,
         };
     }
     if limits_at {
@@ -124,6 +138,12 @@ fn check(surface: &Surface, first_step: bool, limits_at: bool) {
     // A generic iterate.
     let mut z: Vec<f64> = (0..n).map(|i| 3.0 * ((i as f64) * 0.37).sin()).collect();
     z[..lay.nq].copy_from_slice(&q_at(&mech, 0.003));
+    if complementarity {
+        // Large normal forces on every other point: held on the surface.
+        for c in (0..data.contact.len()).step_by(2) {
+            z[lay.contact_force(c, 1)] = 2e6 * (1.0 + 0.1 * c as f64);
+        }
+    }
     let mut r = vec![0.0; n];
     let mut jac = vec![0.0; n * n];
     eval(
@@ -134,6 +154,21 @@ fn check(surface: &Surface, first_step: bool, limits_at: bool) {
         &mut r,
         &mut Dense { n, m: &mut jac },
     );
+    if complementarity && !first_step {
+        // Every branch is visited: sticking and sliding, loaded and not.
+        let b: Vec<_> = (0..data.contact.len())
+            .filter(|&c| data.contact[c].state != SpatialState::Free)
+            .map(|c| data.branch[c])
+            .collect();
+        for want in [
+            |b: &fbd_dynamics::rows::Branch| b.sliding && !b.unloaded,
+            |b: &fbd_dynamics::rows::Branch| !b.sliding && !b.unloaded,
+            |b: &fbd_dynamics::rows::Branch| b.unloaded,
+            |b: &fbd_dynamics::rows::Branch| b.sliding && b.drho > 0.0,
+        ] {
+            assert!(b.iter().any(want), "a branch is not visited: {b:?}");
+        }
+    }
     // The declared pattern covers every non-zero entry.
     let mut entries = Vec::new();
     pattern(&mech, &data, &mut entries);
@@ -187,4 +222,21 @@ fn jacobian_on_a_rotated_slope() {
         0.6,
     );
     check(&s, false, true);
+}
+
+#[test]
+fn jacobian_of_complementarity_rows_on_flat_ground() {
+    check_rows(&Surface::default(), false, false, true);
+}
+
+#[test]
+fn jacobian_of_complementarity_rows_on_a_rotated_slope_at_the_first_step() {
+    let s = Surface::new(
+        Terrain::Slope {
+            slope: 0.2,
+            height: 0.05,
+        },
+        0.6,
+    );
+    check_rows(&s, true, true, true);
 }

@@ -30,6 +30,16 @@ pub struct SpatialContactEquation {
     pub mu_dynamic: f64,
     /// Regularisation β of the position rows.
     pub regularization: f64,
+    /// Static friction coefficient μS (a sticking complementarity point).
+    pub mu_static: f64,
+    /// ST2 and ST3 as complementarity rows
+    /// ([`crate::rows::complementarity_rows`]): stick/slip and lift-off
+    /// solved in the step; otherwise the fixed-state rows of
+    /// [`crate::rows`].
+    pub complementarity: bool,
+    /// The complementarity rows' branches fixed for the solve (`None`:
+    /// chosen by the iterate).
+    pub frozen: Option<rows::Frozen>,
 }
 
 impl Default for SpatialContactEquation {
@@ -39,6 +49,9 @@ impl Default for SpatialContactEquation {
             frame: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
             mu_dynamic: 0.0,
             regularization: 0.0,
+            mu_static: 0.0,
+            complementarity: false,
+            frozen: None,
         }
     }
 }
@@ -152,6 +165,12 @@ pub struct SpatialFbdData {
     /// evaluated iterate (m).
     pub slip_len: Vec<f64>,
     slip_n: Vec<f64>,
+    /// Per contact, the branch of its complementarity rows at the last
+    /// evaluated iterate.
+    pub branch: Vec<rows::Branch>,
+    /// Per contact, the branches fixed for the solves of this step's
+    /// search (`fbd_sim`'s active-set fallback; reset every step).
+    pub frozen: Vec<Option<rows::Frozen>>,
     rot_d: Vec<Matrix3<f64>>,
     /// The `q` `kin_next` was last evaluated at (NaN: none).
     kin_next_q: Vec<f64>,
@@ -219,6 +238,8 @@ impl SpatialFbdData {
             fixed_direction: vec![false; mech.contacts.len()],
             released_direction: vec![false; mech.contacts.len()],
             slip_n: vec![0.0; mech.contacts.len()],
+            branch: vec![rows::Branch::default(); mech.contacts.len()],
+            frozen: vec![None; mech.contacts.len()],
             wrench: vec![Wrench::default(); nb],
             rot_d: vec![Matrix3::zeros(); nb],
             kin_next_q: vec![f64::NAN; mech.layout().nq],
@@ -330,10 +351,14 @@ pub fn advance(data: &mut SpatialFbdData) {
     data.next_is_candidate = false;
 }
 
-/// The sparsity key: contact state codes in base 3, then one bit per limit.
+/// The sparsity key: contact state codes in base 4 (one code for a
+/// complementarity point in contact), then one bit per limit.
 pub fn pattern_key(data: &SpatialFbdData) -> u64 {
     rows::pattern_key(
-        data.contact.iter().map(|c| c.state.code()),
+        data.contact.iter().map(|c| {
+            let code = c.state.code();
+            (!(c.complementarity && code != fbd_contact::StateCode::St1)).then_some(code)
+        }),
         data.limit.iter().map(|l| l.state.is_at()),
     )
 }
@@ -500,6 +525,16 @@ impl FbdModel for SpatialMechanism {
             frame: eq.frame,
             state: match &eq.state {
                 SpatialState::Free => RowState::Free,
+                SpatialState::Stick { anchor } if eq.complementarity => RowState::Contact {
+                    anchor: Some(anchor),
+                    mu: eq.mu_static,
+                    frozen: eq.frozen,
+                },
+                SpatialState::Slide { .. } if eq.complementarity => RowState::Contact {
+                    anchor: None,
+                    mu: eq.mu_dynamic,
+                    frozen: eq.frozen,
+                },
                 SpatialState::Stick { anchor } => RowState::Stick(anchor),
                 SpatialState::Slide { dir } => RowState::Slide(dir),
             },
@@ -569,6 +604,19 @@ impl FbdModel for SpatialMechanism {
             normal: data.slip_n[c],
             bias: data.slip_bias,
         }
+    }
+
+    #[inline]
+    fn set_branch(&self, data: &mut SpatialFbdData, c: usize, branch: rows::Branch) {
+        if branch.sliding {
+            data.slip_hat[c] = [-branch.dir[0], -branch.dir[1]];
+        }
+        data.branch[c] = branch;
+    }
+
+    #[inline]
+    fn branch(&self, data: &SpatialFbdData, c: usize) -> rows::Branch {
+        data.branch[c]
     }
 
     #[inline]

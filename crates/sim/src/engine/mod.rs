@@ -284,6 +284,15 @@ pub trait Engine: Sized {
         from: <Self::State as ContactMode>::Anchor,
         c: usize,
     ) -> <Self::State as ContactMode>::Anchor;
+    /// After a converged solve, models whose contact rows solve stick/slip
+    /// and lift-off in the step (complementarity rows) read the states
+    /// from the solution: `true` when a point must be solved again in
+    /// another state (a sticking point that slides: its friction drops
+    /// from μS to μD). States whose equations the solution already
+    /// satisfies (a stopped slide, a lift-off) change without a new solve.
+    fn complementarity_switches(&self, _data: &mut RunData<Self>) -> bool {
+        false
+    }
     /// After a failed Newton solve: changes the trial states so that the
     /// search may go on (`true`), or gives up (`false`, the default).
     fn newton_fallback(&self, _data: &mut RunData<Self>) -> bool {

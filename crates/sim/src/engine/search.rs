@@ -98,6 +98,9 @@ pub(crate) fn solve<M: Engine>(
             });
         }
         model.evaluate_next(data);
+        if trials < MAX_STATE_TRIALS && model.complementarity_switches(data) {
+            continue;
+        }
         if refinements < MAX_DIRECTION_REFINEMENTS && model.refine_directions(data) {
             refinements += 1;
             data.direction_refinements += 1;

@@ -36,6 +36,11 @@ pub struct SpatialModel {
     /// controller (`pd_stability`) in [`SpatialModel::new`]; near zero
     /// when its result came from the process's cache.
     pub stability_check_seconds: f64,
+    /// Whether the contact points in contact solve stick/slip and lift-off
+    /// in the step as a complementarity problem with the exact Coulomb law
+    /// (`fbd_dynamics::rows::complementarity_rows`; default `true`), rather
+    /// than in fixed states switched by the state search alone.
+    pub complementarity: bool,
 }
 
 /// The body's inertia tensor from `[Ixx, Iyy, Izz, Ixy, Ixz, Iyz]`.
@@ -256,7 +261,7 @@ impl SpatialModel {
             initial_states.push(state);
         }
         let total_mass = mech.total_mass();
-        Ok(Self {
+        let model = Self {
             params: p.clone(),
             steps: (p.duration / p.dt).round() as usize + 1,
             newton: NewtonParams {
@@ -267,6 +272,13 @@ impl SpatialModel {
                 // tolerance of 1e-10 (`tests/spatial_flight.rs`), which
                 // costs 30 % more iterations on a walk.
                 residual_tol: 1e-9,
+                // The complementarity rows are semismooth: near a point
+                // that just starts or stops sliding, or lands while it
+                // slides, Newton's iterates cross branches and converge
+                // linearly for a while, and a step may have to be cut far
+                // down before the residual's max-norm decreases.
+                max_iterations: 50,
+                max_backtracks: 30,
                 ..NewtonParams::default()
             },
             contact_bumper,
@@ -274,8 +286,10 @@ impl SpatialModel {
             max_substeps: 64,
             cycle_tolerance: 1e-7 * total_mass * p.gravity.abs().max(1.0),
             stability_check_seconds,
+            complementarity: true,
             mech,
-        })
+        };
+        Ok(model)
     }
 
     /// Time step (s).

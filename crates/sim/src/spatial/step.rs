@@ -32,8 +32,12 @@ use crate::SimError;
 use crate::engine::{Engine, Law, LimitInfo, Settings, worst};
 use crate::record::LimitCode;
 use crate::rules::{Sink, regularization};
-use fbd_contact::spatial::{STOP_SPEED, clearance, frame, point_at_distance, project};
+use fbd_contact::spatial::{
+    STOP_SPEED, clearance, frame, point_at_distance, project, under_along_normal,
+};
+use fbd_contact::{ContactMode, ContactTrial};
 use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
+use fbd_dynamics::rows::Frozen;
 use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
     half_momentum_and_rotation, pattern, pattern_key, prepare_step, set_previous,
@@ -133,6 +137,7 @@ impl Engine for SpatialModel {
         prepare_step(&self.mech, &mut data.fbd, history, h);
         data.fbd.fixed_direction.fill(false);
         data.fbd.released_direction.fill(false);
+        data.fbd.frozen.fill(None);
     }
     fn torques(&self, data: &mut SpatialData) -> Result<(), SimError> {
         joint_torques(self, data)
@@ -192,7 +197,10 @@ impl Engine for SpatialModel {
                 let law = if len > STOP_SPEED * t.dt {
                     let e = [t.ft[0] + mdn * s[0] / len, t.ft[1] + mdn * s[1] / len];
                     let along = (ft - mdn).abs();
-                    let off = e[0].hypot(e[1]);
+                    // The slip's direction is known to δ/|s| rad, δ the
+                    // solver's resolution of positions (SLIP_RESOLUTION).
+                    let resolution = mdn.abs() * SLIP_RESOLUTION / len;
+                    let off = (e[0].hypot(e[1]) - resolution).max(0.0);
                     if off > along {
                         (off, Law::SlideDirection)
                     } else {
@@ -236,7 +244,13 @@ impl Engine for SpatialModel {
         }
     }
     fn newton_fallback(&self, data: &mut SpatialData) -> bool {
+        if self.complementarity {
+            return freeze_branches(data);
+        }
         fix_slides(data) || stop_slowest_slide(self, data)
+    }
+    fn complementarity_switches(&self, data: &mut SpatialData) -> bool {
+        self.complementarity && complementarity_switches(self, data)
     }
     fn refine_directions(&self, data: &mut SpatialData) -> bool {
         refine_directions(self, data)
@@ -272,6 +286,133 @@ impl Engine for SpatialModel {
     }
 }
 
+/// [`Engine::complementarity_switches`]: the states of the points in
+/// contact read from the branches their complementarity rows took at the
+/// solution ([`fbd_dynamics::rows::complementarity_rows`]):
+///
+/// * a sticking point whose friction projection is active needs more than
+///   μS·N: it slides (ST2 → ST3, opposite to the force it carries), and
+///   the step is solved again with μD — `true`;
+/// * a sliding point inside its disc has stopped: its rows were the stick
+///   rows about `p[k]`, so it sticks there (ST3 → ST2, anchored on the
+///   surface under `p[k]` along the normal) with `|Ft| ≤ μD·N ≤ μS·N`;
+/// * a point without load (`N = 0`) that ends the step above the surface
+///   by more than the penetration tolerance has left it (→ ST1, `F = 0`).
+///
+/// The last two are read off the solution, which already satisfies their
+/// laws. Each switch marks the state left as seen, so that the search's
+/// rule "a point that tried sticking and had to slide again keeps sliding"
+/// bounds the switches of one step.
+fn complementarity_switches(model: &SpatialModel, data: &mut SpatialData) -> bool {
+    if unfreeze_wrong_branches(model, data) {
+        return true;
+    }
+
+    let surface = &model.params.terrain;
+    let tol = model.params.contact.penetration_tol;
+    let mut again = false;
+    for c in 0..data.trial.len() {
+        let state = data.trial[c];
+        if state == SpatialState::Free {
+            continue;
+        }
+        let b = data.fbd.branch[c];
+        let t = trial_of(model, data, c);
+        data.seen[c] |= 1 << (state.code() as u8);
+        if b.unloaded && clearance(surface, t.p_next) > tol {
+            data.trial[c] = SpatialState::Free;
+            continue;
+        }
+        match state {
+            SpatialState::Stick { .. } if b.sliding => {
+                data.trial[c] = SpatialState::slide_against(t.ft);
+                // The next solve starts from this solution with the
+                // point's friction on its new disc, |Ft| = μD·N (sticking
+                // may have needed many times more).
+                let lay = model.mech.layout();
+                let mu_d = model.friction_at(t.location()).mu_dynamic;
+                let len = t.ft[0].hypot(t.ft[1]);
+                if len > 0.0 {
+                    let scale = (mu_d * t.n.max(0.0) / len).min(1.0);
+                    data.z[lay.contact_force(c, 0)] *= scale;
+                    data.z[lay.contact_force(c, 2)] *= scale;
+                }
+                again = true;
+            }
+            SpatialState::Slide { .. } if !b.sliding => {
+                data.trial[c] = SpatialState::Stick {
+                    anchor: under_along_normal(surface, t.p_k),
+                };
+            }
+            _ => {}
+        }
+    }
+    again
+}
+
+/// The active-set fallback of a complementarity solve that Newton could
+/// not converge (a solution on a branch's boundary — a point that just
+/// stops or just starts to slide — where semismooth Newton converges only
+/// linearly): every point in contact keeps the branches of the last
+/// iterate for the next solves of this step, which are smooth, and starts
+/// from that iterate; [`unfreeze_wrong_branches`] corrects a branch the
+/// solution contradicts. `false` when they were fixed already.
+fn freeze_branches(data: &mut SpatialData) -> bool {
+    let mut any = false;
+    for c in 0..data.trial.len() {
+        if data.trial[c] != SpatialState::Free && data.fbd.frozen[c].is_none() {
+            let b = data.fbd.branch[c];
+            data.fbd.frozen[c] = Some(Frozen {
+                unloaded: b.unloaded,
+                sliding: b.sliding,
+            });
+            any = true;
+        }
+    }
+    if any && data.z.iter().all(|v| v.is_finite()) {
+        data.start_z.copy_from_slice(&data.z);
+    }
+    any
+}
+
+/// After a solve with fixed branches: a branch the solution contradicts by
+/// more than the cycle tolerance (a slide inside its disc, a stick outside
+/// it, an unloaded point below the surface, a negative load) is switched
+/// (`true`: solve again). Within the tolerance both branches hold.
+fn unfreeze_wrong_branches(model: &SpatialModel, data: &mut SpatialData) -> bool {
+    let tol = model.cycle_tolerance;
+    let mut again = false;
+    for c in 0..data.trial.len() {
+        let Some(f) = data.fbd.frozen[c] else {
+            continue;
+        };
+        if data.trial[c] == SpatialState::Free {
+            continue;
+        }
+        let b = data.fbd.branch[c];
+        let mut g = f;
+        if f.sliding && b.excess < -tol || !f.sliding && b.excess > tol {
+            g.sliding = !f.sliding;
+        }
+        if f.unloaded && b.held < -tol || !f.unloaded && b.normal < -tol {
+            g.unloaded = !f.unloaded;
+        }
+        if g != f {
+            data.fbd.frozen[c] = Some(g);
+            again = true;
+        }
+    }
+    again
+}
+
+/// The resolution of a slip (m): the solver converges positions to about
+/// 1e-12 m (the stick rows' convergence scale), so the direction of a slip
+/// `s` is known to `δ/|s|` rad and the sliding law's direction is audited
+/// to `μD·N·δ/|s|` beyond the law tolerance: exact for every slip longer
+/// than a few nanometres a step, unresolvable (and not a law) for slides
+/// that have all but stopped.
+pub const SLIP_RESOLUTION: f64 = 1e-12;
+
 /// The regularisation β for a (sub)step of length `h` (as the planar one).
 fn beta(model: &SpatialModel, h: f64) -> f64 {
     regularization(model.params.contact.regularization, h)
@@ -293,11 +434,15 @@ fn system<'a>(
                 (p.x, p.z)
             }
         };
+        let friction = surface.friction_at(&model.params.friction, x, z);
         data.fbd.contact[c] = SpatialContactEquation {
             state,
             frame: frame(surface, x, z),
-            mu_dynamic: surface.friction_at(&model.params.friction, x, z).mu_dynamic,
+            mu_dynamic: friction.mu_dynamic,
             regularization: b + model.contact_bumper[c],
+            mu_static: friction.mu_static,
+            complementarity: model.complementarity,
+            frozen: data.fbd.frozen[c],
         };
     }
     for (eq, &state) in data.fbd.limit.iter_mut().zip(&data.limit_trial) {
@@ -347,6 +492,7 @@ fn row_scales(model: &SpatialModel, data: &mut SpatialData) {
         let row = lay.contact_row(c);
         let s = match data.trial[c] {
             SpatialState::Free => [force; 3],
+            _ if model.complementarity => [force; 3],
             SpatialState::Stick { .. } => [position; 3],
             SpatialState::Slide { .. } => [force, position, force],
         };

@@ -6,8 +6,10 @@
 # examples/hexapod_rough.toml, and the sweep plot of
 # examples/sweep_friction_height.toml; then the viewer screenshots
 # docs/viewer.png, docs/viewer_hexapod.png and docs/viewer_hexapod_walk.png
-# (scripts/test-browser.sh with FBD_SCREENSHOT_DIR=docs; SKIP_SHOTS=1 skips
-# them). The test command never writes docs/.
+# (scripts/test-browser.sh with FBD_SCREENSHOT_DIR=docs) and
+# docs/hexapod_rough_viewer.png (tests/browser/shot.mjs); SKIP_SHOTS=1 skips
+# them. The test command never writes docs/. FBD_BIN=path/to/fbd uses a
+# prebuilt binary (e.g. `cargo build --profile quick -p fbd-cli`'s).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -39,4 +41,7 @@ cp "$runs/sweep/sweep.svg" docs/sweep_friction_height.svg
 echo "docs/: forces.svg joints.svg energy.svg hexapod_tripod_gait.svg hexapod_tripod_footprints.svg hexapod_walk_feet.svg hexapod_walk_torques.svg hexapod_rough_feet.svg sweep_friction_height.svg"
 if [ "${SKIP_SHOTS:-0}" != 1 ]; then
   FBD_SCREENSHOT_DIR="$PWD/docs" bash scripts/test-browser.sh
+  # The rough walk's viewer at mid-run (tests/browser/shot.mjs; the browser
+  # test installed playwright-core).
+  (cd tests/browser && node shot.mjs "$runs/rough" "$OLDPWD/docs/hexapod_rough_viewer.png" 0.5)
 fi

@@ -40,8 +40,20 @@ pub fn doc(name: &str) -> Doc {
     }
 }
 
+/// `s` with every run of white space as one space (kept at its ends).
 fn flatten(s: &str) -> String {
-    s.split_whitespace().collect::<Vec<_>>().join(" ")
+    let inner = s.split_whitespace().collect::<Vec<_>>().join(" ");
+    let lead = if s.starts_with(char::is_whitespace) {
+        " "
+    } else {
+        ""
+    };
+    let trail = if s.ends_with(char::is_whitespace) && !inner.is_empty() {
+        " "
+    } else {
+        ""
+    };
+    format!("{lead}{inner}{trail}")
 }
 
 /// The characters a quoted number is made of (`1,898`, `-0.25`, `4e-21`).

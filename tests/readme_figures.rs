@@ -456,6 +456,19 @@ fn kinematic_gaits() {
         dx.hypot(dz),
         "default stance: reach",
     );
+    let reference = doc("docs/reference.md");
+    reference.figure(
+        "— ",
+        " m above flat ground with",
+        at(r0, "ry") - at(r0, "foot1_y"),
+        "default stance: height",
+    );
+    reference.figure(
+        "`d + a + c·cos 65°` (",
+        " m) from the body",
+        dx.hypot(dz),
+        "default stance: reach",
+    );
 }
 
 /// The CSV and Parquet sizes of the walk (README, "Output files", and the
@@ -562,6 +575,31 @@ fn landing_runs_named_in_the_readme() {
         " at 1 ms (run",
         events("examples/sweep_landing_1000_1ms.toml", worst1),
         "the most events at 1 ms",
+    );
+    // The earlier 100-run sweep: every landing completes.
+    let stress = fbd_cli::sweep::plan(&root().join("examples/sweep_landing_stress.toml")).unwrap();
+    let completed = stress
+        .configs
+        .iter()
+        .filter(|c| {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("config.toml");
+            std::fs::write(&path, c.to_toml()).unwrap();
+            let mut out = Vec::new();
+            fbd_cli::run::run_command(Some(&path), &dir.path().join("out"), &mut out).is_ok()
+        })
+        .count();
+    r.count(
+        "(`examples/sweep_landing_stress.toml`) completes ",
+        " of ",
+        completed,
+        "the 100 landings: completed",
+    );
+    r.count(
+        " of ",
+        " (it was",
+        stress.configs.len(),
+        "the 100 landings: runs",
     );
     r.count(
         "(run 872: 387 events, now ",

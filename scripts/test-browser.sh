@@ -26,8 +26,11 @@ fi
 command -v node >/dev/null || { echo "error: node is missing (apt-get install nodejs npm)" >&2; exit 1; }
 (cd tests/browser && npm ci --no-audit --no-fund --loglevel=error)
 
-cargo build --release --bin fbd
-fbd="${CARGO_TARGET_DIR:-$PWD/target}/release/fbd"
+# FBD_BIN: a prebuilt fbd (e.g. `--profile quick`'s) instead of the release build.
+if [ -z "${FBD_BIN:-}" ]; then
+  cargo build --release --bin fbd
+fi
+fbd="${FBD_BIN:-${CARGO_TARGET_DIR:-$PWD/target}/release/fbd}"
 runs=$(mktemp -d)
 trap 'rm -rf "$runs"' EXIT
 "$fbd" run --out "$runs/paper-fall" >/dev/null

@@ -144,4 +144,80 @@ fn touchdown_slip_events_and_rest_converge_as_dt_goes_to_zero() {
     // The check has teeth: at the finest Δt the touchdowns are within
     // 0.1 ms of free fall, not just within the coarse steps.
     assert!((finest.touchdown[1] - 0.199).abs() < 2e-4);
+    readme_table(&runs);
+}
+
+/// README.md's table ("The same physics at every Δt") quotes these runs:
+/// each cell is read from the README and compared with the run (to its
+/// last quoted digit); a stale cell fails naming the row.
+fn readme_table(runs: &[Outcome]) {
+    let readme = common::readme::doc("README.md");
+    let unit = |q: &str| {
+        let n: String = q.chars().take_while(|c| !c.is_whitespace()).collect();
+        common::readme::last_digit_unit(&n)
+    };
+    let close = |q: &str, v: f64, what: &str, row: &str| {
+        let got = common::readme::parse(q);
+        assert!(
+            (got - v).abs() <= 0.5 * unit(q) * (1.0 + 1e-9),
+            "README.md is stale (Δt table, row {row}, {what}): quotes {q}, the run gives {v}"
+        );
+    };
+    for r in runs {
+        let name = format!("{} ms", r.dt * 1e3);
+        let cells = readme.row(&name);
+        assert_eq!(cells.len(), 7, "row {name}: {cells:?}");
+        // Tips 4 and 3 on the ground: the step [t, t + Δt] of the touchdown.
+        for (cell, td, what) in [
+            (&cells[1], r.touchdown[1], "tip 4"),
+            (&cells[2], r.touchdown[0], "tip 3"),
+        ] {
+            let (a, b) = cell
+                .split_once('–')
+                .unwrap_or_else(|| panic!("row {name}: `{cell}` is not a range"));
+            close(a, td, what, &name);
+            close(b, td + r.dt, what, &name);
+        }
+        close(&cells[3], r.first_slip3, "leg 3 slips", &name);
+        close(&cells[4], r.sustained_slip4, "leg 4 slips", &name);
+        assert_eq!(
+            common::readme::parse(&cells[5]) as usize,
+            r.events,
+            "README.md is stale (Δt table, row {name}): events"
+        );
+        // The kinetic energy at rest is round-off: the README quotes a
+        // bound (`< 1e-15 J`).
+        let bound = cells[6]
+            .strip_prefix("< ")
+            .map(common::readme::parse)
+            .unwrap_or_else(|| panic!("row {name}: `{}` is not a bound", cells[6]));
+        assert!(
+            r.final_kinetic < bound,
+            "README.md is stale (Δt table, row {name}): kinetic energy {}, the run gives {:e} J",
+            cells[6],
+            r.final_kinetic
+        );
+    }
+    let finest = runs.last().unwrap();
+    readme.figure(
+        "the slips converge to ",
+        " s (leg 3)",
+        finest.first_slip3,
+        "converged slip of leg 3",
+    );
+    readme.figure(
+        " s (leg 3) and ",
+        " s (leg 4)",
+        finest.sustained_slip4,
+        "converged slip of leg 4",
+    );
+    let lo = runs.iter().map(|r| r.events).min().unwrap();
+    let hi = runs.iter().map(|r| r.events).max().unwrap();
+    readme.count(
+        "The number of events stays between ",
+        " and ",
+        lo,
+        "fewest events",
+    );
+    readme.count(" and ", " and the robot is at rest", hi, "most events");
 }

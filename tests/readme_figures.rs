@@ -1,16 +1,29 @@
-//! The figures README.md quotes from runs of the examples are those the
-//! runs produce: this test runs each example and fails, naming the README
-//! line it expected, when the README disagrees (a stale figure). Timings
+//! The figures README.md (and docs/*.md) quote from runs of the examples
+//! are those the runs produce: this test runs each example, reads the
+//! figure from the document's text and fails, naming the document's line,
+//! when they disagree (a stale figure; `tests/common/readme.rs`). Timings
 //! are not checked (they are quoted as ranges with the machine and the
 //! command); every other figure below is.
 //!
-//! Checked: the default experiment's events table (touchdowns, slips, the
-//! event count at 10 ms); the tripod gait's printed report; the dynamic
-//! walk's printed report (steps, Newton iterations, distance, height) and
-//! its first slips; the walk on ice's distance against the walk's and the
-//! difference in per cent and millimetres.
+//! Checked here: the default experiment's events table (touchdowns, slips,
+//! the event count at 10 ms), when the hips land, hip 4 reaches its stop
+//! and the robot comes to rest, the tips' heights and free-fall times; the
+//! tripod gait's printed report, the turn's and the wave gait's margins and
+//! distance, the default gait's walk and stance; the dynamic walk's printed
+//! report (steps, Newton iterations, distance, height), its first slips
+//! and the force under its sliding feet, the sizes of its CSV and Parquet
+//! files; the walk on ice's distance against the walk's; the peer
+//! benchmark's standing and walking hexapod (fbd's side). Elsewhere: the
+//! Δt table (`tests/dt_convergence.rs`), the terrain examples
+//! (`crates/cli/tests/terrain.rs`), run 872 of the 1 ms landings
+//! (`tests/landing_chatter.rs`).
 
+mod common;
+
+use std::collections::HashMap;
 use std::path::{Path, PathBuf};
+
+use common::readme::doc;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -20,18 +33,71 @@ fn readme() -> String {
     std::fs::read_to_string(root().join("README.md")).unwrap()
 }
 
+/// A finished run: its printed report, `summary.json` and its folder.
+struct Run {
+    report: String,
+    summary: serde_json::Value,
+    dir: tempfile::TempDir,
+}
+
+impl Run {
+    /// The rows of `trajectory.csv` as maps from column names to values.
+    fn rows(&self) -> Vec<HashMap<String, String>> {
+        let mut r = csv::Reader::from_path(self.dir.path().join("trajectory.csv")).unwrap();
+        let names: Vec<String> = r.headers().unwrap().iter().map(str::to_owned).collect();
+        r.records()
+            .map(|rec| {
+                names
+                    .iter()
+                    .cloned()
+                    .zip(rec.unwrap().iter().map(str::to_owned))
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// Bytes of the file `name` the run wrote.
+    fn size(&self, name: &str) -> u64 {
+        std::fs::metadata(self.dir.path().join(name)).unwrap().len()
+    }
+}
+
+/// A value of a `trajectory.csv` row.
+fn at(row: &HashMap<String, String>, column: &str) -> f64 {
+    row[column].parse().unwrap()
+}
+
 /// Runs `fbd run CONFIG` (the built-in default without one) into a
 /// temporary folder: the printed report and `summary.json`.
 fn run(config: Option<&str>) -> (String, serde_json::Value) {
-    let tmp = tempfile::tempdir().unwrap();
-    let path = config.map(|c| root().join(c));
+    let r = run_in(config.map(|c| root().join(c)).as_deref());
+    (r.report, r.summary)
+}
+
+/// Runs `fbd run CONFIG` into a temporary folder, which the result keeps.
+fn run_in(path: Option<&Path>) -> Run {
+    let dir = tempfile::tempdir().unwrap();
     let mut out = Vec::new();
-    fbd_cli::run::run_command(path.as_deref(), tmp.path(), &mut out).unwrap();
-    let summary = std::fs::read_to_string(tmp.path().join("summary.json")).unwrap();
-    (
-        String::from_utf8(out).unwrap(),
-        serde_json::from_str(&summary).unwrap(),
-    )
+    fbd_cli::run::run_command(path, dir.path(), &mut out).unwrap();
+    let summary = std::fs::read_to_string(dir.path().join("summary.json")).unwrap();
+    Run {
+        report: String::from_utf8(out).unwrap(),
+        summary: serde_json::from_str(&summary).unwrap(),
+        dir,
+    }
+}
+
+/// Runs the configuration `text` (written to a temporary file).
+fn run_text(text: &str) -> Run {
+    let cfg = tempfile::tempdir().unwrap();
+    let path = cfg.path().join("config.toml");
+    std::fs::write(&path, text).unwrap();
+    run_in(Some(&path))
+}
+
+/// An example's text.
+fn example(name: &str) -> String {
+    std::fs::read_to_string(root().join(name)).unwrap()
 }
 
 /// Fails unless README.md contains `want`, showing the README's nearest
@@ -99,6 +165,57 @@ fn default_experiment_events_table() {
     );
 }
 
+/// "all 81 neighbours with ±10 % body mass, ±33 % upper-link mass, …
+/// reproduce the same event times to within one step": the README's
+/// percentages, each parameter at −, 0 and +, every combination (the link
+/// inertias m·a²/12 scale with their masses).
+#[test]
+fn default_parameters_are_robust_as_quoted() {
+    let r = doc("README.md");
+    let pct = |after: &str| common::readme::parse(&r.quoted("±", after)) / 100.0;
+    let (body, upper, lower, inertia) = (
+        pct(" % body mass"),
+        pct(" % upper-link mass"),
+        pct(" % lower-link mass"),
+        pct(" % body inertia"),
+    );
+    let (_, reference) = run(None);
+    let times = |s: &serde_json::Value| -> Vec<f64> {
+        ["first_touchdown", "first_slip"]
+            .iter()
+            .flat_map(|k| ["leg3", "leg4"].map(|l| s[k][l].as_f64().unwrap()))
+            .collect()
+    };
+    let dt = reference["dt"].as_f64().unwrap();
+    let want = times(&reference);
+    let mut n = 0;
+    for b in [-body, 0.0, body] {
+        for u in [-upper, 0.0, upper] {
+            for l in [-lower, 0.0, lower] {
+                for i in [-inertia, 0.0, inertia] {
+                    let (mu, ml) = (0.3 * (1.0 + u), 1.1 * (1.0 + l));
+                    let config = format!(
+                        "[body]\nmass = {}\ninertia = {}\n[leg]\nupper_mass = {mu}\nupper_inertia = {}\nlower_mass = {ml}\nlower_inertia = {}\n[output]\nviewer = false\nplots = false\n",
+                        10.0 * (1.0 + b),
+                        0.3 * (1.0 + i),
+                        mu * 0.2f64.powi(2) / 12.0,
+                        ml * 0.42f64.powi(2) / 12.0,
+                    );
+                    let got = times(&run_text(&config).summary);
+                    for (g, w) in got.iter().zip(&want) {
+                        assert!(
+                            (g - w).abs() <= dt + 1e-9,
+                            "README.md is stale: body mass {b:+}, upper {u:+}, lower {l:+}, inertia {i:+}: events at {got:?}, the default's at {want:?}"
+                        );
+                    }
+                    n += 1;
+                }
+            }
+        }
+    }
+    r.count("(all ", " neighbours with ±", n, "neighbours");
+}
+
 #[test]
 fn tripod_gait_report() {
     let r = readme();
@@ -119,7 +236,25 @@ fn tripod_gait_report() {
 #[test]
 fn dynamic_walk_and_walk_on_ice() {
     let r = readme();
-    let (report, s) = run(Some("examples/hexapod_walk.toml"));
+    let walk = run_in(Some(&root().join("examples/hexapod_walk.toml")));
+    // Every ST3 row of the walk is a foot about to lift off, nearly
+    // unloaded: under the README's bound.
+    let mut sliding = 0.0f64;
+    for row in walk.rows() {
+        for n in 1..=6 {
+            if row[&format!("state{n}")] == "ST3" {
+                sliding = sliding.max(at(&row, &format!("foot{n}_n")));
+            }
+        }
+    }
+    let bound = common::readme::parse(
+        &doc("README.md").quoted("a foot's last milliseconds before ST1, under ", " N)"),
+    );
+    assert!(
+        sliding < bound,
+        "README.md is stale: a sliding foot of the walk carries {sliding} N, the README says under {bound} N"
+    );
+    let (report, s) = (walk.report, walk.summary);
     has(
         &r,
         without_time(line(&report, "solved ")),
@@ -143,7 +278,30 @@ fn dynamic_walk_and_walk_on_ice() {
         "walk: first slips",
     );
 
-    let (_, ice) = run(Some("examples/hexapod_walk_ice.toml"));
+    let ice_run = run_in(Some(&root().join("examples/hexapod_walk_ice.toml")));
+    // The share of the loaded stance rows (above the README's load) that
+    // slide.
+    let readme_doc = doc("README.md");
+    let load = common::readme::parse(
+        &readme_doc.quoted("the stance feet carrying more than ", " N slip in"),
+    );
+    let (mut loaded, mut sliding) = (0usize, 0usize);
+    for row in ice_run.rows() {
+        for n in 1..=6 {
+            let state = &row[&format!("state{n}")];
+            if state != "ST1" && at(&row, &format!("foot{n}_n")) > load {
+                loaded += 1;
+                sliding += usize::from(state == "ST3");
+            }
+        }
+    }
+    readme_doc.figure(
+        " N slip in ",
+        " % of their rows",
+        100.0 * sliding as f64 / loaded as f64,
+        "walk on ice: sliding rows",
+    );
+    let ice = ice_run.summary;
     let d = |s: &serde_json::Value| s["displacement"][0].as_f64().unwrap();
     let (walk, on_ice) = (d(&s), d(&ice));
     let figures = format!("{on_ice:.3} m against {walk:.3} m");
@@ -164,6 +322,290 @@ fn dynamic_walk_and_walk_on_ice() {
         &r,
         &format!("the {:.0} mm lost", (walk - on_ice) * 1e3),
         "walk on ice: millimetres",
+    );
+}
+
+#[test]
+fn default_experiment_after_the_papers_events() {
+    let r = doc("README.md");
+    let run = run_in(None);
+    let s = &run.summary;
+    let dt = s["dt"].as_f64().unwrap();
+    let events = s["events"].as_array().unwrap();
+    let when = |point: &str, leg: u64, from: &str| {
+        events
+            .iter()
+            .find(|e| e["point"] == point && e["leg"] == leg && e["from"] == from)
+            .unwrap_or_else(|| panic!("no {point} {leg} event from {from}"))["t"]
+            .as_f64()
+            .unwrap()
+    };
+    let (hip3, hip4) = (when("hip", 3, "ST1"), when("hip", 4, "ST1"));
+    assert_eq!(hip3, hip4, "the README says both hips land at once");
+    r.figure(
+        "After the paper's events the body lands on both hips at ",
+        " s",
+        hip3,
+        "hips landing",
+    );
+    r.figure(
+        "hip 4 reaches its limit (θ2 = −120°) at ",
+        " s",
+        when("hip_limit", 4, "free"),
+        "hip 4 at its stop",
+    );
+    // At rest from the step after the last event.
+    let last = events.last().unwrap()["t"].as_f64().unwrap() + dt;
+    r.figure(
+        "and from ",
+        " s the robot lies at rest",
+        last,
+        "at rest from",
+    );
+    r.figure(
+        "the robot at rest (from ",
+        " s, on both feet",
+        last,
+        "at rest from (table)",
+    );
+    // The tips' initial heights and their free-fall times.
+    let rows = run.rows();
+    let (h3, h4) = (at(&rows[0], "tip3_y"), at(&rows[0], "tip4_y"));
+    let g = 9.81;
+    r.figure("the tips (at ", " m and ", h4, "tip 4's height");
+    r.figure(
+        " m and ",
+        " m) reach the ground after",
+        h3,
+        "tip 3's height",
+    );
+    r.figure(
+        "the free-fall times √(2h/g) = ",
+        " s and ",
+        (2.0 * h4 / g).sqrt(),
+        "tip 4's free fall",
+    );
+    r.figure(
+        " s and ",
+        " s; the slips converge",
+        (2.0 * h3 / g).sqrt(),
+        "tip 3's free fall",
+    );
+}
+
+#[test]
+fn kinematic_gaits() {
+    let r = doc("README.md");
+    let margin = |s: &serde_json::Value| s["min_margin"]["value"].as_f64().unwrap();
+    let (_, turn) = run(Some("examples/hexapod_turn.toml"));
+    r.figure(
+        "turns in place 90° (tripod, 15°/s; minimum margin ",
+        " m)",
+        margin(&turn),
+        "turn: margin",
+    );
+    r.figure(
+        "turns in place ",
+        "° (tripod",
+        turn["heading_change_deg"].as_f64().unwrap(),
+        "turn: angle",
+    );
+    let (_, wave) = run(Some("examples/hexapod_wave_slope.toml"));
+    r.figure(
+        "`examples/hexapod_wave_slope.toml` climbs ",
+        " m up a 10° slope",
+        wave["distance"].as_f64().unwrap(),
+        "wave gait: distance",
+    );
+    r.figure(
+        "(one leg in the air at a time; minimum margin ",
+        " m)",
+        margin(&wave),
+        "wave gait: margin",
+    );
+    // The defaults: a stance, and an empty [gait] walks.
+    let walk = run_text("model = \"hexapod\"\ndynamics = \"kinematic\"\n[gait]\n");
+    let s = &walk.summary;
+    r.figure(
+        "for 5 periods and stand for one more (",
+        " s, 0.",
+        s["duration"].as_f64().unwrap(),
+        "default gait: duration",
+    );
+    r.figure(
+        " s, ",
+        " m with the start-up and stop)",
+        s["distance"].as_f64().unwrap(),
+        "default gait: distance",
+    );
+    let rows = walk.rows();
+    let r0 = &rows[0];
+    let (dx, dz) = (
+        at(r0, "foot1_x") - at(r0, "rx"),
+        at(r0, "foot1_z") - at(r0, "rz"),
+    );
+    r.figure(
+        "the body ",
+        " m above its feet",
+        at(r0, "ry") - at(r0, "foot1_y"),
+        "default stance: height",
+    );
+    r.figure(
+        "the feet ",
+        " m from the body centre",
+        dx.hypot(dz),
+        "default stance: reach",
+    );
+    let reference = doc("docs/reference.md");
+    reference.figure(
+        "— ",
+        " m above flat ground with",
+        at(r0, "ry") - at(r0, "foot1_y"),
+        "default stance: height",
+    );
+    reference.figure(
+        "`d + a + c·cos 65°` (",
+        " m) from the body",
+        dx.hypot(dz),
+        "default stance: reach",
+    );
+}
+
+/// The CSV and Parquet sizes of the walk (README, "Output files", and the
+/// table of docs/reference.md).
+#[test]
+fn walk_file_sizes() {
+    let text = example("examples/hexapod_walk.toml");
+    assert!(!text.contains("[output]"), "the walk sets no [output]");
+    let csv =
+        run_in(Some(&root().join("examples/hexapod_walk.toml"))).size("trajectory.csv") as f64;
+    let parquet = run_text(&format!("{text}\n[output]\nformat = \"parquet\"\n"))
+        .size("trajectory.parquet") as f64;
+    let r = doc("README.md");
+    r.figure(
+        "`examples/hexapod_walk.toml` (",
+        " MB against ",
+        parquet / 1e6,
+        "parquet size",
+    );
+    r.figure(" MB against ", " MB) and read", csv / 1e6, "csv size");
+    r.figure(
+        "`trajectory.parquet`, ",
+        " times smaller",
+        csv / parquet,
+        "ratio",
+    );
+    let reference = doc("docs/reference.md");
+    reference.figure(
+        "| `csv` | `trajectory.csv` | ",
+        " MB |",
+        csv / 1e6,
+        "csv size",
+    );
+    reference.figure(
+        "| `parquet` | `trajectory.parquet` | ",
+        " MB |",
+        parquet / 1e6,
+        "parquet size",
+    );
+}
+
+/// fbd's side of bench/peer's hexapod cases (the README's paragraph after
+/// the scaling table).
+#[test]
+fn peer_hexapod_figures() {
+    let r = doc("README.md");
+    let stand = run_in(Some(&root().join("bench/peer/hexapod_stand.toml")));
+    let rows = stand.rows();
+    let last = rows.last().unwrap();
+    let n: Vec<f64> = (1..=6).map(|k| at(last, &format!("foot{k}_n"))).collect();
+    let mean = n.iter().sum::<f64>() / 6.0;
+    for f in &n {
+        assert!((f - mean).abs() < 5e-4, "the feet carry {n:?}: not alike");
+    }
+    r.figure(
+        "The standing hexapod's feet carry ",
+        " N each in both",
+        mean,
+        "peer: stand, each foot",
+    );
+    r.figure(
+        "in both (Σ ",
+        " N, the weight)",
+        n.iter().sum(),
+        "peer: stand, sum",
+    );
+    let walk = run_in(Some(&root().join("bench/peer/hexapod_walk.toml")));
+    let rows = walk.rows();
+    let (a, b) = (&rows[0], rows.last().unwrap());
+    let moved = (at(b, "rx") - at(a, "rx")).hypot(at(b, "rz") - at(a, "rz"));
+    r.figure(
+        "over 5 s of walking the body moves ",
+        " m in fbd",
+        moved,
+        "peer: walk distance",
+    );
+}
+
+/// The landings the README names by their run number (the 1000-run sweeps
+/// themselves are measured by `scripts/landing-figures.py`): their events.
+#[test]
+fn landing_runs_named_in_the_readme() {
+    let r = doc("README.md");
+    let events = |sweep: &str, run: usize| {
+        let plan = fbd_cli::sweep::plan(&root().join(sweep)).unwrap();
+        let config = plan.configs[run].to_toml();
+        run_text(&config).summary["events"]
+            .as_array()
+            .unwrap()
+            .len()
+    };
+    let quoted_run =
+        |before: &str, after: &str| common::readme::parse(&r.quoted(before, after)) as usize;
+    let worst10 = quoted_run(" at 10 ms (run ", ")");
+    r.count(
+        "the most events a run writes is ",
+        " at 10 ms (run",
+        events("examples/sweep_landing_1000.toml", worst10),
+        "the most events at 10 ms",
+    );
+    let worst1 = quoted_run(" at 1 ms (run ", ")");
+    r.count(
+        ") and ",
+        " at 1 ms (run",
+        events("examples/sweep_landing_1000_1ms.toml", worst1),
+        "the most events at 1 ms",
+    );
+    // The earlier 100-run sweep: every landing completes.
+    let stress = fbd_cli::sweep::plan(&root().join("examples/sweep_landing_stress.toml")).unwrap();
+    let completed = stress
+        .configs
+        .iter()
+        .filter(|c| {
+            let dir = tempfile::tempdir().unwrap();
+            let path = dir.path().join("config.toml");
+            std::fs::write(&path, c.to_toml()).unwrap();
+            let mut out = Vec::new();
+            fbd_cli::run::run_command(Some(&path), &dir.path().join("out"), &mut out).is_ok()
+        })
+        .count();
+    r.count(
+        "(`examples/sweep_landing_stress.toml`) completes ",
+        " of ",
+        completed,
+        "the 100 landings: completed",
+    );
+    r.count(
+        " of ",
+        " (it was",
+        stress.configs.len(),
+        "the 100 landings: runs",
+    );
+    r.count(
+        "(run 872: 387 events, now ",
+        ")",
+        events("examples/sweep_landing_1000_1ms.toml", 872),
+        "run 872",
     );
 }
 

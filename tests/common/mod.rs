@@ -4,5 +4,6 @@
 pub mod gait;
 pub mod harness;
 pub mod physics;
+pub mod readme;
 pub mod spatial;
 pub mod strategies;

@@ -136,6 +136,97 @@ pub fn warn_size(rows: usize, columns: usize, stride: usize, format: fbd_scenari
     }
 }
 
+/// A sweep that will write more than this (bytes, estimated before its
+/// first run: every run's trajectory file, and its viewer and plots when
+/// asked for) gets one warning on stderr (docs/sweep.md, "Output size").
+pub const LARGE_SWEEP: f64 = 500e6;
+
+/// About what one run's `viewer.html` adds: three.js and the page (some
+/// 0.76 MB a planar run; a hexapod's page is larger, about 2 MB).
+pub const VIEWER_BYTES: [f64; 2] = [0.8e6, 2.0e6];
+
+/// About what one run's plots (`*.svg`) add: planar, hexapod.
+pub const PLOTS_BYTES: [f64; 2] = [0.1e6, 0.3e6];
+
+/// One run's trajectory file as a sweep plans it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TrajectorySize {
+    /// Rows written (`steps / stride`, rounded up).
+    pub rows: usize,
+    /// Columns of a row.
+    pub columns: usize,
+    /// `[output] stride`.
+    pub stride: usize,
+    /// `[output] format`.
+    pub format: fbd_scenario::OutputFormat,
+    /// A hexapod run (its viewer and plots are larger).
+    pub hexapod: bool,
+}
+
+impl TrajectorySize {
+    /// The estimated size of the trajectory file (bytes).
+    pub fn bytes(&self) -> f64 {
+        self.rows as f64 * self.columns as f64 * bytes_per_value(self.format)
+    }
+
+    /// The estimated size of the run's viewer and plots (bytes), as asked.
+    pub fn extras(&self, viewer: bool, plots: bool) -> f64 {
+        let h = usize::from(self.hexapod);
+        f64::from(u8::from(viewer)) * VIEWER_BYTES[h] + f64::from(u8::from(plots)) * PLOTS_BYTES[h]
+    }
+}
+
+/// The warning for a sweep whose runs will write about more than
+/// [`LARGE_SWEEP`] bytes: the estimate, what it is made of, and what would
+/// shrink it (the runs without `--viewer`/`--plots`; a stride that keeps
+/// the trajectory files under the limit; Parquet for CSV).
+pub fn sweep_size_warning(runs: &[TrajectorySize], viewer: bool, plots: bool) -> Option<String> {
+    let traj: f64 = runs.iter().map(TrajectorySize::bytes).sum();
+    let extras: f64 = runs.iter().map(|r| r.extras(viewer, plots)).sum();
+    let total = traj + extras;
+    if total <= LARGE_SWEEP {
+        return None;
+    }
+    let mb = |b: f64| crate::sweep::human_bytes(b as u64);
+    let mut parts = format!("trajectory files {}", mb(traj));
+    if viewer || plots {
+        parts.push_str(&format!(", viewers and plots {}", mb(extras)));
+    }
+    let mut shrink = Vec::new();
+    if (viewer || plots) && extras >= total / 10.0 {
+        let flags = match (viewer, plots) {
+            (true, true) => "--viewer and --plots",
+            (true, false) => "--viewer",
+            _ => "--plots",
+        };
+        shrink.push(format!(
+            "without {flags} it writes {} (`fbd view DIR/runs/<i>` writes one run's viewer later)",
+            mb(traj)
+        ));
+    }
+    if traj > LARGE_SWEEP / 2.0 {
+        let stride = runs.iter().map(|r| r.stride.max(1)).max().unwrap_or(1);
+        let factor = (traj / (LARGE_SWEEP / 2.0)).ceil() as usize;
+        shrink.push(format!(
+            "`[output] stride = {}` in the base configuration keeps the trajectory files under {}",
+            stride * factor,
+            mb(LARGE_SWEEP / 2.0)
+        ));
+        if runs
+            .iter()
+            .any(|r| r.format == fbd_scenario::OutputFormat::Csv)
+        {
+            shrink.push("`format = \"parquet\"` makes them about 2.5 times smaller".to_owned());
+        }
+    }
+    Some(format!(
+        "warning: this sweep will write about {} ({}: {parts}); {}",
+        mb(total),
+        count(runs.len(), "run", "runs"),
+        shrink.join("; ")
+    ))
+}
+
 /// `x` with `decimals` decimals, never `-0.0000`: a value that rounds to
 /// zero prints without a sign.
 pub fn fixed(x: f64, decimals: usize) -> String {
@@ -927,6 +1018,51 @@ pub struct Summary {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `n` planar runs of `rows` rows of 50 CSV columns.
+    fn planar(n: usize, rows: usize) -> Vec<TrajectorySize> {
+        vec![
+            TrajectorySize {
+                rows,
+                columns: 50,
+                stride: 1,
+                format: fbd_scenario::OutputFormat::Csv,
+                hexapod: false,
+            };
+            n
+        ]
+    }
+
+    #[test]
+    fn a_sweep_warns_above_its_size_with_what_would_shrink_it() {
+        // Like the 10 ms landings: 1000 runs of 100 rows, 95 MB of CSV.
+        let landings = planar(1000, 100);
+        assert_eq!(sweep_size_warning(&landings, false, false), None);
+        // With their viewers and plots, some 0.9 GB: drop the flags.
+        let w = sweep_size_warning(&landings, true, true).unwrap();
+        assert!(w.starts_with("warning: this sweep will write about 995.0 MB (1000 runs: trajectory files 95.0 MB, viewers and plots 900.0 MB); without --viewer and --plots it writes 95.0 MB"), "{w}");
+        assert!(!w.contains("stride"), "{w}");
+        // The 1 ms landings: ten times the rows. A stride of 4 keeps them
+        // under a half of the limit; Parquet shrinks them too.
+        let w = sweep_size_warning(&planar(1000, 1000), false, false).unwrap();
+        assert!(w.contains("(1000 runs: trajectory files 950.0 MB)"), "{w}");
+        assert!(w.contains("`[output] stride = 4` in the base configuration keeps the trajectory files under 250.0 MB; `format = \"parquet\"`"), "{w}");
+        let strided: Vec<TrajectorySize> = planar(1000, 250)
+            .into_iter()
+            .map(|t| TrajectorySize { stride: 4, ..t })
+            .collect();
+        assert_eq!(sweep_size_warning(&strided, false, false), None);
+        // Parquet already: no format advice.
+        let parquet: Vec<TrajectorySize> = planar(1000, 10_001)
+            .into_iter()
+            .map(|t| TrajectorySize {
+                format: fbd_scenario::OutputFormat::Parquet,
+                ..t
+            })
+            .collect();
+        let w = sweep_size_warning(&parquet, false, false).unwrap();
+        assert!(w.contains("stride = 17`") && !w.contains("format"), "{w}");
+    }
 
     /// A contact point named `name` (deliberately unrelated to its
     /// identity: nothing may decide by it).

@@ -759,6 +759,9 @@ pub struct Plan {
     pub values: Vec<Vec<toml::Value>>,
     /// Per run: the complete configuration.
     pub configs: Vec<Config>,
+    /// Per run: its trajectory file as planned (rows, columns, format),
+    /// for the sweep's size warning.
+    pub trajectories: Vec<crate::output::TrajectorySize>,
 }
 
 /// Reads the sweep file, expands it and validates every run's
@@ -803,6 +806,7 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         None => (String::new(), "the built-in default".to_owned()),
     };
     let mut configs = Vec::with_capacity(values.len());
+    let mut trajectories = Vec::with_capacity(values.len());
     for (i, vals) in values.iter().enumerate() {
         let overrides: Vec<Override> = keys
             .iter()
@@ -819,18 +823,39 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         let fail = |e: String| CliError::Usage(format!("{name}: run {i} ({}): {e}", what()));
         let c = config::parse_str(&base_text, &base_name, &overrides)
             .map_err(|e| fail(e.to_string()))?;
-        match &c {
+        let size = |steps: usize, columns: usize, output: &fbd_scenario::OutputConfig| {
+            let stride = output.stride.max(1);
+            crate::output::TrajectorySize {
+                rows: steps.div_ceil(stride),
+                columns,
+                stride,
+                format: output.format,
+                hexapod: matches!(c, Config::Hexapod(_)),
+            }
+        };
+        trajectories.push(match &c {
             Config::Planar(p) => {
-                p.model(&base_name).map_err(|e| fail(e.to_string()))?;
+                let m = p.model(&base_name).map_err(|e| fail(e.to_string()))?;
+                let columns = crate::output::ContactSlots::of(&m.mech.contacts)
+                    .columns()
+                    .len();
+                size(m.steps, columns, &p.output)
             }
             Config::Hexapod(h) if h.is_dynamic() => {
-                h.spatial_model(&base_name)
+                let m = h
+                    .spatial_model(&base_name)
                     .map_err(|e| fail(e.to_string()))?;
+                let params = h
+                    .spatial_params(&base_name)
+                    .map_err(|e| fail(e.to_string()))?;
+                let columns = crate::spatial::columns(&crate::spatial::Layout::of(&params)).len();
+                size(m.steps, columns, &h.output)
             }
             Config::Hexapod(h) => {
-                h.gait_model(&base_name).map_err(|e| fail(e.to_string()))?;
+                let m = h.gait_model(&base_name).map_err(|e| fail(e.to_string()))?;
+                size(m.steps, crate::hexapod::columns().len(), &h.output)
             }
-        }
+        });
         configs.push(c);
     }
     Ok(Plan {
@@ -838,6 +863,7 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         keys,
         values,
         configs,
+        trajectories,
     })
 }
 
@@ -1031,6 +1057,18 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
         output.plots = a.plots;
     }
     let total = plan.configs.len();
+    // Before anything is written: a sweep larger than LARGE_SWEEP says so
+    // once, with what would shrink it (this shard's runs).
+    let planned: Vec<crate::output::TrajectorySize> = plan
+        .trajectories
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| i % shard_n == shard_i)
+        .map(|(_, t)| *t)
+        .collect();
+    if let Some(w) = crate::output::sweep_size_warning(&planned, a.viewer, a.plots) {
+        eprintln!("{w}");
+    }
     let dir = &a.out;
     crate::output::prepare_dir(dir)?;
     crate::output::prepare_dir(&dir.join("runs"))?;

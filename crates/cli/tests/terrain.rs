@@ -368,6 +368,12 @@ fn the_rough_walk_covers_its_metre_obeying_coulomb_and_newton_on_every_row() {
     let moved = last.q[2] - first.q[2];
     println!("moved {moved} m along Z, largest relative imbalance {worst:e}");
     assert!(moved < -0.95, "walks 1 m along −Z: {moved}");
+    common::readme::doc("README.md").figure(
+        "the body ends ",
+        " m along −Z",
+        -moved,
+        "the rough walk's distance",
+    );
     // Every foot touched down on the surface, whose height varies.
     let touchdowns: Vec<_> = run
         .events
@@ -413,11 +419,22 @@ fn the_stairs_example_climbs_three_steps() {
         last.q[2] - first.q[2]
     );
     assert!(climbed > 0.13, "climbed {climbed}");
+    common::readme::doc("README.md").figure(
+        "all six feet end on the top step, the body ",
+        " m higher",
+        climbed,
+        "the stairs' climb",
+    );
 }
 
 #[test]
 fn on_the_ice_patch_the_feet_slip_and_off_it_they_stick() {
     let (_, rows, _) = run_example("hexapod_ice_patch.toml");
+    // The README's bound on the feet that slide off the ice.
+    let readme = common::readme::doc("README.md");
+    let unloaded = common::readme::parse(
+        &readme.quoted("off it only nearly unloaded feet (N < ", " N) slide"),
+    );
     let (mut on_ice, mut off_ice, mut off_loaded) = (0, 0, 0);
     for r in &rows {
         for c in r.contacts.iter().filter(|c| c.state == StateCode::St3) {
@@ -425,7 +442,7 @@ fn on_the_ice_patch_the_feet_slip_and_off_it_they_stick() {
                 on_ice += 1;
             } else {
                 off_ice += 1;
-                off_loaded += usize::from(c.normal > 12.0);
+                off_loaded += usize::from(c.normal > unloaded);
             }
         }
     }
@@ -433,6 +450,12 @@ fn on_the_ice_patch_the_feet_slip_and_off_it_they_stick() {
     assert!(on_ice > 1000, "the feet on the ice slip");
     assert_eq!(off_loaded, 0, "a loaded foot off the ice slid");
     assert!(off_ice * 10 < on_ice);
+    readme.count(
+        "(`[[terrain.patch]]`, μ = 0.1, on ground of μS = 0.8): ",
+        " sliding rows on the ice",
+        on_ice,
+        "sliding rows on the ice",
+    );
 }
 
 #[test]

@@ -193,3 +193,29 @@ def test_ctrl_c_interrupts_a_long_run_and_a_long_step_call(ctrl_c):
     assert 0 < k < sim.steps
     sim.step()
     assert sim.k == k + 1
+
+
+def test_unstable_gains_in_a_python_loop_end_with_a_hint():
+    # A PD law written in Python with gains far too stiff for Δt (the
+    # torques are applied explicitly: kp·Δt²/I ≈ 50 ≫ 4): the oscillation
+    # grows until Newton's method cannot solve a step. The error says why
+    # and what to change, not only "Newton did not converge".
+    sim = fbd.Simulator(
+        {
+            "terrain": {"kind": "none"},
+            "leg": {"theta2_deg": [-1e6, 1e6], "theta3_deg": [-1e6, 1e6]},
+        }
+    )
+    target = sim.q0[3:7] + 0.05
+    with pytest.raises(fbd.SimulationError) as info:
+        while sim.k < sim.steps:
+            sim.step(5000.0 * (target - sim.q[3:7]))
+    msg = str(info.value)
+    assert "did not converge" in msg, msg
+    assert "the torques given to step() are applied explicitly" in msg, msg
+    assert "lower the gains or time.dt" in msg and "set_pd_targets()" in msg, msg
+    # The configured controller's steps get no such hint: the hint is
+    # about the torques a caller gives.
+    with pytest.raises(fbd.SimulationError) as ref:
+        fbd.Simulator(FAILING).step(steps=100)
+    assert "applied explicitly" not in str(ref.value), str(ref.value)

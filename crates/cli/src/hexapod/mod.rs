@@ -460,9 +460,9 @@ pub fn run_command(
     let mut text = String::new();
     for e in run.events.iter().filter(|e| e.leg.is_none()) {
         text.push_str(&format!(
-            "t={} s  stability margin {:.4} m {}\n",
+            "t={} s  stability margin {} m {}\n",
             fbd_sim::gait::error::fmt_time(e.t),
-            e.margin,
+            output::fixed(e.margin, 4),
             if e.kind == fbd_sim::gait::GaitEventKind::MarginLow {
                 "below the warning threshold"
             } else {
@@ -488,13 +488,16 @@ pub fn run_command(
         run.wall_seconds
     ));
     text.push_str(&format!(
-        "distance walked {:.4} m (net {:.4} m, heading change {:.2}°), mean speed {:.4} m/s\n",
-        summary.distance, summary.displacement, summary.heading_change_deg, summary.mean_speed
+        "distance walked {} m (net {} m, heading change {}°), mean speed {} m/s\n",
+        output::fixed(summary.distance, 4),
+        output::fixed(summary.displacement, 4),
+        output::fixed(summary.heading_change_deg, 2),
+        output::fixed(summary.mean_speed, 4)
     ));
     match &summary.min_margin {
         Some(m) => text.push_str(&format!(
-            "minimum stability margin {:.4} m at t = {} s\n",
-            m.value,
+            "minimum stability margin {} m at t = {} s\n",
+            output::fixed(m.value, 4),
             fbd_sim::gait::error::fmt_time(m.t)
         )),
         None => text.push_str("minimum stability margin: no support polygon\n"),

@@ -74,3 +74,8 @@ pub const FAIL_DT: f64 = 0.01;
 pub fn fail_prefix() -> String {
     format!("step {FAIL_STEP} (t = {:.2}", FAIL_STEP as f64 * FAIL_DT)
 }
+
+/// The figures README.md and docs/*.md quote, checked against runs (one
+/// module for the workspace's and the CLI's tests).
+#[path = "../../../../tests/common/readme.rs"]
+pub mod readme;

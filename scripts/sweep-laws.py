@@ -10,7 +10,8 @@ checked on every row, from the CSV alone: a free point (ST1) carries no
 force; otherwise N ≥ 0, and with Ft the horizontal part of the force
 (flat ground: the normal is +Y) |Ft| ≤ μS·N when sticking (ST2), |Ft| = μD·N
 when sliding (ST3), and for a foot (whose position is a column) Ft opposes
-the foot's slip to the next row, Ft = −μD·N·ŝ (not on the row of a step
+the foot's slip to the next row, Ft = −μD·N·ŝ to the direction's
+resolution 1e-12 m/|s| (docs/reference.md; not on the row of a step
 solved in substeps, whose forces are its first substep's). Tolerance: `tol` × the
 robot's weight (default 1e-6). Prints one line per law-breaking run and the
 table of the README: completed runs, exact rows, steps per second (median,
@@ -25,6 +26,10 @@ import statistics
 import sys
 import tomllib
 from pathlib import Path
+
+
+# fbd_sim::spatial::step::SLIP_RESOLUTION (m).
+SLIP_RESOLUTION = 1e-12
 
 
 def weight(cfg):
@@ -83,6 +88,9 @@ def check_run(run, retried):
                         sl = math.hypot(sx, sz)
                         if sl > 1e-9 * DT:
                             e = math.hypot(ftx + mu_d * n * sx / sl, ftz + mu_d * n * sz / sl)
+                            # The direction of a slip s is resolved to
+                            # SLIP_RESOLUTION/|s| rad (docs/reference.md).
+                            e = max(e - mu_d * abs(n) * SLIP_RESOLUTION / sl, 0.0)
                             if e > v:
                                 v, law = e, "Ft not -muD N s^"
             if v > tol:

@@ -171,6 +171,9 @@ pub struct SpatialFbdData {
     /// Per contact, the branches fixed for the solves of this step's
     /// search (`fbd_sim`'s active-set fallback; reset every step).
     pub frozen: Vec<Option<rows::Frozen>>,
+    /// This step's solves use fixed states, not complementarity rows
+    /// (`fbd_sim`'s last fallback; reset every step).
+    pub fixed_states: bool,
     rot_d: Vec<Matrix3<f64>>,
     /// The `q` `kin_next` was last evaluated at (NaN: none).
     kin_next_q: Vec<f64>,
@@ -240,6 +243,7 @@ impl SpatialFbdData {
             slip_n: vec![0.0; mech.contacts.len()],
             branch: vec![rows::Branch::default(); mech.contacts.len()],
             frozen: vec![None; mech.contacts.len()],
+            fixed_states: false,
             wrench: vec![Wrench::default(); nb],
             rot_d: vec![Matrix3::zeros(); nb],
             kin_next_q: vec![f64::NAN; mech.layout().nq],

@@ -138,6 +138,7 @@ impl Engine for SpatialModel {
         data.fbd.fixed_direction.fill(false);
         data.fbd.released_direction.fill(false);
         data.fbd.frozen.fill(None);
+        data.fbd.fixed_states = false;
     }
     fn torques(&self, data: &mut SpatialData) -> Result<(), SimError> {
         joint_torques(self, data)
@@ -244,13 +245,17 @@ impl Engine for SpatialModel {
         }
     }
     fn newton_fallback(&self, data: &mut SpatialData) -> bool {
-        if self.complementarity {
-            return freeze_branches(data);
+        if complementarity(self, data) {
+            if !freeze_branches(data) {
+                // The last resort of the step: fixed states, searched.
+                data.fbd.fixed_states = true;
+            }
+            return true;
         }
         fix_slides(data) || stop_slowest_slide(self, data)
     }
     fn complementarity_switches(&self, data: &mut SpatialData) -> bool {
-        self.complementarity && complementarity_switches(self, data)
+        complementarity(self, data) && complementarity_switches(self, data)
     }
     fn refine_directions(&self, data: &mut SpatialData) -> bool {
         refine_directions(self, data)
@@ -350,6 +355,15 @@ fn complementarity_switches(model: &SpatialModel, data: &mut SpatialData) -> boo
     again
 }
 
+/// Whether this solve's points in contact use complementarity rows: the
+/// model's choice, unless both the semismooth and the active-set solves of
+/// this step have failed, when the step falls back to fixed states
+/// searched by the switching rules (the rows of [`fbd_dynamics::rows`]
+/// with the implicit slip direction), audited like every other.
+fn complementarity(model: &SpatialModel, data: &SpatialData) -> bool {
+    model.complementarity && !data.fbd.fixed_states
+}
+
 /// The active-set fallback of a complementarity solve that Newton could
 /// not converge (a solution on a branch's boundary — a point that just
 /// stops or just starts to slide — where semismooth Newton converges only
@@ -441,7 +455,7 @@ fn system<'a>(
             mu_dynamic: friction.mu_dynamic,
             regularization: b + model.contact_bumper[c],
             mu_static: friction.mu_static,
-            complementarity: model.complementarity,
+            complementarity: complementarity(model, data),
             frozen: data.fbd.frozen[c],
         };
     }
@@ -492,7 +506,7 @@ fn row_scales(model: &SpatialModel, data: &mut SpatialData) {
         let row = lay.contact_row(c);
         let s = match data.trial[c] {
             SpatialState::Free => [force; 3],
-            _ if model.complementarity => [force; 3],
+            _ if complementarity(model, data) => [force; 3],
             SpatialState::Stick { .. } => [position; 3],
             SpatialState::Slide { .. } => [force, position, force],
         };

@@ -111,7 +111,10 @@ pub fn check_contact_laws(
             if sl > fbd_contact::spatial::STOP_SPEED * model.params.dt {
                 rep.directions += 1;
                 let e: [f64; 3] = std::array::from_fn(|a| ft[a] + mu_d * n * s[a] / sl);
-                let off = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
+                // The slip's direction is resolved to δ/|s| rad
+                // (docs/reference.md, "Resolution of a slip's direction").
+                let resolution = mu_d * n.abs() * fbd_sim::spatial::step::SLIP_RESOLUTION / sl;
+                let off = ((e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt() - resolution).max(0.0);
                 note(
                     off,
                     at(&format!("Ft not −μD·N·ŝ (slip {:.3e} m/s)", sl / p.dt)),

@@ -36,7 +36,8 @@ pub struct SpatialModel {
     pub cycle_tolerance: f64,
     /// Wall time (s) of the start-up stability check of the joint
     /// controller (`pd_stability`) in [`SpatialModel::new`]: under a
-    /// millisecond when the gains pass the Cholesky test of every pose.
+    /// millisecond when the gains pass the Cholesky test of every pose,
+    /// near zero when its result came from the process's cache.
     pub stability_check_seconds: f64,
 }
 
@@ -311,10 +312,11 @@ const GAIT_POSES: usize = 200;
 /// The rule holds when every pose's modes are slower than the inertia
 /// limit of the gains ([`crate::rules::pd_inertia_limit`]), which
 /// [`spatial_modes_slower_than`] decides from a few small Cholesky
-/// factorisations per pose (about 2 % of the eigenvalues' cost). Only
+/// factorisations per pose (about 4 % of the eigenvalues' cost). Only
 /// when that fails (or is undecided at a singular standing leg) the
 /// eigenvalues of every pose ([`fastest_mode_over_poses`]) give the
-/// verdict and the error's inertia and joint. The limit is raised by a
+/// verdict and the error's inertia and joint. Both results are kept in
+/// the process ([`PASSED`], [`MODES`]). The limit is raised by a
 /// relative 1e-6 for the fast test, so that a pose within round-off of it
 /// is left to the eigenvalues: both paths give the same verdict
 /// (`tests/pd_stability.rs` compares them over a grid of gains and steps).
@@ -329,10 +331,24 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
         return Ok(());
     }
     let limit = crate::rules::pd_inertia_limit(kp, kd, p.dt) * (1.0 + 1e-6);
-    if modes_slower_than(p, mech, limit) == Some(true) {
-        return Ok(());
-    }
-    let (inertia, joint) = cached_fastest_mode(p, mech);
+    let key = cache_key(p);
+    let mode = match cached(&MODES, &key) {
+        Some(mode) => mode,
+        // A limit at most one that passed passes (`M − I·SᵀS` only grows
+        // as `I` falls).
+        None if cached(&PASSED, &key).is_some_and(|passed| limit <= passed) => return Ok(()),
+        None if modes_slower_than(p, mech, limit) == Some(true) => {
+            let passed = cached(&PASSED, &key).map_or(limit, |l| l.max(limit));
+            keep(&PASSED, key, passed);
+            return Ok(());
+        }
+        None => {
+            let mode = fastest_mode_over_poses(p, mech);
+            keep(&MODES, key, mode);
+            mode
+        }
+    };
+    let (inertia, joint) = mode;
     crate::rules::pd_stability(
         kp,
         kd,
@@ -366,19 +382,24 @@ pub fn modes_slower_than(p: &SpatialParams, mech: &SpatialMechanism, inertia: f6
 }
 
 /// Results of [`fastest_mode_over_poses`] kept in this process, keyed by
-/// the parameters with what it does not read normalised away (the gains
-/// and limits of the controller, friction, contact tolerances, initial
-/// rates, output stride): the runs of a sweep over gains or friction, and
-/// the resets of an environment, compute it once. At most
-/// [`MODE_CACHE`] entries, the oldest dropped first.
+/// the parameters with what it does not read normalised away
+/// ([`cache_key`]): the runs of a sweep over gains or friction, and the
+/// resets of an environment, compute it once. At most [`CACHE`] entries,
+/// the oldest dropped first.
 static MODES: std::sync::Mutex<Vec<(SpatialParams, (f64, usize))>> =
     std::sync::Mutex::new(Vec::new());
 
-/// Entries of [`MODES`].
-const MODE_CACHE: usize = 16;
+/// The largest inertia limit that passed [`modes_slower_than`] in this
+/// process, by [`cache_key`] (as [`MODES`]).
+static PASSED: std::sync::Mutex<Vec<(SpatialParams, f64)>> = std::sync::Mutex::new(Vec::new());
 
-/// [`fastest_mode_over_poses`], through the cache [`MODES`].
-fn cached_fastest_mode(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usize) {
+/// Entries of [`MODES`] and of [`PASSED`].
+const CACHE: usize = 16;
+
+/// `p` less what the poses of [`pd_stability`] do not depend on: the
+/// gains and limits of the controller, friction, contact tolerances,
+/// initial rates, output stride.
+fn cache_key(p: &SpatialParams) -> SpatialParams {
     let mut key = p.clone();
     match &mut key.control {
         SpatialControl::None => {}
@@ -408,19 +429,31 @@ fn cached_fastest_mode(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usiz
     key.qdot0.clear();
     key.stride = 0;
     key.duration = 0.0;
-    if let Ok(cache) = MODES.lock()
-        && let Some((_, mode)) = cache.iter().find(|(k, _)| *k == key)
-    {
-        return *mode;
-    }
-    let mode = fastest_mode_over_poses(p, mech);
-    if let Ok(mut cache) = MODES.lock() {
-        if cache.len() == MODE_CACHE {
+    key
+}
+
+/// The value `cache` keeps for `key`.
+fn cached<T: Copy>(
+    cache: &std::sync::Mutex<Vec<(SpatialParams, T)>>,
+    key: &SpatialParams,
+) -> Option<T> {
+    let cache = cache.lock().ok()?;
+    cache.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
+}
+
+/// Keeps `value` for `key` in `cache` (replacing its value, or dropping
+/// the oldest entry of a full cache).
+fn keep<T>(cache: &std::sync::Mutex<Vec<(SpatialParams, T)>>, key: SpatialParams, value: T) {
+    if let Ok(mut cache) = cache.lock() {
+        if let Some(entry) = cache.iter_mut().find(|(k, _)| *k == key) {
+            entry.1 = value;
+            return;
+        }
+        if cache.len() == CACHE {
             cache.remove(0);
         }
-        cache.push((key, mode));
+        cache.push((key, value));
     }
-    mode
 }
 
 /// The smallest effective joint inertia over the poses of

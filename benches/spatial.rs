@@ -156,10 +156,9 @@ fn bench(c: &mut Criterion) {
         });
     }
 
-    // Start-up: the walk's model (after the first, the verdict of its
-    // stability check comes from the process's cache, as in a sweep), and
-    // that check alone (every pose decided by Cholesky tests, as a fresh
-    // process does it).
+    // Start-up: the walk's model, its stability check of the joint
+    // controller included (every pose decided by Cholesky tests, no cache
+    // involved when the gains pass), and that check alone.
     let walk_params = walk.params.clone();
     c.bench_function("spatial/model_new_walk", |b| {
         b.iter(|| SpatialModel::new(black_box(&walk_params)).expect("model"))

@@ -36,8 +36,7 @@ pub struct SpatialModel {
     pub cycle_tolerance: f64,
     /// Wall time (s) of the start-up stability check of the joint
     /// controller (`pd_stability`) in [`SpatialModel::new`]: under a
-    /// millisecond when the gains pass the Cholesky test of every pose,
-    /// near zero when its result came from the process's cache.
+    /// millisecond when the gains pass the Cholesky test of every pose.
     pub stability_check_seconds: f64,
 }
 
@@ -315,8 +314,8 @@ const GAIT_POSES: usize = 200;
 /// factorisations per pose (about 4 % of the eigenvalues' cost). Only
 /// when that fails (or is undecided at a singular standing leg) the
 /// eigenvalues of every pose ([`fastest_mode_over_poses`]) give the
-/// verdict and the error's inertia and joint. Both results are kept in
-/// the process ([`PASSED`], [`MODES`]). The limit is raised by a
+/// verdict and the error's inertia and joint (kept in the process,
+/// [`MODES`]). The limit is raised by a
 /// relative 1e-6 for the fast test, so that a pose within round-off of it
 /// is left to the eigenvalues: both paths give the same verdict
 /// (`tests/pd_stability.rs` compares them over a grid of gains and steps).
@@ -331,24 +330,17 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
         return Ok(());
     }
     let limit = crate::rules::pd_inertia_limit(kp, kd, p.dt) * (1.0 + 1e-6);
+    if modes_slower_than(p, mech, limit) == Some(true) {
+        return Ok(());
+    }
+    // Only now the parameters are cloned for the cache's key: a passing
+    // check costs less than cloning a large terrain.
     let key = cache_key(p);
-    let mode = match cached(&MODES, &key) {
-        Some(mode) => mode,
-        // A limit at most one that passed passes (`M − I·SᵀS` only grows
-        // as `I` falls).
-        None if cached(&PASSED, &key).is_some_and(|passed| limit <= passed) => return Ok(()),
-        None if modes_slower_than(p, mech, limit) == Some(true) => {
-            let passed = cached(&PASSED, &key).map_or(limit, |l| l.max(limit));
-            keep(&PASSED, key, passed);
-            return Ok(());
-        }
-        None => {
-            let mode = fastest_mode_over_poses(p, mech);
-            keep(&MODES, key, mode);
-            mode
-        }
-    };
-    let (inertia, joint) = mode;
+    let (inertia, joint) = cached(&MODES, &key).unwrap_or_else(|| {
+        let mode = fastest_mode_over_poses(p, mech);
+        keep(&MODES, key, mode);
+        mode
+    });
     crate::rules::pd_stability(
         kp,
         kd,
@@ -389,11 +381,7 @@ pub fn modes_slower_than(p: &SpatialParams, mech: &SpatialMechanism, inertia: f6
 static MODES: std::sync::Mutex<Vec<(SpatialParams, (f64, usize))>> =
     std::sync::Mutex::new(Vec::new());
 
-/// The largest inertia limit that passed [`modes_slower_than`] in this
-/// process, by [`cache_key`] (as [`MODES`]).
-static PASSED: std::sync::Mutex<Vec<(SpatialParams, f64)>> = std::sync::Mutex::new(Vec::new());
-
-/// Entries of [`MODES`] and of [`PASSED`].
+/// Entries of [`MODES`].
 const CACHE: usize = 16;
 
 /// `p` less what the poses of [`pd_stability`] do not depend on: the

@@ -6,7 +6,12 @@
 //! PD, `examples/hexapod_walk.toml`, steps 0.5–2.5 s) and landing
 //! (`examples/hexapod_drop.toml`, steps 0.3–1 s: touchdown of the feet,
 //! then of the hips); the numeric LU both compiled (the default) and by
-//! faer's pivoting LU (the reference path).
+//! faer's pivoting LU (the reference path). Walking (step 1000: three
+//! feet down) and landing (step 700: resting on its feet and hips, twelve
+//! sticking points) also have their assembly (residual and Jacobian into
+//! the solver's pattern) and numeric LU; the start-up of the walk's model
+//! (`SpatialModel::new`, whose stability check of the joint controller
+//! visits 189 poses of the gait) and that check alone.
 //!
 //! `cargo bench -p fbd-suite --bench spatial`
 
@@ -123,10 +128,50 @@ fn bench(c: &mut Criterion) {
         b.iter(|| faer_solver.factorize_loaded(None).expect("factorisation"))
     });
 
+    // Assembly (residual and analytic Jacobian into the solver's pattern,
+    // as each full Newton iteration loads it) and the compiled numeric LU
+    // while walking and after landing.
+    let drop = example("hexapod_drop.toml");
+    for (name, model, at) in [("walk", &walk, 1000usize), ("landing", &drop, 700usize)] {
+        let mut data = warmed(model, at);
+        let z = data.z.clone();
+        let mut z2 = z.clone();
+        z2[0] += 1e-9;
+        let zs = [z.clone(), z2];
+        let mut solver = NewtonSolver::new(model.newton);
+        c.bench_function(&format!("spatial/assembly_{name}"), |b| {
+            b.iter(|| {
+                flip ^= 1;
+                let mut sys = fbd_sim::spatial::step::system_for_bench(model, &mut data);
+                solver.load_jacobian(&mut sys, black_box(&zs[flip]));
+            })
+        });
+        {
+            let mut sys = fbd_sim::spatial::step::system_for_bench(model, &mut data);
+            solver.load_jacobian(&mut sys, &z);
+        }
+        println!("{name}: {} unknowns", model.mech.layout().dim());
+        c.bench_function(&format!("spatial/numeric_lu_{name}"), |b| {
+            b.iter(|| solver.factorize_loaded(None).expect("factorisation"))
+        });
+    }
+
+    // Start-up: the walk's model, its stability check of the joint
+    // controller included (every pose decided by Cholesky tests, no cache
+    // involved when the gains pass), and that check alone.
+    let walk_params = walk.params.clone();
+    c.bench_function("spatial/model_new_walk", |b| {
+        b.iter(|| SpatialModel::new(black_box(&walk_params)).expect("model"))
+    });
+    // The inertia limit of the walk's gains, (kp·Δt² + 2·kd·Δt)/4.
+    let limit = 0.25 * (1000.0 * 1e-6 + 2.0 * 15.0 * 1e-3);
+    c.bench_function("spatial/stability_check_walk", |b| {
+        b.iter(|| fbd_sim::spatial::modes_slower_than(black_box(&walk_params), &walk.mech, limit))
+    });
+
     // One whole step, standing, walking, and landing (the passive drop:
     // the six feet touch down at 0.321 s, the hips at 0.417 s, then rest
     // on twelve sticking points).
-    let drop = example("hexapod_drop.toml");
     for (name, model, from) in [
         ("stand", &stand, 500usize),
         ("walk", &walk, 500usize),

@@ -120,3 +120,95 @@ fn the_limit_is_the_engine_s_boundary_in_flight() {
         "kd = 1.1 × {kd_max}: {above} rad"
     );
 }
+
+/// The parameters of a shipped 3D example (with `overrides`).
+fn spatial_params(name: &str, overrides: &[Override]) -> fbd_sim::spatial::SpatialParams {
+    let file = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("examples")
+        .join(name);
+    match load_with_overrides(&file, overrides).unwrap() {
+        Config::Hexapod(h) => h.spatial_params(&file.display().to_string()).unwrap(),
+        Config::Planar(_) => panic!("{name} is planar"),
+    }
+}
+
+/// The start-up check's fast path (a Cholesky test per pose,
+/// `modes_slower_than`) against the eigenvalues of every pose
+/// (`fastest_mode_over_poses`): bisecting on the fast test's inertia
+/// finds the eigenvalues' smallest inertia to 1e-9; and over a grid of
+/// gains and steps the verdict of the model (fast test, eigenvalues only
+/// when it fails) is the eigenvalues' rule `kp·Δt² + 2·kd·Δt < 4·I`.
+#[test]
+fn the_fast_check_gives_the_eigenvalues_verdict() {
+    use fbd_sim::spatial::{
+        SpatialControl, SpatialModel, fastest_mode_over_poses, modes_slower_than,
+    };
+    let mut checked = 0;
+    for name in [
+        "hexapod_walk.toml",
+        "hexapod_stand.toml",
+        "hexapod_slope.toml",
+        "hexapod_rough.toml",
+        "hexapod_stairs.toml",
+    ] {
+        for dt in [0.0005, 0.001, 0.002] {
+            // Gains that pass at every step: the poses do not depend on them.
+            let base = spatial_params(
+                name,
+                &[
+                    Override::new("time.dt", dt),
+                    Override::new("control.kp", 1.0),
+                    Override::new("control.kd", 0.0),
+                ],
+            );
+            let probe = SpatialModel::new(&base).unwrap();
+            let (inertia, _) = fastest_mode_over_poses(&base, &probe.mech);
+            assert!(inertia > 0.0 && inertia.is_finite(), "{name}: {inertia}");
+            // Bisection on the fast test recovers the smallest inertia.
+            let (mut lo, mut hi) = (0.0, 10.0 * inertia);
+            for _ in 0..80 {
+                let mid = 0.5 * (lo + hi);
+                match modes_slower_than(&base, &probe.mech, mid) {
+                    Some(true) => lo = mid,
+                    Some(false) => hi = mid,
+                    None => panic!("{name}: a singular standing leg"),
+                }
+            }
+            assert!(
+                (lo - inertia).abs() <= 1e-9 * inertia,
+                "{name} at Δt = {dt}: fast {lo:e}, eigenvalues {inertia:e}"
+            );
+            for kp in [0.0, 300.0, 1000.0, 3000.0] {
+                // kd from well inside to well beyond the limit.
+                let kd_max = 2.0 * inertia / dt - 0.5 * kp * dt;
+                for f in [-0.5, 0.0, 0.5, 0.9, 0.99, 0.999, 1.001, 1.01, 1.1, 2.0] {
+                    let kd = (f * kd_max.abs()).max(0.0);
+                    if kp == 0.0 && kd == 0.0 {
+                        continue;
+                    }
+                    let mut p = base.clone();
+                    match &mut p.control {
+                        SpatialControl::Pd { kp: a, kd: b, .. }
+                        | SpatialControl::Trajectory { kp: a, kd: b, .. }
+                        | SpatialControl::Gait { kp: a, kd: b, .. } => (*a, *b) = (kp, kd),
+                        SpatialControl::None => panic!("{name} has no controller"),
+                    }
+                    let limit = 0.25 * (kp * dt * dt + 2.0 * kd * dt);
+                    let stable = limit < inertia;
+                    assert_eq!(
+                        modes_slower_than(&p, &probe.mech, limit),
+                        Some(stable),
+                        "{name}: Δt = {dt}, kp = {kp}, kd = {kd}"
+                    );
+                    assert_eq!(
+                        SpatialModel::new(&p).is_ok(),
+                        stable,
+                        "{name}: Δt = {dt}, kp = {kp}, kd = {kd}"
+                    );
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked > 500, "{checked}");
+}

@@ -29,9 +29,10 @@
 //! the rule allows kd < 19.74 N·m·s/rad; the walk runs with kd = 20 and
 //! blows up with kd = 22.
 
-use fbd_dynamics::spatial::{SpatialKin, SpatialMechanism};
+use fbd_dynamics::spatial::so3::hat;
+use fbd_dynamics::spatial::{SpatialKin, SpatialMechanism, lower_body, upper_body};
 use fbd_dynamics::{Mechanism, PointKind};
-use fbd_kinematics::nalgebra::{DMatrix, Matrix3};
+use fbd_kinematics::nalgebra::{DMatrix, Matrix3, Matrix3x6, Matrix6, SMatrix, Vector3};
 
 /// The mass matrix `M(q)` (kinetic energy `½·q̇ᵀ·M·q̇`) of the planar
 /// model at `q`.
@@ -154,5 +155,136 @@ pub fn fastest_mode(m: &DMatrix<f64>, g: &DMatrix<f64>, joints: &[usize]) -> Joi
     JointMode {
         inertia: 1.0 / eig.eigenvalues[top],
         joint: v.iamax(),
+    }
+}
+
+/// Whether every joint mode of the spatial model at `q`, with the tips of
+/// the slots `standing` on the ground, is slower than a joint of inertia
+/// `inertia`: whether the smallest effective joint inertia of
+/// [`fastest_mode`] (on [`spatial_mass_matrix`] and
+/// [`spatial_feet_jacobian`]) exceeds `inertia`, decided without an
+/// eigenvalue. `None` when a standing leg is at (or near) a singular pose,
+/// where only [`fastest_mode`] decides.
+///
+/// `1/μ_max > I` for the joint block `P` of the constrained inverse
+/// inertia if and only if the kinetic energy beats `I`'s on every motion
+/// the feet allow: `q̇ᵀ·M·q̇ > I·|S·q̇|²` for every `q̇ ≠ 0` with `G·q̇ = 0`,
+/// i.e. `K = M − I·SᵀS` positive definite on the null space of `G`
+/// (minimising `q̇ᵀMq̇` over the motions with given joint rates
+/// `S·q̇ = y` leaves `yᵀP⁻¹y`). The central body's coordinates do not
+/// matter (a change of them is a congruence): here its twist, `ω` and the
+/// velocity `v` of its centre of mass, so that `M` is the composite
+/// rigid-body inertia (each leg coupled only with the central body). A
+/// standing foot fixes its leg's rates by the twist
+/// (`θ̇ = T·(ω, v)`, `T = −G_leg⁻¹·G_body`), so `K` is positive definite
+/// if and only if every swinging leg's `3×3` block is, and the central
+/// body's `6×6` block after eliminating every leg (Schur complements):
+/// a few hundred flops and Cholesky factorisations of `3×3` and `6×6`
+/// per pose.
+///
+/// `kin` is a workspace for `mech`.
+pub fn spatial_modes_slower_than(
+    mech: &SpatialMechanism,
+    kin: &mut SpatialKin,
+    q: &[f64],
+    standing: &[usize],
+    inertia: f64,
+) -> Option<bool> {
+    kin.eval(mech, q);
+    let o = kin.fk.body_com;
+    // The composite inertia about `o`: mass, first moment, rotational.
+    let central = &mech.bodies[0];
+    let mut mass = central.mass;
+    let mut first = Vector3::zeros();
+    let mut rot = world_inertia(kin.rot[0], &central.inertia);
+    // Eliminated legs' energy on the twist (ω, v).
+    let mut k_body = Matrix6::zeros();
+    for s in 0..mech.legs.len() {
+        let l = &kin.fk.legs[mech.legs[s] - 1];
+        let axes = [l.hip_axis, l.upper_versor, l.lower_versor];
+        let pivots = [l.hip, l.hip, l.knee];
+        // Leg block, and its coupling with ω (rows 0–2) and v (rows 3–5).
+        let mut m_leg = Matrix3::zeros();
+        let mut m_bl = SMatrix::<f64, 6, 3>::zeros();
+        for (b, depth) in [(upper_body(s), 2), (lower_body(s), 3)] {
+            let body = &mech.bodies[b];
+            let (m, c) = (body.mass, kin.com[b]);
+            let r = c - o;
+            let iw = world_inertia(kin.rot[b], &body.inertia);
+            mass += m;
+            first += m * r;
+            rot += iw + m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose());
+            let mut u = [Vector3::zeros(); 3];
+            let mut iwa = [Vector3::zeros(); 3];
+            for j in 0..depth {
+                u[j] = axes[j].cross(&(c - pivots[j]));
+                iwa[j] = iw * axes[j];
+                let top = m * r.cross(&u[j]) + iwa[j];
+                let bottom = m * u[j];
+                for a in 0..3 {
+                    m_bl[(a, j)] += top[a];
+                    m_bl[(3 + a, j)] += bottom[a];
+                }
+                for k in 0..=j {
+                    let v = m * u[j].dot(&u[k]) + axes[k].dot(&iwa[j]);
+                    m_leg[(j, k)] += v;
+                    if k != j {
+                        m_leg[(k, j)] += v;
+                    }
+                }
+            }
+        }
+        let k_leg = m_leg - Matrix3::identity() * inertia;
+        if standing.contains(&s) {
+            let p = l.tip;
+            let g_leg = Matrix3::from_columns(&[
+                axes[0].cross(&(p - pivots[0])),
+                axes[1].cross(&(p - pivots[1])),
+                axes[2].cross(&(p - pivots[2])),
+            ]);
+            // Near a singular leg the null space is ill-conditioned: the
+            // eigenvalues decide (so do non-finite values).
+            let scale = g_leg.column(0).norm() * g_leg.column(1).norm() * g_leg.column(2).norm();
+            let det = g_leg.determinant().abs();
+            if !det.is_finite() || det <= 1e-6 * scale {
+                return None;
+            }
+            let g_inv = g_leg.try_inverse()?;
+            // The foot's velocity v + ω × (p − o) + G_leg·θ̇ = 0.
+            let mut t = Matrix3x6::zeros();
+            t.fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(g_inv * hat(&(p - o))));
+            t.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-g_inv));
+            let c = m_bl * t;
+            k_body += c + c.transpose() + t.transpose() * k_leg * t;
+        } else {
+            let Some(chol) = k_leg.cholesky() else {
+                return Some(false);
+            };
+            k_body -= m_bl * chol.solve(&m_bl.transpose());
+        }
+    }
+    let h = hat(&first);
+    let mut k = Matrix6::zeros();
+    k.fixed_view_mut::<3, 3>(0, 0).copy_from(&rot);
+    k.fixed_view_mut::<3, 3>(0, 3).copy_from(&h);
+    k.fixed_view_mut::<3, 3>(3, 0).copy_from(&h.transpose());
+    k.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&(Matrix3::identity() * mass));
+    k += k_body;
+    let k = 0.5 * (k + k.transpose());
+    Some(k.cholesky().is_some())
+}
+
+/// `R·I·Rᵀ`: a body's inertia tensor in the inertial frame; for a link's
+/// (`diag(a, t, t)`, symmetric about its axis, the first column `e` of
+/// `R`) `t·1 + (a − t)·e·eᵀ`.
+fn world_inertia(r: Matrix3<f64>, inertia: &Matrix3<f64>) -> Matrix3<f64> {
+    let (a, t) = (inertia[(0, 0)], inertia[(1, 1)]);
+    if inertia[(2, 2)] == t && *inertia == Matrix3::from_diagonal(&Vector3::new(a, t, t)) {
+        let e = r.column(0);
+        Matrix3::from_diagonal_element(t) + (a - t) * e * e.transpose()
+    } else {
+        r * inertia * r.transpose()
     }
 }

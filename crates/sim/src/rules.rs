@@ -114,6 +114,14 @@ pub(crate) fn pd_stable(a: f64, b: f64) -> bool {
     a + 2.0 * b < 4.0
 }
 
+/// The smallest effective joint inertia (kg·m²) on which gains `kp`, `kd`
+/// are stable at step `dt`: [`pd_stable`] holds on inertia `I > 0` if and
+/// only if `I > (kp·Δt² + 2·kd·Δt)/4`.
+#[inline]
+pub(crate) fn pd_inertia_limit(kp: f64, kd: f64, dt: f64) -> f64 {
+    0.25 * (kp * dt * dt + 2.0 * kd * dt)
+}
+
 /// The largest stable damping (N·m·s/rad) for stiffness `kp` on inertia
 /// `inertia` at step `dt`: `2·I/Δt − kp·Δt/2` ([`pd_stable`]; negative
 /// when `kp` alone is unstable).

@@ -2,7 +2,9 @@
 
 use super::params::{SpatialControl, SpatialParams};
 use crate::SimError;
-use crate::joint_inertia::{fastest_mode, spatial_feet_jacobian, spatial_mass_matrix};
+use crate::joint_inertia::{
+    fastest_mode, spatial_feet_jacobian, spatial_mass_matrix, spatial_modes_slower_than,
+};
 use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
 use fbd_dynamics::PointKind;
@@ -33,8 +35,8 @@ pub struct SpatialModel {
     /// weight.
     pub cycle_tolerance: f64,
     /// Wall time (s) of the start-up stability check of the joint
-    /// controller (`pd_stability`) in [`SpatialModel::new`]; near zero
-    /// when its result came from the process's cache.
+    /// controller (`pd_stability`) in [`SpatialModel::new`]: under a
+    /// millisecond when the gains pass the Cholesky test of every pose.
     pub stability_check_seconds: f64,
     /// Whether the contact points in contact solve stick/slip and lift-off
     /// in the step as a complementarity problem with the exact Coulomb law
@@ -319,6 +321,18 @@ const GAIT_POSES: usize = 200;
 /// the ground; for the gait, its joint angles along the run (at most
 /// [`GAIT_POSES`] steps) with its stance feet on the ground. Without
 /// ground, the free robot's.
+///
+/// The rule holds when every pose's modes are slower than the inertia
+/// limit of the gains ([`crate::rules::pd_inertia_limit`]), which
+/// [`spatial_modes_slower_than`] decides from a few small Cholesky
+/// factorisations per pose (about 4 % of the eigenvalues' cost). Only
+/// when that fails (or is undecided at a singular standing leg) the
+/// eigenvalues of every pose ([`fastest_mode_over_poses`]) give the
+/// verdict and the error's inertia and joint (kept in the process,
+/// [`MODES`]). The limit is raised by a
+/// relative 1e-6 for the fast test, so that a pose within round-off of it
+/// is left to the eigenvalues: both paths give the same verdict
+/// (`tests/pd_stability.rs` compares them over a grid of gains and steps).
 fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimError> {
     let (kp, kd) = match &p.control {
         SpatialControl::None => return Ok(()),
@@ -329,7 +343,18 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
     if kp == 0.0 && kd == 0.0 {
         return Ok(());
     }
-    let (inertia, joint) = cached_fastest_mode(p, mech);
+    let limit = crate::rules::pd_inertia_limit(kp, kd, p.dt) * (1.0 + 1e-6);
+    if modes_slower_than(p, mech, limit) == Some(true) {
+        return Ok(());
+    }
+    // Only now the parameters are cloned for the cache's key: a passing
+    // check costs less than cloning a large terrain.
+    let key = cache_key(p);
+    let (inertia, joint) = cached(&MODES, &key).unwrap_or_else(|| {
+        let mode = fastest_mode_over_poses(p, mech);
+        keep(&MODES, key, mode);
+        mode
+    });
     crate::rules::pd_stability(
         kp,
         kd,
@@ -339,20 +364,44 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
     )
 }
 
+/// Whether every pose of [`pd_stability`] has every joint mode slower
+/// than a joint of inertia `inertia` (kg·m²,
+/// [`spatial_modes_slower_than`]): `Some(false)` at the first pose that
+/// has a faster one, `None` when a pose is undecided.
+pub fn modes_slower_than(p: &SpatialParams, mech: &SpatialMechanism, inertia: f64) -> Option<bool> {
+    let mut kin = SpatialKin::new(mech);
+    let mut verdict = Some(true);
+    for_each_pose(p, mech, |q, standing| {
+        match spatial_modes_slower_than(mech, &mut kin, q, standing, inertia) {
+            Some(true) => true,
+            Some(false) => {
+                verdict = Some(false);
+                false
+            }
+            None => {
+                verdict = None;
+                true
+            }
+        }
+    });
+    verdict
+}
+
 /// Results of [`fastest_mode_over_poses`] kept in this process, keyed by
-/// the parameters with what it does not read normalised away (the gains
-/// and limits of the controller, friction, contact tolerances, initial
-/// rates, output stride): the runs of a sweep over gains or friction, and
-/// the resets of an environment, compute it once. At most
-/// [`MODE_CACHE`] entries, the oldest dropped first.
+/// the parameters with what it does not read normalised away
+/// ([`cache_key`]): the runs of a sweep over gains or friction, and the
+/// resets of an environment, compute it once. At most [`CACHE`] entries,
+/// the oldest dropped first.
 static MODES: std::sync::Mutex<Vec<(SpatialParams, (f64, usize))>> =
     std::sync::Mutex::new(Vec::new());
 
 /// Entries of [`MODES`].
-const MODE_CACHE: usize = 16;
+const CACHE: usize = 16;
 
-/// [`fastest_mode_over_poses`], through the cache [`MODES`].
-fn cached_fastest_mode(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usize) {
+/// `p` less what the poses of [`pd_stability`] do not depend on: the
+/// gains and limits of the controller, friction, contact tolerances,
+/// initial rates, output stride.
+fn cache_key(p: &SpatialParams) -> SpatialParams {
     let mut key = p.clone();
     match &mut key.control {
         SpatialControl::None => {}
@@ -382,24 +431,61 @@ fn cached_fastest_mode(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usiz
     key.qdot0.clear();
     key.stride = 0;
     key.duration = 0.0;
-    if let Ok(cache) = MODES.lock()
-        && let Some((_, mode)) = cache.iter().find(|(k, _)| *k == key)
-    {
-        return *mode;
-    }
-    let mode = fastest_mode_over_poses(p, mech);
-    if let Ok(mut cache) = MODES.lock() {
-        if cache.len() == MODE_CACHE {
+    key
+}
+
+/// The value `cache` keeps for `key`.
+fn cached<T: Copy>(
+    cache: &std::sync::Mutex<Vec<(SpatialParams, T)>>,
+    key: &SpatialParams,
+) -> Option<T> {
+    let cache = cache.lock().ok()?;
+    cache.iter().find(|(k, _)| k == key).map(|(_, v)| *v)
+}
+
+/// Keeps `value` for `key` in `cache` (replacing its value, or dropping
+/// the oldest entry of a full cache).
+fn keep<T>(cache: &std::sync::Mutex<Vec<(SpatialParams, T)>>, key: SpatialParams, value: T) {
+    if let Ok(mut cache) = cache.lock() {
+        if let Some(entry) = cache.iter_mut().find(|(k, _)| *k == key) {
+            entry.1 = value;
+            return;
+        }
+        if cache.len() == CACHE {
             cache.remove(0);
         }
-        cache.push((key, mode));
+        cache.push((key, value));
     }
-    mode
 }
 
 /// The smallest effective joint inertia over the poses of
 /// [`pd_stability`] and its joint (index `3·slot + j`).
-fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usize) {
+pub fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usize) {
+    let joints: Vec<usize> = (0..mech.legs.len())
+        .flat_map(|s| (0..3).map(move |j| q_joint(s, j)))
+        .collect();
+    let (mut inertia, mut joint) = (f64::INFINITY, 0);
+    for_each_pose(p, mech, |q, standing| {
+        let mode = fastest_mode(
+            &spatial_mass_matrix(mech, q),
+            &spatial_feet_jacobian(mech, standing, q),
+            &joints,
+        );
+        if mode.inertia < inertia {
+            (inertia, joint) = (mode.inertia, mode.joint);
+        }
+        true
+    });
+    (inertia, joint)
+}
+
+/// Calls `visit(q, standing)` on every pose of [`pd_stability`] (the
+/// coordinates, the slots standing) in order, until it returns `false`.
+fn for_each_pose(
+    p: &SpatialParams,
+    mech: &SpatialMechanism,
+    mut visit: impl FnMut(&[f64], &[usize]) -> bool,
+) {
     let nlegs = mech.legs.len();
     // Without ground no foot ever stands: the free robot's modes.
     let ground = p.terrain.exists();
@@ -408,22 +494,34 @@ fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, 
     } else {
         Vec::new()
     };
-    // (joint angles of every slot, the slots standing).
-    let mut poses: Vec<(Vec<[f64; 3]>, Vec<usize>)> = Vec::new();
-    let initial: Vec<[f64; 3]> = (0..nlegs)
-        .map(|s| std::array::from_fn(|j| p.q0[q_joint(s, j)]))
-        .collect();
-    poses.push((initial, all.clone()));
+    let mut q = p.q0.clone();
+    fn at(q: &mut [f64], angles: impl Iterator<Item = [f64; 3]>) {
+        for (s, a) in angles.enumerate() {
+            for (j, v) in a.iter().enumerate() {
+                q[q_joint(s, j)] = *v;
+            }
+        }
+    }
+    if !visit(&q, &all) {
+        return;
+    }
     match &p.control {
-        SpatialControl::Pd { target, .. } => poses.push((target.clone(), all)),
+        SpatialControl::Pd { target, .. } => {
+            at(&mut q, target.iter().copied());
+            visit(&q, &all);
+        }
         SpatialControl::Trajectory { legs, .. } => {
             for t in legs.iter().flat_map(|l| l.times.iter()) {
-                poses.push((legs.iter().map(|l| l.at(*t)).collect(), all.clone()));
+                at(&mut q, legs.iter().map(|l| l.at(*t)));
+                if !visit(&q, &all) {
+                    return;
+                }
             }
         }
         SpatialControl::Gait { gait, .. } => {
             let mut g = crate::gait::GaitData::new(gait);
             let stride = gait.steps / GAIT_POSES + 1;
+            let mut standing = Vec::with_capacity(nlegs);
             // Only the sampled steps: the gait's closed-form inverse
             // kinematics needs the previous angles only to stay on their
             // turn (±2π), which `stride` ms of a gait never leaves, so each
@@ -436,35 +534,14 @@ fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, 
                     break;
                 }
                 let stance = g.stance();
-                poses.push((
-                    mech.legs.iter().map(|&n| g.legs[n - 1].theta).collect(),
-                    (0..nlegs)
-                        .filter(|&s| ground && stance[mech.legs[s] - 1])
-                        .collect(),
-                ));
+                standing.clear();
+                standing.extend((0..nlegs).filter(|&s| ground && stance[mech.legs[s] - 1]));
+                at(&mut q, mech.legs.iter().map(|&n| g.legs[n - 1].theta));
+                if !visit(&q, &standing) {
+                    return;
+                }
             }
         }
         SpatialControl::None => {}
     }
-    let joints: Vec<usize> = (0..nlegs)
-        .flat_map(|s| (0..3).map(move |j| q_joint(s, j)))
-        .collect();
-    let mut q = p.q0.clone();
-    let (mut inertia, mut joint) = (f64::INFINITY, 0);
-    for (angles, standing) in &poses {
-        for (s, a) in angles.iter().enumerate() {
-            for (j, v) in a.iter().enumerate() {
-                q[q_joint(s, j)] = *v;
-            }
-        }
-        let mode = fastest_mode(
-            &spatial_mass_matrix(mech, &q),
-            &spatial_feet_jacobian(mech, standing, &q),
-            &joints,
-        );
-        if mode.inertia < inertia {
-            (inertia, joint) = (mode.inertia, mode.joint);
-        }
-    }
-    (inertia, joint)
 }

@@ -12,10 +12,15 @@
 //! or again in substeps; the planar engine is not audited): from there the
 //! two runs differ by design.
 
+mod common;
+
+use common::readme::{doc, parse};
 use fbd_sim::spatial::{SpatialModel, SpatialParams, run_collect as run3};
 use fbd_sim::{Control, Model, PlanarParams, run_collect};
 
-fn compare(p: &PlanarParams) {
+/// Compares the twins; returns the last step compared, the events up to it
+/// and the largest difference of `q`.
+fn compare(p: &PlanarParams) -> (usize, usize, f64) {
     let model = Model::planar(p).unwrap();
     let (rows, summary) = run_collect(&model);
     assert!(summary.error.is_none(), "planar: {:?}", summary.error);
@@ -100,17 +105,39 @@ fn compare(p: &PlanarParams) {
             .collect::<Vec<_>>(),
         "limit events differ"
     );
+    let compared = rows.iter().take_while(|a| a.step <= cut).count();
     println!(
-        "{} rows ({} compared), {} events, max |Δq| = {worst:.2e}",
+        "{} rows ({compared} compared), {} events, max |Δq| = {worst:.2e}",
         rows.len(),
-        rows.iter().take_while(|a| a.step <= cut).count(),
         planar.len()
+    );
+    (compared - 1, planar.len(), worst)
+}
+
+/// The README's figures of the planar twin: the events, the bound on `q`,
+/// and where the fall's comparison ends.
+fn check_readme(before: &str, (last, events, worst): (usize, usize, f64), dt: f64, fall: bool) {
+    let readme = doc("README.md");
+    if fall {
+        readme.figure(
+            "10 ms up to t = ",
+            " s (the same",
+            last as f64 * dt,
+            "planar twin: end of the fall's comparison",
+        );
+    }
+    readme.count(before, " events,", events, "planar twin: events");
+    let bound = parse(&readme.quoted(&format!("{before}{events} events, `q` within "), ")"));
+    assert!(
+        worst <= bound,
+        "README.md: the planar twin's `q` within {bound:e}, the run gives {worst:e}"
     );
 }
 
 #[test]
 fn the_default_fall_is_the_planar_fall() {
-    compare(&PlanarParams::default());
+    let p = PlanarParams::default();
+    check_readme("0.41 s (the same ", compare(&p), p.dt, true);
 }
 
 #[test]
@@ -127,5 +154,5 @@ fn a_pd_squat_at_1ms_is_the_planar_squat() {
         ..PlanarParams::default()
     };
     p.qdot0[0] = 0.3;
-    compare(&p);
+    check_readme("squat at 1 ms (the same ", compare(&p), p.dt, false);
 }

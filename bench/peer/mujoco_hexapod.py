@@ -21,6 +21,10 @@ Cases:
   ``τ = kp·(θ* − θ) + kd·(θ̇* − θ̇)``; MuJoCo's servo is
   ``τ = kp·(ctrl − θ) − kv·θ̇``, so ``ctrl = θ* + (kd/kp)·θ̇*`` gives the
   same torque. Reports the body's displacement.
+* ``drop``: the passive robot (no actuators) dropped from the keyframe,
+  tilted and spinning, onto its feet, knees and hips (spheres at every
+  contact point; bench/peer/hexapod_drop.toml). Reports the body's
+  displacement and the normal forces at the end.
 
 Prints one JSON object: {case, steps, seconds, steps_per_second, ...}.
 
@@ -87,6 +91,8 @@ def run(case, xml, steps, repeat, targets):
         control = data.ctrl.copy()[None, None, :]
     elif case == "walk":
         control = gait_controls(model, targets, steps)[None, :, :]
+    elif case == "drop":
+        control = np.zeros((1, 1, model.nu))
     else:
         raise ValueError(case)
     out = np.empty((1, steps, state0.size))
@@ -142,7 +148,7 @@ def kinematic_twin(config, out):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
-    for case in ("stand", "walk"):
+    for case in ("stand", "walk", "drop"):
         c = sub.add_parser(case, help=f"time the {case} case")
         c.add_argument("xml", help="the model, from `fbd export mjcf CONFIG`")
         c.add_argument("--steps", type=int, required=True, help="steps per rollout (fbd's count)")

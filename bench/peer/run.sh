@@ -5,6 +5,7 @@
 #   bench/peer/run.sh            # from anywhere; needs cargo and python3
 #   REPEAT=5 bench/peer/run.sh   # best of 5 rounds per case (default 3)
 #   CASES="moving_flight hexapod_stand" bench/peer/run.sh   # some cases
+#   FBD=path/to/fbd bench/peer/run.sh   # a prebuilt fbd, no build
 #
 # fbd: `fbd run` on bench/peer/<case>.toml, steps_per_second from
 # summary.json (wall time of the stepping loop alone, output excluded), and
@@ -49,8 +50,12 @@ if [ "$have" != "$want" ]; then
     echo "note: MuJoCo $have, the table in README.md was measured with $want" >&2
 fi
 
-(cd "$root" && cargo build --release -q --bin fbd)
-fbd="${CARGO_TARGET_DIR:-$root/target}/release/fbd"
+if [ -n "${FBD:-}" ]; then
+    fbd=$FBD # a prebuilt binary (e.g. on a machine without the toolchain)
+else
+    (cd "$root" && cargo build --release -q --bin fbd)
+    fbd="${CARGO_TARGET_DIR:-$root/target}/release/fbd"
+fi
 
 # case           model    MuJoCo case
 all=(
@@ -62,6 +67,7 @@ all=(
     "hexapod_stand hexapod stand"
     "hexapod_walk hexapod walk"
     "hexapod_rough hexapod stand"
+    "hexapod_drop hexapod drop"
 )
 wanted="${CASES:-}"
 
@@ -148,7 +154,7 @@ rows = list(csv.DictReader(open(sys.argv[1])))
 case, mj = sys.argv[2], json.loads(sys.argv[3])
 first, last = rows[0], rows[-1]
 print()
-if case == "stand":
+if case in ("stand", "drop"):
     print(f"{sys.argv[4]} at t = {float(last['t']):g} s: normal force of the ground on each foot (N)")
     print(f"{'foot':>6} {'fbd':>10} {'MuJoCo':>10}")
     total = 0.0

@@ -121,6 +121,10 @@ pub struct LimitEquation {
     pub state: LimitState,
     /// Regularisation β of the stop row (see the module docs).
     pub regularization: f64,
+    /// At an end, the stop row as a complementarity row
+    /// ([`crate::rows::limit_row`]): the stop pushes or the joint leaves
+    /// the end, solved in the step.
+    pub complementarity: bool,
 }
 
 impl Default for LimitEquation {
@@ -128,6 +132,7 @@ impl Default for LimitEquation {
         Self {
             state: LimitState::Free,
             regularization: 0.0,
+            complementarity: false,
         }
     }
 }

@@ -261,6 +261,13 @@ pub trait FbdModel {
     /// Keeps the branch of complementarity point `c` at the iterate
     /// ([`RowState::Contact`]; models without them ignore it).
     fn set_branch(&self, _data: &mut Self::Data, _c: usize, _branch: rows::Branch) {}
+    /// Keeps whether complementarity stop `l` is unloaded at the iterate
+    /// ([`rows::limit_row`]; models without them ignore it).
+    fn set_limit_unloaded(&self, _data: &mut Self::Data, _l: usize, _unloaded: bool) {}
+    /// What [`Self::set_limit_unloaded`] kept.
+    fn limit_unloaded(&self, _data: &Self::Data, _l: usize) -> bool {
+        false
+    }
     /// The branch kept by [`Self::set_branch`].
     fn branch(&self, _data: &Self::Data, _c: usize) -> rows::Branch {
         rows::Branch::default()
@@ -351,8 +358,10 @@ pub fn eval<M: FbdModel, J: JacobianSink>(
     for l in 0..dims.limits {
         let stop = model.stop(data, l);
         let lambda = z[dims.limit_moment(l)];
-        r[dims.limit_row(l)] =
+        let (v, unloaded) =
             rows::limit_row(stop.equation, lambda, z[stop.q_index], model.gains(data).2);
+        r[dims.limit_row(l)] = v;
+        model.set_limit_unloaded(data, l, unloaded);
     }
     if J::ACTIVE {
         force_entries(model, &dims, data, jac);
@@ -669,7 +678,7 @@ fn force_entries<M: FbdModel, J: JacobianSink>(
         jac.add(
             dims.limit_row(l),
             col,
-            rows::limit_row_diagonal(stop.equation),
+            rows::limit_row_diagonal(stop.equation, model.limit_unloaded(data, l)),
         );
     }
 }
@@ -765,7 +774,9 @@ fn position_entries<M: FbdModel, J: JacobianSink>(
     for l in 0..dims.limits {
         let stop = model.stop(data, l);
         if stop.equation.state.is_at() {
-            jac.add(dims.limit_row(l), stop.q_index, limit_gain);
+            let unloaded = model.limit_unloaded(data, l);
+            let v = rows::limit_row_angle(stop.equation, unloaded, limit_gain);
+            jac.add(dims.limit_row(l), stop.q_index, v);
         }
     }
 }

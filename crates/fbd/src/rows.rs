@@ -172,21 +172,55 @@ pub fn complementarity_rows(
     }
 }
 
-/// The stop row of a joint limit with moment `lambda` at angle `angle`.
+/// The stop row of a joint limit with moment `lambda` at angle `angle`,
+/// and whether a complementarity stop is unloaded. At an end with
+/// [`LimitEquation::complementarity`] the row is
+/// `min(σ·λ, σ·(Kθ·(θ − end) + β·λ))`, `σ` the side's sign (+1 at the lower
+/// end): the joint is held at the end by a pushing moment (`σ·λ ≥ 0`), or
+/// the stop carries none (`λ = 0`) and the joint does not cross the end.
 #[inline]
-pub fn limit_row(eq: &LimitEquation, lambda: f64, angle: f64, gain: f64) -> f64 {
+pub fn limit_row(eq: &LimitEquation, lambda: f64, angle: f64, gain: f64) -> (f64, bool) {
     match eq.state {
-        LimitState::Free => lambda,
-        LimitState::At { angle: end, .. } => gain * (angle - end) + eq.regularization * lambda,
+        LimitState::Free => (lambda, false),
+        LimitState::At { angle: end, side } => {
+            let held = gain * (angle - end) + eq.regularization * lambda;
+            if eq.complementarity {
+                let s = side.sign();
+                let unloaded = s * lambda < s * held;
+                (if unloaded { s * lambda } else { s * held }, unloaded)
+            } else {
+                (held, false)
+            }
+        }
     }
 }
 
-/// `∂(stop row)/∂λ`.
+/// `∂(stop row)/∂λ` (`unloaded`: the branch of [`limit_row`]).
 #[inline]
-pub fn limit_row_diagonal(eq: &LimitEquation) -> f64 {
+pub fn limit_row_diagonal(eq: &LimitEquation, unloaded: bool) -> f64 {
     match eq.state {
         LimitState::Free => 1.0,
+        LimitState::At { side, .. } if eq.complementarity => {
+            side.sign() * if unloaded { 1.0 } else { eq.regularization }
+        }
         LimitState::At { .. } => eq.regularization,
+    }
+}
+
+/// `∂(stop row)/∂θ` at an end (`gain` = Kθ; `unloaded`: the branch of
+/// [`limit_row`]).
+#[inline]
+pub fn limit_row_angle(eq: &LimitEquation, unloaded: bool, gain: f64) -> f64 {
+    match eq.state {
+        LimitState::Free => 0.0,
+        LimitState::At { side, .. } if eq.complementarity => {
+            if unloaded {
+                0.0
+            } else {
+                side.sign() * gain
+            }
+        }
+        LimitState::At { .. } => gain,
     }
 }
 

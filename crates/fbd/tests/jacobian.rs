@@ -100,6 +100,7 @@ fn check_with_limits(
             state,
             // Far larger than the default, as for the contacts.
             regularization: 0.03,
+            complementarity: false,
         };
     }
     data.torque

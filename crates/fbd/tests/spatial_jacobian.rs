@@ -127,10 +127,15 @@ fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementar
             if l % 2 == 0 {
                 *eq = LimitEquation {
                     state: LimitState::At {
-                        side: LimitSide::Lower,
+                        side: if complementarity && l % 4 == 2 {
+                            LimitSide::Upper
+                        } else {
+                            LimitSide::Lower
+                        },
                         angle: 0.1,
                     },
                     regularization: 1e-3,
+                    complementarity,
                 };
             }
         }
@@ -154,6 +159,14 @@ fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementar
         &mut r,
         &mut Dense { n, m: &mut jac },
     );
+    if complementarity && limits_at {
+        // Both branches of the stops: held and unloaded.
+        let at: Vec<bool> = (0..data.limit.len())
+            .filter(|&l| data.limit[l].state.is_at())
+            .map(|l| data.limit_unloaded[l])
+            .collect();
+        assert!(at.contains(&true) && at.contains(&false), "{at:?}");
+    }
     if complementarity && !first_step {
         // Every branch is visited: sticking and sliding, loaded and not.
         let b: Vec<_> = (0..data.contact.len())

@@ -202,6 +202,7 @@ pub fn system<'a>(
         *eq = LimitEquation {
             state,
             regularization: beta(model, data.fbd.dt),
+            complementarity: false,
         };
     }
     row_scales(

@@ -174,6 +174,9 @@ pub struct SpatialFbdData {
     /// This step's solves use fixed states, not complementarity rows
     /// (`fbd_sim`'s last fallback; reset every step).
     pub fixed_states: bool,
+    /// Per limit, whether its complementarity stop row is unloaded at the
+    /// last evaluated iterate.
+    pub limit_unloaded: Vec<bool>,
     rot_d: Vec<Matrix3<f64>>,
     /// The `q` `kin_next` was last evaluated at (NaN: none).
     kin_next_q: Vec<f64>,
@@ -244,6 +247,7 @@ impl SpatialFbdData {
             branch: vec![rows::Branch::default(); mech.contacts.len()],
             frozen: vec![None; mech.contacts.len()],
             fixed_states: false,
+            limit_unloaded: vec![false; mech.limits.len()],
             wrench: vec![Wrench::default(); nb],
             rot_d: vec![Matrix3::zeros(); nb],
             kin_next_q: vec![f64::NAN; mech.layout().nq],
@@ -621,6 +625,16 @@ impl FbdModel for SpatialMechanism {
     #[inline]
     fn branch(&self, data: &SpatialFbdData, c: usize) -> rows::Branch {
         data.branch[c]
+    }
+
+    #[inline]
+    fn set_limit_unloaded(&self, data: &mut SpatialFbdData, l: usize, unloaded: bool) {
+        data.limit_unloaded[l] = unloaded;
+    }
+
+    #[inline]
+    fn limit_unloaded(&self, data: &SpatialFbdData, l: usize) -> bool {
+        data.limit_unloaded[l]
     }
 
     #[inline]

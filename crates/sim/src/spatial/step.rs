@@ -42,7 +42,7 @@ use fbd_dynamics::spatial::{
     SpatialContactEquation, SpatialFbdData, SpatialMechanism, advance, eval, evaluate_next,
     half_momentum_and_rotation, pattern, pattern_key, prepare_step, set_previous,
 };
-use fbd_dynamics::{History, LimitEquation, NoJacobian};
+use fbd_dynamics::{History, LimitEquation, LimitState, NoJacobian};
 use fbd_kinematics::nalgebra::Vector3;
 use fbd_solver::{NewtonReport, NewtonSolver, NewtonSystem, SolverError};
 
@@ -302,7 +302,9 @@ impl Engine for SpatialModel {
 ///   rows about `p[k]`, so it sticks there (ST3 → ST2, anchored on the
 ///   surface under `p[k]` along the normal) with `|Ft| ≤ μD·N ≤ μS·N`;
 /// * a point without load (`N = 0`) that ends the step above the surface
-///   by more than the penetration tolerance has left it (→ ST1, `F = 0`).
+///   by more than the penetration tolerance has left it (→ ST1, `F = 0`);
+///   a joint stop without load whose joint ends the step inside its range
+///   by more than the limits' angle tolerance is free.
 ///
 /// The last two are read off the solution, which already satisfies their
 /// laws. Each switch marks the state left as seen, so that the search's
@@ -313,6 +315,17 @@ fn complementarity_switches(model: &SpatialModel, data: &mut SpatialData) -> boo
         return true;
     }
 
+    // A stop without load whose joint has left the end is free (its row
+    // was `λ = 0`, the free row).
+    for l in 0..data.limit_trial.len() {
+        if let LimitState::At { side, angle } = data.limit_trial[l] {
+            let q = data.z[model.mech.limits[l].q_index];
+            if data.fbd.limit_unloaded[l] && side.sign() * (q - angle) > LIMIT_RELEASE_ANGLE {
+                data.limit_trial[l] = LimitState::Free;
+                data.z[model.mech.layout().limit_moment(l)] = 0.0;
+            }
+        }
+    }
     let surface = &model.params.terrain;
     let tol = model.params.contact.penetration_tol;
     let mut again = false;
@@ -324,8 +337,22 @@ fn complementarity_switches(model: &SpatialModel, data: &mut SpatialData) -> boo
         let b = data.fbd.branch[c];
         let t = trial_of(model, data, c);
         data.seen[c] |= 1 << (state.code() as u8);
-        if b.unloaded && clearance(surface, t.p_next) > tol {
+        if b.unloaded && clearance(surface, t.p_next) > LIFT_OFF_DISTANCE.max(tol) {
             data.trial[c] = SpatialState::Free;
+            // Its force is zero to the solver's tolerance: exactly zero in
+            // the free state's row.
+            let lay = model.mech.layout();
+            for m in 0..3 {
+                data.z[lay.contact_force(c, m)] = 0.0;
+            }
+            continue;
+        }
+        if b.unloaded && matches!(state, SpatialState::Stick { .. }) {
+            // Touching without load: held where it is now (its rows carry
+            // no force whatever its anchor).
+            data.trial[c] = SpatialState::Stick {
+                anchor: under_along_normal(surface, t.p_next),
+            };
             continue;
         }
         match state {
@@ -427,6 +454,18 @@ fn unfreeze_wrong_branches(model: &SpatialModel, data: &mut SpatialData) -> bool
 /// that have all but stopped.
 pub const SLIP_RESOLUTION: f64 = 1e-12;
 
+/// A point in contact without load leaves it (→ ST1) only once it ends a
+/// step this far above the surface (m): until then its complementarity
+/// rows let it lift and land again without events (a knee or hip
+/// micro-bouncing as the robot settles), carrying no force while it is
+/// above the surface.
+pub const LIFT_OFF_DISTANCE: f64 = 1e-5;
+
+/// A joint stop without load is released (→ free) only once its joint ends
+/// a step this far inside its range (rad): until then its complementarity
+/// row lets the joint leave and return to the end without events.
+pub const LIMIT_RELEASE_ANGLE: f64 = 1e-4;
+
 /// The regularisation β for a (sub)step of length `h` (as the planar one).
 fn beta(model: &SpatialModel, h: f64) -> f64 {
     regularization(model.params.contact.regularization, h)
@@ -459,10 +498,12 @@ fn system<'a>(
             frozen: data.fbd.frozen[c],
         };
     }
+    let ncp = complementarity(model, data);
     for (eq, &state) in data.fbd.limit.iter_mut().zip(&data.limit_trial) {
         *eq = LimitEquation {
             state,
             regularization: b,
+            complementarity: ncp,
         };
     }
     row_scales(model, data);

@@ -164,6 +164,14 @@ if case in ("stand", "drop"):
         total += f
         m = mj["normal"].get(f"tip{n}", 0.0)
         print(f"{n:>6} {f:>10.3f} {m:>10.3f}")
+    # Every contact point's normal force (knees and hips too, when they
+    # touch: the drop comes to rest on its hips).
+    for kind, col in (("knee", "kneepoint{}_n"), ("hip", "hippoint{}_n")):
+        f = sum(float(last.get(col.format(n)) or 0.0) for n in range(1, 7))
+        m = sum(mj["normal"].get(f"{kind}{n}", 0.0) for n in range(1, 7))
+        if f or m:
+            print(f"{kind + 's':>6} {f:>10.3f} {m:>10.3f}")
+            total += f
     print(f"{'sum':>6} {total:>10.3f} {mj['normal_sum']:>10.3f}   weight {mj['weight']:.3f} N")
 else:
     d = [float(last[k]) - float(first[k]) for k in ("rx", "ry", "rz")]

@@ -14,7 +14,9 @@ use fbd_dynamics::spatial::SpatialKin;
 use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_collect};
 
 /// Checks the law on every contact row; returns (sticking, sliding) rows.
-fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize) {
+/// `(sticking rows, sliding rows, sliding rows aligned with their slip,
+/// sliding rows checked)`.
+fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize, usize, usize) {
     let p = &model.params;
     let (mu_s, mu_d) = (p.friction.mu_static, p.friction.mu_dynamic);
     let (mut sticking, mut sliding) = (0, 0);
@@ -84,7 +86,7 @@ fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize) {
         aligned * 100 >= checked * 95,
         "{aligned} of {checked} aligned"
     );
-    (sticking, sliding)
+    (sticking, sliding, aligned, checked)
 }
 
 /// A throw: the robot lands moving sideways and spinning, feet sliding in
@@ -104,7 +106,15 @@ fn a_spinning_landing_obeys_coulomb_on_every_row() {
     let model = SpatialModel::new(&p).unwrap();
     let (rows, summary) = run_collect(&model);
     assert!(summary.error.is_none(), "{:?}", summary.error);
-    let (stick, slide) = check_law(&model, &rows);
+    let (stick, slide, aligned, checked) = check_law(&model, &rows);
+    // The README's figure.
+    let row = common::readme::doc("README.md")
+        .row("sliding rows whose friction is within 0.08° of the slip, spinning landing");
+    assert_eq!(
+        row[1],
+        format!("{aligned} of {checked}"),
+        "README.md is stale (the spinning landing's aligned sliding rows)"
+    );
     println!(
         "{stick} sticking and {slide} sliding rows, {} events",
         summary.events.len()

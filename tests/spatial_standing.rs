@@ -72,4 +72,20 @@ fn at_rest_the_forces_and_torques_are_the_static_ones() {
         }
     }
     println!("max |τ − τ_static| = {worst:.2e} N·m");
+    // The README's bounds (round-off: any change of the arithmetic moves
+    // the figures themselves).
+    let readme = common::readme::doc("README.md");
+    let row = readme.row("standing: Σ N vs weight; joint torques vs statics `Jᵀ F` + gravity");
+    let bounds: Vec<f64> = row[1]
+        .split(';')
+        .map(|b| {
+            let b = b.trim().trim_start_matches("below ");
+            common::readme::parse(b.split_whitespace().next().unwrap())
+        })
+        .collect();
+    let rel = (normal - weight).abs() / weight;
+    assert!(
+        rel <= bounds[0] && worst <= bounds[1],
+        "README.md is stale (standing): Σ N off by {rel:e} relative, torques by {worst:e} N·m, the README bounds them by {bounds:?}"
+    );
 }

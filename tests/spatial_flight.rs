@@ -11,6 +11,8 @@ use fbd_kinematics::nalgebra::Vector3;
 use fbd_sim::spatial::{SpatialModel, SpatialParams, run_collect, run_until};
 use std::sync::atomic::AtomicBool;
 
+mod common;
+
 /// A tumbling robot: tilted body spinning about all three axes, every
 /// joint moving.
 fn tumbling(dt: f64, duration: f64, gravity: f64) -> SpatialParams {
@@ -71,6 +73,12 @@ fn the_centre_of_mass_falls_exactly_and_momentum_is_exact() {
         assert!(dp < 1e-9 * m * 9.81, "t = {t}: momentum off by {dp:e}");
     }
     println!("CoM vs g·t²/2: max deviation {worst:.2e} m over 1 s");
+    let b = bounds("free fall of the tumbling robot's centre of mass vs `g·t²/2` over 1 s");
+    assert!(
+        worst <= b[0],
+        "README.md is stale: {worst:e} m, bound {}",
+        b[0]
+    );
     // Exact up to the solver's tolerance on the force rows (1e-9 of the
     // weight): 5 nm after a 4.9 m fall would be that tolerance everywhere.
     assert!(worst < 1e-8, "the centre of mass deviates by {worst:e} m");
@@ -112,9 +120,29 @@ fn weightless(n: usize) -> (f64, f64, f64, f64, f64) {
     (worst_h, e_first, e_last, e_min, e_max)
 }
 
+/// The README's row of the momentum figures.
+const MOMENTUM_ROW: &str = "angular momentum of the weightless tumbling robot, 2000 steps / 1e5 steps (solver tolerance 1e-10)";
+
+/// The bounds `below X` quoted in the README's row `first` (round-off
+/// figures are quoted as bounds: any change of the arithmetic moves them).
+fn bounds(first: &str) -> Vec<f64> {
+    let row = common::readme::doc("README.md").row(first);
+    row[1]
+        .split("below ")
+        .skip(1)
+        .map(|b| common::readme::parse(b.split([' ', ')']).next().unwrap()))
+        .collect()
+}
+
 #[test]
 fn angular_momentum_is_conserved_to_1e_9() {
     let (worst_h, ..) = weightless(2000);
+    let b = bounds(MOMENTUM_ROW);
+    assert!(
+        worst_h <= b[0],
+        "README.md is stale: {worst_h:e}, bound {}",
+        b[0]
+    );
     assert!(
         worst_h < 1e-9,
         "angular momentum drifts by {worst_h:e} (relative)"
@@ -125,6 +153,18 @@ fn angular_momentum_is_conserved_to_1e_9() {
 fn no_energy_drift_over_1e5_steps() {
     let (worst_h, e_first, e_last, e_min, e_max) = weightless(100_000);
     let drift = (e_last - e_first).abs() / e_first;
+    let b = bounds(MOMENTUM_ROW);
+    assert!(
+        worst_h <= b[1],
+        "README.md is stale: {worst_h:e}, bound {}",
+        b[1]
+    );
+    let e = bounds("kinetic energy, mean of the first vs the last 1000 of 1e5 steps");
+    let range = (e_max - e_min) / e_first;
+    assert!(
+        drift <= e[0] && range <= e[1],
+        "README.md is stale: drift {drift:e}, range {range:e}, bounds {e:?}"
+    );
     assert!(drift < 1e-5, "energy drifts by {drift:e} (relative)");
     assert!(
         (e_max - e_min) / e_first < 1e-3,
@@ -163,6 +203,13 @@ fn the_scheme_is_second_order() {
     let (e1, e2, e3) = (err(2e-3), err(1e-3), err(0.5e-3));
     let (p1, p2) = ((e1 / e2).log2(), (e2 / e3).log2());
     println!("max |q − q_ref| over [0, {t}] s: {e1:.3e} {e2:.3e} {e3:.3e}; orders {p1:.3} {p2:.3}");
+    let row = common::readme::doc("README.md")
+        .row("order of convergence (whole robot; single free body)");
+    assert!(
+        row[1].starts_with(&format!("{p1:.3}, {p2:.3};")),
+        "README.md is stale: quotes {}, the runs give {p1:.3}, {p2:.3}",
+        row[1]
+    );
     assert!(
         (1.8..2.2).contains(&p1) && (1.8..2.2).contains(&p2),
         "orders {p1} {p2}"

@@ -9,6 +9,9 @@ use fbd_dynamics::spatial::half_momentum;
 use fbd_dynamics::spatial::so3::{exp, hat, right_jacobian};
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
 
+#[path = "../../../tests/common/readme.rs"]
+mod readme;
+
 fn inertia() -> Matrix3<f64> {
     Matrix3::from_diagonal(&Vector3::new(0.1, 0.2, 0.3))
 }
@@ -111,6 +114,18 @@ fn second_order_against_euler_equations() {
     let (e1, e2, e3) = (err(100), err(200), err(400));
     let (p1, p2) = ((e1 / e2).log2(), (e2 / e3).log2());
     println!("errors {e1:.3e} {e2:.3e} {e3:.3e}, orders {p1:.3} {p2:.3}");
+    // The README's figure (the single free body: after the `;`).
+    let row = readme::doc("README.md").row("order of convergence (whole robot; single free body)");
+    let quoted = row[1]
+        .split(';')
+        .nth(1)
+        .unwrap_or_default()
+        .trim()
+        .to_owned();
+    assert!(
+        quoted == format!("{p1:.3}") || quoted == format!("{p2:.3}"),
+        "README.md is stale: quotes {quoted}, the orders are {p1:.3} {p2:.3}"
+    );
     assert!(
         (1.9..2.1).contains(&p1) && (1.9..2.1).contains(&p2),
         "orders {p1} {p2}"
@@ -137,6 +152,14 @@ fn spinning_near_the_intermediate_axis_flips() {
     let wy_ref: Vec<f64> = ref_run.iter().map(|(_, w)| w.y).collect();
     let t_ref = first_flip(&wy_ref, t_end / 240_000.0).expect("Euler's equations flip");
     println!("first flip: scheme {t_scheme:.4} s, Runge–Kutta {t_ref:.4} s");
+    let readme = readme::doc("README.md");
+    readme.figure(
+        "first flip | ",
+        " s (Runge–Kutta",
+        t_scheme,
+        "first flip, scheme",
+    );
+    readme.figure("(Runge–Kutta: ", " s) |", t_ref, "first flip, Runge–Kutta");
     assert!(
         (t_scheme - t_ref).abs() < 0.01 * t_ref,
         "{t_scheme} vs {t_ref}"

@@ -241,6 +241,18 @@ pub struct SpatialTrial {
 }
 
 impl SpatialTrial {
+    /// `p[k+1] − a` in `(t1, t2)` components (m): how far the point is
+    /// from `a` along the surface.
+    pub fn slip_from(&self, a: [f64; 3]) -> [f64; 2] {
+        let d = [
+            self.p_next[0] - a[0],
+            self.p_next[1] - a[1],
+            self.p_next[2] - a[2],
+        ];
+        let dot = |t: [f64; 3]| d[0] * t[0] + d[1] * t[1] + d[2] * t[2];
+        [dot(self.frame[0]), dot(self.frame[2])]
+    }
+
     /// The slip over the step in `(t1, t2)` components (m).
     pub fn slip(&self) -> [f64; 2] {
         let d = [

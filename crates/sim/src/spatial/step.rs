@@ -303,6 +303,8 @@ impl Engine for SpatialModel {
 ///   surface under `p[k]` along the normal) with `|Ft| ≤ μD·N ≤ μS·N`;
 /// * a point without load (`N = 0`) that ends the step above the surface
 ///   by more than the penetration tolerance has left it (→ ST1, `F = 0`);
+///   one that still touches stays ST2 at its contact point, or slides
+///   (ST3, no force) if it moved along the surface;
 ///   a joint stop without load whose joint ends the step inside its range
 ///   by more than the limits' angle tolerance is free.
 ///
@@ -337,7 +339,7 @@ fn complementarity_switches(model: &SpatialModel, data: &mut SpatialData) -> boo
         let b = data.fbd.branch[c];
         let t = trial_of(model, data, c);
         data.seen[c] |= 1 << (state.code() as u8);
-        if b.unloaded && clearance(surface, t.p_next) > LIFT_OFF_DISTANCE.max(tol) {
+        if b.unloaded && clearance(surface, t.p_next) > tol {
             data.trial[c] = SpatialState::Free;
             // Its force is zero to the solver's tolerance: exactly zero in
             // the free state's row.
@@ -347,12 +349,20 @@ fn complementarity_switches(model: &SpatialModel, data: &mut SpatialData) -> boo
             }
             continue;
         }
-        if b.unloaded && matches!(state, SpatialState::Stick { .. }) {
-            // Touching without load: held where it is now (its rows carry
-            // no force whatever its anchor).
-            data.trial[c] = SpatialState::Stick {
-                anchor: under_along_normal(surface, t.p_next),
-            };
+        if b.unloaded {
+            // Touching without load: a sticking point still at its contact
+            // point stays ST2 (a resting point without load writes no
+            // events); one that moved along the surface slides (ST3, its
+            // friction μD·0 = 0).
+            if let SpatialState::Stick { anchor } = state {
+                let s = t.slip_from(anchor);
+                let len = s[0].hypot(s[1]);
+                if len > UNLOADED_STICK_DRIFT {
+                    data.trial[c] = SpatialState::Slide {
+                        dir: [s[0] / len, s[1] / len],
+                    };
+                }
+            }
             continue;
         }
         match state {
@@ -454,12 +464,11 @@ fn unfreeze_wrong_branches(model: &SpatialModel, data: &mut SpatialData) -> bool
 /// that have all but stopped.
 pub const SLIP_RESOLUTION: f64 = 1e-12;
 
-/// A point in contact without load leaves it (→ ST1) only once it ends a
-/// step this far above the surface (m): until then its complementarity
-/// rows let it lift and land again without events (a knee or hip
-/// micro-bouncing as the robot settles), carrying no force while it is
-/// above the surface.
-pub const LIFT_OFF_DISTANCE: f64 = 1e-5;
+/// How far (m) a sticking point without load may be from its contact
+/// point, along the surface, and still be written as sticking: a resting
+/// point without load stays ST2 at its contact point; one that moved
+/// further slides (ST3 with no force).
+pub const UNLOADED_STICK_DRIFT: f64 = 1e-9;
 
 /// A joint stop without load is released (→ free) only once its joint ends
 /// a step this far inside its range (rad): until then its complementarity

@@ -255,13 +255,7 @@ impl SpatialTrial {
 
     /// The slip over the step in `(t1, t2)` components (m).
     pub fn slip(&self) -> [f64; 2] {
-        let d = [
-            self.p_next[0] - self.p_k[0],
-            self.p_next[1] - self.p_k[1],
-            self.p_next[2] - self.p_k[2],
-        ];
-        let dot = |t: [f64; 3]| d[0] * t[0] + d[1] * t[1] + d[2] * t[2];
-        [dot(self.frame[0]), dot(self.frame[2])]
+        self.slip_from(self.p_k)
     }
 }
 

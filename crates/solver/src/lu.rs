@@ -70,13 +70,22 @@
 //!   demand (never shrinking). Their fill depends on the numerical row
 //!   pivoting, so a later refactorisation of the same pattern could need
 //!   more room than the first one and would then allocate. To rule that
-//!   out, [`Factors::new`] factors a fully dense `n × n` matrix once into
-//!   new storage: any `n × n` factorisation needs at most the storage of
-//!   the dense one, so every later one fits. The storage is shared by the
+//!   out, [`Factors::new`] grows new storage to that of a dense `n × n` LU:
+//!   any `n × n` factorisation needs at most the storage of the dense one
+//!   (faer asks, at column `j`, for the entries so far plus the column's
+//!   reach, both at most the dense LU's), so every later one fits. A dense
+//!   LU through the sparse code costs `O(n³)`, 0.7–6 ms at 80–135
+//!   unknowns — a third of `bench/peer/hexapod_drop.toml`'s run, whose 18
+//!   contact points meet 49 reduced dimensions. Two triangular matrices
+//!   make the same requests in `O(n²)`: a dense lower triangle whose last
+//!   column is full (`L` as dense, and the full last column's request of
+//!   `U`), then a dense upper triangle (`U` as dense), both diagonally
+//!   dominant so that partial pivoting keeps the diagonal and no column
+//!   updates another. `tests/no_alloc.rs` of this crate checks a
+//!   re-pivoted refactorisation against it. The storage is shared by the
 //!   patterns of one dimension (the contact states of a run change the
-//!   pattern, seldom the dimension), so that this warm-up — a dense LU
-//!   through the sparse code, about 0.1 ms at 31 unknowns — is done once
-//!   per dimension rather than once per pattern; it holds the last
+//!   pattern, seldom the dimension), so that this warm-up is done once per
+//!   dimension rather than once per pattern; it holds the last
 //!   factorisation of one of them ([`Factors::holds`]). Storage is never
 //!   shared across dimensions: a simplicial LU cannot be reused for a
 //!   smaller one.
@@ -360,7 +369,7 @@ impl Factors {
     }
 
     /// Storage for (reduced) dimension `n`, grown to that of a dense
-    /// `n × n` LU (see the module docs). Allocates; `mem` must hold
+    /// `n × n` LU by two triangular warm-ups (see the module docs). Allocates; `mem` must hold
     /// [`Self::scratch`].
     pub(crate) fn new(n: usize, mem: &mut MemBuffer) -> Self {
         // The sweeps' streams index rows and columns as `u32`.
@@ -382,26 +391,45 @@ impl Factors {
             // Every row eliminated: no LU at all.
             return f;
         }
-        // Diagonally dominant, hence nonsingular.
-        let col_ptr: Vec<usize> = (0..=n).map(|j| j * n).collect();
-        let row_idx: Vec<usize> = (0..n * n).map(|k| k % n).collect();
-        let values: Vec<f64> = (0..n * n)
-            .map(|k| if k % n == k / n { 2.0 * n as f64 } else { 1.0 })
-            .collect();
-        let dense = SparseColMatRef::new(
-            SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx),
-            &values,
-        );
+        // Two triangular warm-ups reach the storage of a dense LU at the
+        // cost of O(n²) each (see the module docs): a dense lower triangle
+        // with a full last column grows `L` (and the last column's request
+        // of `U`), a dense upper triangle grows `U`. Diagonally dominant,
+        // so partial pivoting keeps the diagonal.
         let identity: Vec<usize> = (0..n).collect();
-        factorize_simplicial_numeric_lu(
-            &mut f.row_perm,
-            &mut f.row_perm_inv,
-            &mut f.lu,
-            dense,
-            PermRef::new_checked(&identity, &identity, n),
-            MemStack::new(mem),
-        )
-        .unwrap_or_else(|e| panic!("faer dense warm-up LU failed: {e:?}"));
+        for lower in [true, false] {
+            let mut col_ptr = Vec::with_capacity(n + 1);
+            let mut row_idx = Vec::new();
+            let mut values = Vec::new();
+            col_ptr.push(0);
+            for j in 0..n {
+                let rows = if lower && j + 1 < n {
+                    j..n
+                } else if lower {
+                    0..n
+                } else {
+                    0..j + 1
+                };
+                for i in rows {
+                    row_idx.push(i);
+                    values.push(if i == j { 2.0 * n as f64 } else { 1.0 });
+                }
+                col_ptr.push(row_idx.len());
+            }
+            let triangle = SparseColMatRef::new(
+                SymbolicSparseColMatRef::new_checked(n, n, &col_ptr, None, &row_idx),
+                &values,
+            );
+            factorize_simplicial_numeric_lu(
+                &mut f.row_perm,
+                &mut f.row_perm_inv,
+                &mut f.lu,
+                triangle,
+                PermRef::new_checked(&identity, &identity, n),
+                MemStack::new(mem),
+            )
+            .unwrap_or_else(|e| panic!("faer warm-up LU failed: {e:?}"));
+        }
         f
     }
 

@@ -160,3 +160,50 @@ fn bad_set_keys_are_one_line_errors_naming_the_file_and_key() {
         assert!(!out.exists(), "nothing written for a bad sweep file");
     }
 }
+
+/// The 1000-run examples write under 100 MB by default: their first 20
+/// runs (the same draws) write under 100 kB a run, what `fbd sweep`
+/// prints for them.
+#[test]
+fn the_1000_run_examples_write_under_100_mb() {
+    let t = tempfile::tempdir().unwrap();
+    for name in [
+        "sweep_landing_1000.toml",
+        "sweep_landing_1000_1ms.toml",
+        "sweep_hexapod_landing_1000.toml",
+    ] {
+        let text = std::fs::read_to_string(examples().join(name)).unwrap();
+        assert!(text.contains("\nsamples = 1000\n"), "{name}");
+        // The copy sits beside the examples' base files in the temporary
+        // directory.
+        let dir = t.path().join(name.trim_end_matches(".toml"));
+        std::fs::create_dir_all(&dir).unwrap();
+        for base in ["paper.toml", "hexapod_drop.toml"] {
+            std::fs::copy(examples().join(base), dir.join(base)).unwrap();
+        }
+        let sweep = dir.join("sweep.toml");
+        std::fs::write(
+            &sweep,
+            text.replace("\nsamples = 1000\n", "\nsamples = 20\n"),
+        )
+        .unwrap();
+        let out = dir.join("out");
+        let o = fbd(&["sweep", s(&sweep), "--out", s(&out), "--jobs", "2"]);
+        assert!(o.status.success(), "{name}: {o:?}");
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(!e.contains("warning"), "{name}: {e}");
+        let bytes = fbd_cli::sweep::dir_bytes(&out);
+        let said = format!(
+            "files in {}: index.csv sweep.json sweep.svg runs/ ({};",
+            out.display(),
+            fbd_cli::sweep::human_bytes(bytes)
+        );
+        let so = String::from_utf8_lossy(&o.stdout);
+        assert!(so.contains(&said), "{name}: {so}");
+        assert!(
+            bytes * 50 < 100_000_000,
+            "{name}: 20 runs wrote {bytes} bytes, 1000 would write about {} MB",
+            bytes * 50 / 1_000_000
+        );
+    }
+}

@@ -13,7 +13,8 @@
 //! report (steps, Newton iterations, distance, height), its first slips
 //! and the force under its sliding feet, the sizes of its CSV and Parquet
 //! files; the walk on ice's distance against the walk's; the peer
-//! benchmark's standing and walking hexapod (fbd's side). Elsewhere: the
+//! benchmark's standing and walking hexapod (fbd's side); the friction
+//! sweep of the standing hexapod (docs/sweep.md). Elsewhere: the
 //! Δt table (`tests/dt_convergence.rs`), the terrain examples
 //! (`crates/cli/tests/terrain.rs`), run 872 of the 1 ms landings
 //! (`tests/landing_chatter.rs`).
@@ -612,4 +613,86 @@ fn landing_runs_named_in_the_readme() {
 #[test]
 fn the_readme_is_where_this_test_looks() {
     assert!(Path::new(&root().join("README.md")).exists());
+}
+
+/// docs/sweep.md's friction sweep of the standing hexapod
+/// (`examples/sweep_hexapod_friction.toml`, run as `fbd sweep` runs it):
+/// the feet's |Ft|/N standing and at the touchdown's impact, and which μS
+/// slide (`foot_slips` of index.csv).
+#[test]
+fn hexapod_friction_sweep() {
+    let d = doc("docs/sweep.md");
+    let out = tempfile::tempdir().unwrap();
+    let args = fbd_cli::sweep::SweepArgs {
+        command: None,
+        sweep: Some(root().join("examples/sweep_hexapod_friction.toml")),
+        out: out.path().to_path_buf(),
+        jobs: Some(2),
+        shard: None,
+        resume: false,
+        plot: "foot_slips".into(),
+        viewer: false,
+        plots: false,
+    };
+    fbd_cli::sweep::sweep_command(args, &mut Vec::new()).unwrap();
+    let mut index = csv::Reader::from_path(out.path().join("index.csv")).unwrap();
+    let names: Vec<String> = index.headers().unwrap().iter().map(str::to_owned).collect();
+    let col = |rec: &csv::StringRecord, c: &str| -> f64 {
+        rec[names.iter().position(|n| n == c).unwrap()].parse().unwrap()
+    };
+    let (mut standing, mut impact) = (Vec::new(), 0.0f64);
+    let mut mus = Vec::new();
+    for rec in index.records() {
+        let rec = rec.unwrap();
+        let (run, mu, slips) = (
+            col(&rec, "run"),
+            col(&rec, "terrain.mu_static"),
+            col(&rec, "foot_slips"),
+        );
+        mus.push(mu);
+        // "with μS 0.05 and 0.1 the feet slide at touchdown (foot_slips >
+        // 0), with 0.2 and 0.8 they stick (0)": every foot slides.
+        if mu < 0.15 {
+            assert!(slips >= 6.0, "run {run}: μS {mu}, {slips} slips");
+            continue;
+        }
+        assert_eq!(slips, 0.0, "run {run}: μS {mu}");
+        // The feet that stick: |Ft|/N of every foot on every row (the
+        // impact's largest) and on the last row (standing).
+        let mut r =
+            csv::Reader::from_path(out.path().join(format!("runs/{run}/trajectory.csv"))).unwrap();
+        let h: Vec<String> = r.headers().unwrap().iter().map(str::to_owned).collect();
+        let at = |rec: &csv::StringRecord, c: &str| -> String {
+            rec[h.iter().position(|n| n == c).unwrap()].to_owned()
+        };
+        let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+        let ratio = |rec: &csv::StringRecord, n: usize| -> Option<f64> {
+            let f = |a: &str| at(rec, &format!("foot{n}_{a}")).parse::<f64>().unwrap();
+            (at(rec, &format!("state{n}")) == "ST2" && f("n") > 1e-6)
+                .then(|| f("fx").hypot(f("fz")) / f("n"))
+        };
+        for rec in &rows {
+            for n in 1..=6 {
+                impact = impact.max(ratio(rec, n).unwrap_or(0.0));
+            }
+        }
+        let last = rows.last().unwrap();
+        for n in 1..=6 {
+            standing.push(ratio(last, n).expect("every foot stands at the end"));
+        }
+    }
+    assert_eq!(mus, [0.05, 0.05, 0.1, 0.1, 0.2, 0.2, 0.8, 0.8]);
+    // Every standing foot of every run rounds to the quoted figure.
+    for s in &standing {
+        d.figure("sideways with |Ft|/N ≈ ", ", and", *s, "standing feet");
+    }
+    d.figure(
+        "with up to |Ft|/N ≈ ",
+        " in the touchdown's impact",
+        impact,
+        "the impact's largest |Ft|/N of a sticking foot",
+    );
+    // The impact's ratio lies between the μS that slide and those that
+    // stick.
+    assert!(0.1 < impact && impact < 0.2, "{impact}");
 }

@@ -14,7 +14,9 @@
 //! and the force under its sliding feet, the sizes of its CSV and Parquet
 //! files; the walk on ice's distance against the walk's; the peer
 //! benchmark's standing and walking hexapod (fbd's side); the friction
-//! sweep of the standing hexapod (docs/sweep.md). Elsewhere: the
+//! sweep of the standing hexapod (docs/sweep.md); the two 1000-run landing
+//! sweeps (completed runs, substeps, cycles, runs still moving, events).
+//! Elsewhere: the
 //! Δt table (`tests/dt_convergence.rs`), the terrain examples
 //! (`crates/cli/tests/terrain.rs`), run 872 of the 1 ms landings
 //! (`tests/landing_chatter.rs`).
@@ -549,7 +551,7 @@ fn peer_hexapod_figures() {
 }
 
 /// The landings the README names by their run number (the 1000-run sweeps
-/// themselves are measured by `scripts/landing-figures.py`): their events.
+/// themselves: [`landing_sweeps_of_1000_runs`]): their events.
 #[test]
 fn landing_runs_named_in_the_readme() {
     let r = doc("README.md");
@@ -638,7 +640,9 @@ fn hexapod_friction_sweep() {
     let mut index = csv::Reader::from_path(out.path().join("index.csv")).unwrap();
     let names: Vec<String> = index.headers().unwrap().iter().map(str::to_owned).collect();
     let col = |rec: &csv::StringRecord, c: &str| -> f64 {
-        rec[names.iter().position(|n| n == c).unwrap()].parse().unwrap()
+        rec[names.iter().position(|n| n == c).unwrap()]
+            .parse()
+            .unwrap()
     };
     let (mut standing, mut impact) = (Vec::new(), 0.0f64);
     let mut mus = Vec::new();
@@ -695,4 +699,213 @@ fn hexapod_friction_sweep() {
     // The impact's ratio lies between the μS that slide and those that
     // stick.
     assert!(0.1 < impact && impact < 0.2, "{impact}");
+}
+
+/// What the runs of a sweep's `summary.json` say, as
+/// `scripts/landing-figures.py` prints it.
+struct Landings {
+    runs: usize,
+    completed: usize,
+    retried_runs: usize,
+    retried_steps: u64,
+    cycle_runs: usize,
+    cycle_steps: u64,
+    moving: usize,
+    most_events: usize,
+    most_events_run: usize,
+    median_events: f64,
+}
+
+/// Runs the 1000-run landing sweep `name` (its runs' trajectories written
+/// every 1000th step only: the summaries use every step) and tabulates it.
+fn landings(name: &str) -> Landings {
+    let dir = tempfile::tempdir().unwrap();
+    let text = example(&format!("examples/{name}"));
+    let base = root().join("examples/paper.toml");
+    let mut text = text.replace(
+        "base = \"paper.toml\"",
+        &format!("base = {:?}", base.display().to_string()),
+    );
+    if text.contains("\n[set]\n\"output.stride\" = 10\n") {
+        text = text.replace(
+            "\n[set]\n\"output.stride\" = 10\n",
+            "\n[set]\n\"output.stride\" = 1000\n",
+        );
+    } else {
+        assert!(!text.contains("[set]"), "{name}");
+        text.push_str("\n[set]\n\"output.stride\" = 1000\n");
+    }
+    let sweep = dir.path().join(name);
+    std::fs::write(&sweep, text).unwrap();
+    let out = dir.path().join("out");
+    let args = fbd_cli::sweep::SweepArgs {
+        command: None,
+        sweep: Some(sweep),
+        out: out.clone(),
+        jobs: None,
+        shard: None,
+        resume: false,
+        plot: "touchdown".into(),
+        viewer: false,
+        plots: false,
+    };
+    fbd_cli::sweep::sweep_command(args, &mut Vec::new()).unwrap();
+    let total = fbd_cli::sweep::plan(&root().join("examples").join(name))
+        .unwrap()
+        .configs
+        .len();
+    let s: Vec<serde_json::Value> = (0..total)
+        .map(|i| {
+            let p = out.join(format!("runs/{i}/summary.json"));
+            serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+        })
+        .collect();
+    let n = |j: &serde_json::Value, k: &str| j[k].as_u64().unwrap();
+    let mut events: Vec<usize> = s
+        .iter()
+        .map(|j| j["events"].as_array().unwrap().len())
+        .collect();
+    let most_events = *events.iter().max().unwrap();
+    let most_events_run = events.iter().position(|e| *e == most_events).unwrap();
+    events.sort_unstable();
+    let m = events.len();
+    let median_events = if m % 2 == 1 {
+        events[m / 2] as f64
+    } else {
+        (events[m / 2 - 1] + events[m / 2]) as f64 / 2.0
+    };
+    Landings {
+        runs: s.len(),
+        completed: s.iter().filter(|j| j["status"] == "ok").count(),
+        retried_runs: s.iter().filter(|j| n(j, "retried_steps") > 0).count(),
+        retried_steps: s.iter().map(|j| n(j, "retried_steps")).sum(),
+        cycle_runs: s.iter().filter(|j| n(j, "resolved_cycles") > 0).count(),
+        cycle_steps: s.iter().map(|j| n(j, "resolved_cycles")).sum(),
+        moving: s
+            .iter()
+            .filter(|j| j["final_energy"]["kinetic"].as_f64().unwrap() > 1e-6)
+            .count(),
+        most_events,
+        most_events_run,
+        median_events,
+    }
+}
+
+/// The README's paragraph on the two 1000-run landing sweeps ("How robust
+/// this is"): both sweeps run here (some 20 s of both cores).
+#[test]
+fn landing_sweeps_of_1000_runs() {
+    let r = doc("README.md");
+    let (a, b) = (
+        landings("sweep_landing_1000.toml"),
+        landings("sweep_landing_1000_1ms.toml"),
+    );
+    assert_eq!((a.runs, b.runs), (1000, 1000));
+    r.has(
+        "How robust this is: **1000 of 1000** random passive landings complete at Δt = 10 ms",
+        "the runs of the 10 ms sweep",
+    );
+    r.count(
+        "How robust this is: **",
+        " of 1000** random",
+        a.completed,
+        "completed at 10 ms",
+    );
+    r.count(
+        "(`examples/sweep_landing_1000.toml`) and **",
+        " of 1000** at Δt = 1 ms",
+        b.completed,
+        "completed at 1 ms",
+    );
+    r.count(
+        "At Δt = 10 ms, ",
+        " runs needed substeps",
+        a.retried_runs,
+        "10 ms: runs in substeps",
+    );
+    r.count(
+        "runs needed substeps for at least one step (",
+        " steps in all)",
+        a.retried_steps as usize,
+        "10 ms: steps in substeps",
+    );
+    r.count(
+        " steps in all) and ",
+        " runs closed a cycling",
+        a.cycle_runs,
+        "10 ms: cycle runs",
+    );
+    r.count(
+        "least inconsistent combination (",
+        " steps); at Δt = 1 ms",
+        a.cycle_steps as usize,
+        "10 ms: cycle steps",
+    );
+    r.count(
+        "at Δt = 1 ms, ",
+        " runs used substeps",
+        b.retried_runs,
+        "1 ms: runs in substeps",
+    );
+    r.count(
+        " runs used substeps (",
+        " steps) and",
+        b.retried_steps as usize,
+        "1 ms: steps in substeps",
+    );
+    r.count(
+        " steps) and ",
+        " runs closed cycling searches",
+        b.cycle_runs,
+        "1 ms: cycle runs",
+    );
+    r.count(
+        "runs closed cycling searches that way (",
+        " steps)",
+        b.cycle_steps as usize,
+        "1 ms: cycle steps",
+    );
+    r.count(
+        "What is not guaranteed: ",
+        " of the 1000",
+        a.moving,
+        "10 ms: still moving",
+    );
+    r.count(
+        " landings at 10 ms and ",
+        " at 1 ms still move",
+        b.moving,
+        "1 ms: still moving",
+    );
+    r.count(
+        "the most events a run writes is ",
+        " at 10 ms (run",
+        a.most_events,
+        "10 ms: most events",
+    );
+    r.count(
+        " at 10 ms (run ",
+        ")",
+        a.most_events_run,
+        "10 ms: the run with the most events",
+    );
+    r.count(
+        ") and ",
+        " at 1 ms (run",
+        b.most_events,
+        "1 ms: most events",
+    );
+    r.count(
+        " at 1 ms (run ",
+        ") (median",
+        b.most_events_run,
+        "1 ms: the run with the most events",
+    );
+    r.figure("(median ", " and ", a.median_events, "10 ms: median events");
+    r.figure(
+        " and ",
+        "). Before the search",
+        b.median_events,
+        "1 ms: median events",
+    );
 }

@@ -714,27 +714,20 @@ struct Landings {
     most_events: usize,
     most_events_run: usize,
     median_events: f64,
+    /// The bytes `fbd sweep` says it wrote.
+    bytes: u64,
 }
 
-/// Runs the 1000-run landing sweep `name` (its runs' trajectories written
-/// every 1000th step only: the summaries use every step) and tabulates it.
+/// Runs the 1000-run landing sweep `name` as `fbd sweep` runs it (some
+/// 70 MB in a temporary folder) and tabulates it.
 fn landings(name: &str) -> Landings {
     let dir = tempfile::tempdir().unwrap();
     let text = example(&format!("examples/{name}"));
     let base = root().join("examples/paper.toml");
-    let mut text = text.replace(
+    let text = text.replace(
         "base = \"paper.toml\"",
         &format!("base = {:?}", base.display().to_string()),
     );
-    if text.contains("\n[set]\n\"output.stride\" = 10\n") {
-        text = text.replace(
-            "\n[set]\n\"output.stride\" = 10\n",
-            "\n[set]\n\"output.stride\" = 1000\n",
-        );
-    } else {
-        assert!(!text.contains("[set]"), "{name}");
-        text.push_str("\n[set]\n\"output.stride\" = 1000\n");
-    }
     let sweep = dir.path().join(name);
     std::fs::write(&sweep, text).unwrap();
     let out = dir.path().join("out");
@@ -749,7 +742,14 @@ fn landings(name: &str) -> Landings {
         viewer: false,
         plots: false,
     };
-    fbd_cli::sweep::sweep_command(args, &mut Vec::new()).unwrap();
+    let mut said = Vec::new();
+    fbd_cli::sweep::sweep_command(args, &mut said).unwrap();
+    let bytes = fbd_cli::sweep::dir_bytes(&out);
+    let said = String::from_utf8(said).unwrap();
+    assert!(
+        said.contains(&format!("({};", fbd_cli::sweep::human_bytes(bytes))),
+        "{said}"
+    );
     let total = fbd_cli::sweep::plan(&root().join("examples").join(name))
         .unwrap()
         .configs
@@ -788,6 +788,7 @@ fn landings(name: &str) -> Landings {
         most_events,
         most_events_run,
         median_events,
+        bytes,
     }
 }
 
@@ -907,5 +908,32 @@ fn landing_sweeps_of_1000_runs() {
         "). Before the search",
         b.median_events,
         "1 ms: median events",
+    );
+    // What the two sweeps write (`fbd sweep` prints it).
+    let (mb10, mb1) = (a.bytes as f64 / 1e6, b.bytes as f64 / 1e6);
+    r.figure(
+        "`examples/sweep_landing_1000.toml` writes ",
+        " MB, ",
+        mb10,
+        "10 ms sweep size",
+    );
+    r.figure(
+        "`examples/sweep_landing_1000_1ms.toml` ",
+        " MB with its `[set]",
+        mb1,
+        "1 ms sweep size",
+    );
+    let s = doc("docs/sweep.md");
+    s.figure(
+        "`examples/sweep_landing_1000.toml` writes ",
+        " MB by default",
+        mb10,
+        "10 ms sweep size",
+    );
+    s.figure(
+        "`examples/sweep_landing_1000_1ms.toml` ",
+        " MB (its `[set]",
+        mb1,
+        "1 ms sweep size",
     );
 }

@@ -207,3 +207,42 @@ fn the_1000_run_examples_write_under_100_mb() {
         );
     }
 }
+
+/// docs/sweep.md: the 1 ms landings without their `[set]` table are
+/// estimated at 951 MB, and the warning suggests a stride of 4 or Parquet.
+#[test]
+fn the_1ms_landings_without_set_warn_as_quoted() {
+    let text = std::fs::read_to_string(examples().join("sweep_landing_1000_1ms.toml")).unwrap();
+    // The [set] table is the file's last.
+    let (without, set) = text.split_once("\n[set]\n").unwrap();
+    assert!(!set.contains('['), "{set}");
+    let t = tempfile::tempdir().unwrap();
+    std::fs::copy(examples().join("paper.toml"), t.path().join("paper.toml")).unwrap();
+    let bare = t.path().join("bare.toml");
+    std::fs::write(&bare, without).unwrap();
+    let p = plan(&bare).unwrap();
+    let w = fbd_cli::output::sweep_size_warning(&p.trajectories, false, false).unwrap();
+    let d = common::readme::doc("docs/sweep.md");
+    let mb = common::readme::parse(&d.quoted(
+        "landings without their `[set]` table are estimated at ",
+        " MB",
+    ));
+    assert!(
+        w.contains(&format!("will write about {mb:.1} MB")),
+        "docs/sweep.md quotes {mb} MB: {w}"
+    );
+    d.has(
+        "`[output] stride = 4` (or `[set] \"output.stride\" = 4`) or `format = \"parquet\"` is suggested",
+        "the suggestion",
+    );
+    assert!(
+        w.contains("`[output] stride = 4`") && w.contains("parquet"),
+        "{w}"
+    );
+    // With the [set] table: no warning.
+    let p = plan(&examples().join("sweep_landing_1000_1ms.toml")).unwrap();
+    assert_eq!(
+        fbd_cli::output::sweep_size_warning(&p.trajectories, false, false),
+        None
+    );
+}

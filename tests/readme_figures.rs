@@ -480,8 +480,20 @@ fn kinematic_gaits() {
 fn walk_file_sizes() {
     let text = example("examples/hexapod_walk.toml");
     assert!(!text.contains("[output]"), "the walk sets no [output]");
-    let csv =
-        run_in(Some(&root().join("examples/hexapod_walk.toml"))).size("trajectory.csv") as f64;
+    let walk = run_in(Some(&root().join("examples/hexapod_walk.toml")));
+    let csv = walk.size("trajectory.csv") as f64;
+    // docs/reference.md's attitude columns: the walk starts pitched up its
+    // 3.5° slope, heading −π/2.
+    let first = &walk.rows()[0];
+    let reference = doc("docs/reference.md");
+    reference.figure(
+        "`examples/hexapod_walk.toml` starts at pitch = ",
+        " rad",
+        at(first, "pitch"),
+        "the walk's initial pitch",
+    );
+    assert!((at(first, "heading") + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert!(at(first, "roll").abs() < 1e-12);
     let parquet = run_text(&format!("{text}\n[output]\nformat = \"parquet\"\n"))
         .size("trajectory.parquet") as f64;
     let r = doc("README.md");
@@ -498,7 +510,6 @@ fn walk_file_sizes() {
         csv / parquet,
         "ratio",
     );
-    let reference = doc("docs/reference.md");
     reference.figure(
         "| `csv` | `trajectory.csv` | ",
         " MB |",

@@ -710,6 +710,22 @@ fn hexapod_friction_sweep() {
     // The impact's ratio lies between the μS that slide and those that
     // stick.
     assert!(0.1 < impact && impact < 0.2, "{impact}");
+    // The README's table of examples says it too.
+    let r = doc("README.md");
+    r.figure(
+        "the feet slide at touchdown below μS ≈ ",
+        " (the impact's |Ft|/N; ",
+        impact,
+        "the impact's |Ft|/N",
+    );
+    for s in &standing {
+        r.figure(
+            "(the impact's |Ft|/N; ",
+            " standing), stick above",
+            *s,
+            "standing feet",
+        );
+    }
 }
 
 /// What the runs of a sweep's `summary.json` say, as

@@ -160,7 +160,8 @@ pub struct SweepArgs {
     /// `fbd sweep merge DIR... --out DIR`.
     #[command(subcommand)]
     pub command: Option<SweepCommand>,
-    /// The sweep file (TOML: base, mode, samples, seed, [vary]).
+    /// The sweep file (TOML: base, mode, samples, seed, [vary], [set],
+    /// [derive]; docs/sweep.md).
     #[arg(value_name = "SWEEP", required = true)]
     pub sweep: Option<PathBuf>,
     /// Output directory, created if needed.

@@ -9,10 +9,9 @@ prints the runs that completed, the runs (and steps) solved in substeps,
 the runs (and steps) that closed a cycling state search by its least
 inconsistent combination, the runs still moving at the end (kinetic energy
 above 1 µJ) and the most and the median events of a run. Reads only each
-run's summary.json (standard library only). A 1000-run sweep is too long
-for the test command: these figures are measured by this script, and the
-README says so; the tests check single runs of the same sweeps
-(tests/readme_figures.rs).
+run's summary.json (standard library only). tests/readme_figures.rs
+(landing_sweeps_of_1000_runs) computes the same figures from both sweeps
+and checks the README's paragraph.
 """
 
 import json

@@ -132,6 +132,21 @@ fn trajectory_error_is_second_order() {
             "halving Δt divided the error by {ratio} (errors {e1:e}, {e2:e}, {e3:e}); second order expects ≈ 4"
         );
     }
+    // The README quotes both ratios.
+    let readme = common::readme::doc("README.md");
+    readme.figure(
+        "(halving Δt from 4 ms divides it by ",
+        ", then ",
+        e1 / e2,
+        "flight: order of convergence",
+    );
+    let first = readme.quoted("(halving Δt from 4 ms divides it by ", ", then ");
+    readme.figure(
+        &format!("divides it by {first}, then "),
+        "; `tests/flight.rs`)",
+        e2 / e3,
+        "flight: order of convergence",
+    );
 }
 
 #[test]

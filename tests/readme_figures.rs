@@ -13,7 +13,10 @@
 //! report (steps, Newton iterations, distance, height), its first slips
 //! and the force under its sliding feet, the sizes of its CSV and Parquet
 //! files; the walk on ice's distance against the walk's; the peer
-//! benchmark's standing and walking hexapod (fbd's side). Elsewhere: the
+//! benchmark's standing and walking hexapod (fbd's side); the friction
+//! sweep of the standing hexapod (docs/sweep.md); the two 1000-run landing
+//! sweeps (completed runs, substeps, cycles, runs still moving, events).
+//! Elsewhere: the
 //! Δt table (`tests/dt_convergence.rs`), the terrain examples
 //! (`crates/cli/tests/terrain.rs`), run 872 of the 1 ms landings
 //! (`tests/landing_chatter.rs`).
@@ -477,8 +480,20 @@ fn kinematic_gaits() {
 fn walk_file_sizes() {
     let text = example("examples/hexapod_walk.toml");
     assert!(!text.contains("[output]"), "the walk sets no [output]");
-    let csv =
-        run_in(Some(&root().join("examples/hexapod_walk.toml"))).size("trajectory.csv") as f64;
+    let walk = run_in(Some(&root().join("examples/hexapod_walk.toml")));
+    let csv = walk.size("trajectory.csv") as f64;
+    // docs/reference.md's attitude columns: the walk starts pitched up its
+    // 3.5° slope, heading −π/2.
+    let first = &walk.rows()[0];
+    let reference = doc("docs/reference.md");
+    reference.figure(
+        "`examples/hexapod_walk.toml` starts at pitch = ",
+        " rad",
+        at(first, "pitch"),
+        "the walk's initial pitch",
+    );
+    assert!((at(first, "heading") + std::f64::consts::FRAC_PI_2).abs() < 1e-12);
+    assert!(at(first, "roll").abs() < 1e-12);
     let parquet = run_text(&format!("{text}\n[output]\nformat = \"parquet\"\n"))
         .size("trajectory.parquet") as f64;
     let r = doc("README.md");
@@ -495,7 +510,6 @@ fn walk_file_sizes() {
         csv / parquet,
         "ratio",
     );
-    let reference = doc("docs/reference.md");
     reference.figure(
         "| `csv` | `trajectory.csv` | ",
         " MB |",
@@ -548,7 +562,7 @@ fn peer_hexapod_figures() {
 }
 
 /// The landings the README names by their run number (the 1000-run sweeps
-/// themselves are measured by `scripts/landing-figures.py`): their events.
+/// themselves: [`landing_sweeps_of_1000_runs`]): their events.
 #[test]
 fn landing_runs_named_in_the_readme() {
     let r = doc("README.md");
@@ -612,4 +626,341 @@ fn landing_runs_named_in_the_readme() {
 #[test]
 fn the_readme_is_where_this_test_looks() {
     assert!(Path::new(&root().join("README.md")).exists());
+}
+
+/// docs/sweep.md's friction sweep of the standing hexapod
+/// (`examples/sweep_hexapod_friction.toml`, run as `fbd sweep` runs it):
+/// the feet's |Ft|/N standing and at the touchdown's impact, and which μS
+/// slide (`foot_slips` of index.csv).
+#[test]
+fn hexapod_friction_sweep() {
+    let d = doc("docs/sweep.md");
+    let out = tempfile::tempdir().unwrap();
+    let args = fbd_cli::sweep::SweepArgs {
+        command: None,
+        sweep: Some(root().join("examples/sweep_hexapod_friction.toml")),
+        out: out.path().to_path_buf(),
+        jobs: Some(2),
+        shard: None,
+        resume: false,
+        plot: "foot_slips".into(),
+        viewer: false,
+        plots: false,
+    };
+    fbd_cli::sweep::sweep_command(args, &mut Vec::new()).unwrap();
+    let mut index = csv::Reader::from_path(out.path().join("index.csv")).unwrap();
+    let names: Vec<String> = index.headers().unwrap().iter().map(str::to_owned).collect();
+    let col = |rec: &csv::StringRecord, c: &str| -> f64 {
+        rec[names.iter().position(|n| n == c).unwrap()]
+            .parse()
+            .unwrap()
+    };
+    let (mut standing, mut impact) = (Vec::new(), 0.0f64);
+    let mut mus = Vec::new();
+    for rec in index.records() {
+        let rec = rec.unwrap();
+        let (run, mu, slips) = (
+            col(&rec, "run"),
+            col(&rec, "terrain.mu_static"),
+            col(&rec, "foot_slips"),
+        );
+        mus.push(mu);
+        // "with μS 0.05 and 0.1 the feet slide at touchdown (foot_slips >
+        // 0), with 0.2 and 0.8 they stick (0)": every foot slides.
+        if mu < 0.15 {
+            assert!(slips >= 6.0, "run {run}: μS {mu}, {slips} slips");
+            continue;
+        }
+        assert_eq!(slips, 0.0, "run {run}: μS {mu}");
+        // The feet that stick: |Ft|/N of every foot on every row (the
+        // impact's largest) and on the last row (standing).
+        let mut r =
+            csv::Reader::from_path(out.path().join(format!("runs/{run}/trajectory.csv"))).unwrap();
+        let h: Vec<String> = r.headers().unwrap().iter().map(str::to_owned).collect();
+        let at = |rec: &csv::StringRecord, c: &str| -> String {
+            rec[h.iter().position(|n| n == c).unwrap()].to_owned()
+        };
+        let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+        let ratio = |rec: &csv::StringRecord, n: usize| -> Option<f64> {
+            let f = |a: &str| at(rec, &format!("foot{n}_{a}")).parse::<f64>().unwrap();
+            (at(rec, &format!("state{n}")) == "ST2" && f("n") > 1e-6)
+                .then(|| f("fx").hypot(f("fz")) / f("n"))
+        };
+        for rec in &rows {
+            for n in 1..=6 {
+                impact = impact.max(ratio(rec, n).unwrap_or(0.0));
+            }
+        }
+        let last = rows.last().unwrap();
+        for n in 1..=6 {
+            standing.push(ratio(last, n).expect("every foot stands at the end"));
+        }
+    }
+    assert_eq!(mus, [0.05, 0.05, 0.1, 0.1, 0.2, 0.2, 0.8, 0.8]);
+    // Every standing foot of every run rounds to the quoted figure.
+    for s in &standing {
+        d.figure("sideways with |Ft|/N ≈ ", ", and", *s, "standing feet");
+    }
+    d.figure(
+        "with up to |Ft|/N ≈ ",
+        " in the touchdown's impact",
+        impact,
+        "the impact's largest |Ft|/N of a sticking foot",
+    );
+    // The impact's ratio lies between the μS that slide and those that
+    // stick.
+    assert!(0.1 < impact && impact < 0.2, "{impact}");
+    // The README's table of examples says it too.
+    let r = doc("README.md");
+    r.figure(
+        "the feet slide at touchdown below μS ≈ ",
+        " (the impact's |Ft|/N; ",
+        impact,
+        "the impact's |Ft|/N",
+    );
+    for s in &standing {
+        r.figure(
+            "(the impact's |Ft|/N; ",
+            " standing), stick above",
+            *s,
+            "standing feet",
+        );
+    }
+}
+
+/// What the runs of a sweep's `summary.json` say, as
+/// `scripts/landing-figures.py` prints it.
+struct Landings {
+    runs: usize,
+    completed: usize,
+    retried_runs: usize,
+    retried_steps: u64,
+    cycle_runs: usize,
+    cycle_steps: u64,
+    moving: usize,
+    most_events: usize,
+    most_events_run: usize,
+    median_events: f64,
+    /// The bytes `fbd sweep` says it wrote.
+    bytes: u64,
+}
+
+/// Runs the 1000-run landing sweep `name` as `fbd sweep` runs it (some
+/// 70 MB in a temporary folder) and tabulates it.
+fn landings(name: &str) -> Landings {
+    let dir = tempfile::tempdir().unwrap();
+    let text = example(&format!("examples/{name}"));
+    let base = root().join("examples/paper.toml");
+    let text = text.replace(
+        "base = \"paper.toml\"",
+        &format!("base = {:?}", base.display().to_string()),
+    );
+    let sweep = dir.path().join(name);
+    std::fs::write(&sweep, text).unwrap();
+    let out = dir.path().join("out");
+    let args = fbd_cli::sweep::SweepArgs {
+        command: None,
+        sweep: Some(sweep),
+        out: out.clone(),
+        jobs: None,
+        shard: None,
+        resume: false,
+        plot: "touchdown".into(),
+        viewer: false,
+        plots: false,
+    };
+    let mut said = Vec::new();
+    fbd_cli::sweep::sweep_command(args, &mut said).unwrap();
+    let bytes = fbd_cli::sweep::dir_bytes(&out);
+    let said = String::from_utf8(said).unwrap();
+    assert!(
+        said.contains(&format!("({};", fbd_cli::sweep::human_bytes(bytes))),
+        "{said}"
+    );
+    let total = fbd_cli::sweep::plan(&root().join("examples").join(name))
+        .unwrap()
+        .configs
+        .len();
+    let s: Vec<serde_json::Value> = (0..total)
+        .map(|i| {
+            let p = out.join(format!("runs/{i}/summary.json"));
+            serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+        })
+        .collect();
+    let n = |j: &serde_json::Value, k: &str| j[k].as_u64().unwrap();
+    let mut events: Vec<usize> = s
+        .iter()
+        .map(|j| j["events"].as_array().unwrap().len())
+        .collect();
+    let most_events = *events.iter().max().unwrap();
+    let most_events_run = events.iter().position(|e| *e == most_events).unwrap();
+    events.sort_unstable();
+    let m = events.len();
+    let median_events = if m % 2 == 1 {
+        events[m / 2] as f64
+    } else {
+        (events[m / 2 - 1] + events[m / 2]) as f64 / 2.0
+    };
+    Landings {
+        runs: s.len(),
+        completed: s.iter().filter(|j| j["status"] == "ok").count(),
+        retried_runs: s.iter().filter(|j| n(j, "retried_steps") > 0).count(),
+        retried_steps: s.iter().map(|j| n(j, "retried_steps")).sum(),
+        cycle_runs: s.iter().filter(|j| n(j, "resolved_cycles") > 0).count(),
+        cycle_steps: s.iter().map(|j| n(j, "resolved_cycles")).sum(),
+        moving: s
+            .iter()
+            .filter(|j| j["final_energy"]["kinetic"].as_f64().unwrap() > 1e-6)
+            .count(),
+        most_events,
+        most_events_run,
+        median_events,
+        bytes,
+    }
+}
+
+/// The README's paragraph on the two 1000-run landing sweeps ("How robust
+/// this is"): both sweeps run here (some 20 s of both cores).
+#[test]
+fn landing_sweeps_of_1000_runs() {
+    let r = doc("README.md");
+    let (a, b) = (
+        landings("sweep_landing_1000.toml"),
+        landings("sweep_landing_1000_1ms.toml"),
+    );
+    assert_eq!((a.runs, b.runs), (1000, 1000));
+    r.has(
+        "How robust this is: **1000 of 1000** random passive landings complete at Δt = 10 ms",
+        "the runs of the 10 ms sweep",
+    );
+    r.count(
+        "How robust this is: **",
+        " of 1000** random",
+        a.completed,
+        "completed at 10 ms",
+    );
+    r.count(
+        "(`examples/sweep_landing_1000.toml`) and **",
+        " of 1000** at Δt = 1 ms",
+        b.completed,
+        "completed at 1 ms",
+    );
+    r.count(
+        "At Δt = 10 ms, ",
+        " runs needed substeps",
+        a.retried_runs,
+        "10 ms: runs in substeps",
+    );
+    r.count(
+        "runs needed substeps for at least one step (",
+        " steps in all)",
+        a.retried_steps as usize,
+        "10 ms: steps in substeps",
+    );
+    r.count(
+        " steps in all) and ",
+        " runs closed a cycling",
+        a.cycle_runs,
+        "10 ms: cycle runs",
+    );
+    r.count(
+        "least inconsistent combination (",
+        " steps); at Δt = 1 ms",
+        a.cycle_steps as usize,
+        "10 ms: cycle steps",
+    );
+    r.count(
+        "at Δt = 1 ms, ",
+        " runs used substeps",
+        b.retried_runs,
+        "1 ms: runs in substeps",
+    );
+    r.count(
+        " runs used substeps (",
+        " steps) and",
+        b.retried_steps as usize,
+        "1 ms: steps in substeps",
+    );
+    r.count(
+        " steps) and ",
+        " runs closed cycling searches",
+        b.cycle_runs,
+        "1 ms: cycle runs",
+    );
+    r.count(
+        "runs closed cycling searches that way (",
+        " steps)",
+        b.cycle_steps as usize,
+        "1 ms: cycle steps",
+    );
+    r.count(
+        "What is not guaranteed: ",
+        " of the 1000",
+        a.moving,
+        "10 ms: still moving",
+    );
+    r.count(
+        " landings at 10 ms and ",
+        " at 1 ms still move",
+        b.moving,
+        "1 ms: still moving",
+    );
+    r.count(
+        "the most events a run writes is ",
+        " at 10 ms (run",
+        a.most_events,
+        "10 ms: most events",
+    );
+    r.count(
+        " at 10 ms (run ",
+        ")",
+        a.most_events_run,
+        "10 ms: the run with the most events",
+    );
+    r.count(
+        ") and ",
+        " at 1 ms (run",
+        b.most_events,
+        "1 ms: most events",
+    );
+    r.count(
+        " at 1 ms (run ",
+        ") (median",
+        b.most_events_run,
+        "1 ms: the run with the most events",
+    );
+    r.figure("(median ", " and ", a.median_events, "10 ms: median events");
+    r.figure(
+        " and ",
+        "). Before the search",
+        b.median_events,
+        "1 ms: median events",
+    );
+    // What the two sweeps write (`fbd sweep` prints it).
+    let (mb10, mb1) = (a.bytes as f64 / 1e6, b.bytes as f64 / 1e6);
+    r.figure(
+        "`examples/sweep_landing_1000.toml` writes ",
+        " MB, ",
+        mb10,
+        "10 ms sweep size",
+    );
+    r.figure(
+        "`examples/sweep_landing_1000_1ms.toml` ",
+        " MB with its `[set]",
+        mb1,
+        "1 ms sweep size",
+    );
+    let s = doc("docs/sweep.md");
+    s.figure(
+        "`examples/sweep_landing_1000.toml` writes ",
+        " MB by default",
+        mb10,
+        "10 ms sweep size",
+    );
+    s.figure(
+        "`examples/sweep_landing_1000_1ms.toml` ",
+        " MB (its `[set]",
+        mb1,
+        "1 ms sweep size",
+    );
 }

@@ -208,9 +208,9 @@ pub fn sweep_size_warning(runs: &[TrajectorySize], viewer: bool, plots: bool) ->
         let stride = runs.iter().map(|r| r.stride.max(1)).max().unwrap_or(1);
         let factor = (traj / (LARGE_SWEEP / 2.0)).ceil() as usize;
         shrink.push(format!(
-            "`[output] stride = {}` in the base configuration keeps the trajectory files under {}",
-            stride * factor,
-            mb(LARGE_SWEEP / 2.0)
+            "`[output] stride = {s}` in the base configuration (or `[set] \"output.stride\" = {s}` in the sweep file) keeps the trajectory files under {}",
+            mb(LARGE_SWEEP / 2.0),
+            s = stride * factor,
         ));
         if runs
             .iter()
@@ -1046,7 +1046,7 @@ mod tests {
         // under a half of the limit; Parquet shrinks them too.
         let w = sweep_size_warning(&planar(1000, 1000), false, false).unwrap();
         assert!(w.contains("(1000 runs: trajectory files 950.0 MB)"), "{w}");
-        assert!(w.contains("`[output] stride = 4` in the base configuration keeps the trajectory files under 250.0 MB; `format = \"parquet\"`"), "{w}");
+        assert!(w.contains("`[output] stride = 4` in the base configuration (or `[set] \"output.stride\" = 4` in the sweep file) keeps the trajectory files under 250.0 MB; `format = \"parquet\"`"), "{w}");
         let strided: Vec<TrajectorySize> = planar(1000, 250)
             .into_iter()
             .map(|t| TrajectorySize { stride: 4, ..t })

@@ -77,8 +77,13 @@ pub const HEXAPOD_COLUMNS: [&str; 12] = [
 /// torque (N·m) and foot normal force (N), the first touchdown of any foot
 /// (s), the number of slip events of the feet (a foot entering ST3), of
 /// all events (`events.csv`), the Newton iterations and steps per second
-/// of the run, then as for the planar model.
-pub const DYNAMIC_COLUMNS: [&str; 12] = [
+/// of the run, then as for the planar model but `error`; then the run's
+/// own audit of every step: the largest violation of a contact law or a
+/// body's balance over all steps (N, `max_law_violation` of
+/// `summary.json`), the steps solved again in substeps and the substeps
+/// they took (so that a strided or Parquet sweep still shows per run that
+/// every row is exact), then `error`.
+pub const DYNAMIC_COLUMNS: [&str; 15] = [
     "distance",
     "final_height",
     "peak_torque",
@@ -90,6 +95,9 @@ pub const DYNAMIC_COLUMNS: [&str; 12] = [
     "steps_per_second",
     "steps",
     "wall_seconds",
+    "max_law_violation",
+    "retried_steps",
+    "substeps",
     "error",
 ];
 
@@ -106,8 +114,8 @@ pub enum IndexKind {
 }
 
 impl IndexKind {
-    /// The fixed columns of `index.csv`.
-    pub fn columns(self) -> &'static [&'static str; 12] {
+    /// The fixed columns of `index.csv` (`error` last).
+    pub fn columns(self) -> &'static [&'static str] {
         match self {
             IndexKind::Planar => &COLUMNS,
             IndexKind::Hexapod => &HEXAPOD_COLUMNS,
@@ -152,7 +160,8 @@ pub struct SweepArgs {
     /// `fbd sweep merge DIR... --out DIR`.
     #[command(subcommand)]
     pub command: Option<SweepCommand>,
-    /// The sweep file (TOML: base, mode, samples, seed, [vary]).
+    /// The sweep file (TOML: base, mode, samples, seed, [vary], [set],
+    /// [derive]; docs/sweep.md).
     #[arg(value_name = "SWEEP", required = true)]
     pub sweep: Option<PathBuf>,
     /// Output directory, created if needed.
@@ -260,6 +269,11 @@ pub struct SweepFile {
     /// Dotted keys and their values.
     #[serde(default)]
     pub vary: Vary,
+    /// Dotted keys set to one value in every run, in every mode (e.g.
+    /// `"output.stride" = 10`): applied before the varied and derived
+    /// keys, not columns of `index.csv`, no random draws.
+    #[serde(default, skip_serializing_if = "Vary::is_empty")]
+    pub set: Vary,
     /// Keys computed from varied ones: `"key" = { from = "varied.key",
     /// scale = X }` sets `key` to `X ×` the run's value of `varied.key`
     /// (e.g. μD = 0.75·μS).
@@ -485,8 +499,9 @@ pub struct Row {
     /// The varied values, formatted ([`format_value`]).
     pub values: Vec<String>,
     /// The numeric columns of `kind` ([`COLUMNS`] `touchdown3` …
-    /// `wall_seconds`, or [`HEXAPOD_COLUMNS`]), `None` = empty.
-    pub numbers: [Option<f64>; 11],
+    /// `wall_seconds`, or [`HEXAPOD_COLUMNS`]), `None` = empty (missing
+    /// entries too).
+    pub numbers: Vec<Option<f64>>,
     /// Which columns `numbers` holds.
     pub kind: IndexKind,
     /// The error message ("" when ok).
@@ -497,15 +512,17 @@ impl Row {
     /// A plotted column of this row (see [`plot_columns`]).
     pub fn column(&self, name: &str) -> Option<f64> {
         if name == "touchdown" {
-            return match (self.numbers[0], self.numbers[1]) {
+            let n = |i: usize| self.numbers.get(i).copied().flatten();
+            return match (n(0), n(1)) {
                 (Some(a), Some(b)) => Some(a.min(b)),
                 (a, b) => a.or(b),
             };
         }
-        self.kind.columns()[..11]
+        let cols = self.kind.columns();
+        cols[..cols.len() - 1]
             .iter()
             .position(|c| *c == name)
-            .and_then(|i| self.numbers[i])
+            .and_then(|i| self.numbers.get(i).copied().flatten())
     }
 }
 
@@ -564,11 +581,13 @@ pub fn write_index(
     for r in rows {
         let mut rec = vec![r.run.to_string(), r.status.clone()];
         rec.extend(r.values.iter().cloned());
-        rec.extend(r.numbers.iter().enumerate().map(|(i, v)| {
+        let cols = kind.columns();
+        rec.extend((0..cols.len() - 1).map(|i| {
+            let v = r.numbers.get(i).copied().flatten();
             if i == 9 {
                 v.map(|s| (s as u64).to_string()).unwrap_or_default()
             } else {
-                fmt_num(*v)
+                fmt_num(v)
             }
         }));
         rec.push(r.error.clone());
@@ -594,10 +613,11 @@ pub fn read_index(path: &Path, nkeys: usize) -> Result<(IndexKind, Vec<Row>), Cl
     for rec in r.records() {
         let rec = rec.map_err(|e| CliError::Io(format!("{}: {e}", path.display())))?;
         let bad = || CliError::Io(format!("{}: malformed row", path.display()));
-        if rec.len() != 2 + nkeys + 12 {
+        let ncols = kind.columns().len();
+        if rec.len() != 2 + nkeys + ncols {
             return Err(bad());
         }
-        let mut numbers = [None; 11];
+        let mut numbers = vec![None; ncols - 1];
         for (i, n) in numbers.iter_mut().enumerate() {
             let s = &rec[2 + nkeys + i];
             *n = if s.is_empty() {
@@ -612,7 +632,7 @@ pub fn read_index(path: &Path, nkeys: usize) -> Result<(IndexKind, Vec<Row>), Cl
             values: (0..nkeys).map(|i| rec[2 + i].to_owned()).collect(),
             numbers,
             kind,
-            error: rec[2 + nkeys + 11].to_owned(),
+            error: rec[2 + nkeys + ncols - 1].to_owned(),
         });
     }
     Ok((kind, rows))
@@ -634,7 +654,7 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
             run,
             status: s["status"].as_str().unwrap_or("error").to_owned(),
             values,
-            numbers: [
+            numbers: vec![
                 num(&s["distance"]),
                 num(&s["displacement"]),
                 num(&s["mean_speed"]),
@@ -651,7 +671,7 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
             error: s["error"].as_str().unwrap_or("").replace('\n', " "),
         });
     }
-    let numbers = [
+    let numbers = vec![
         num(&s["first_touchdown"]["leg3"]),
         num(&s["first_touchdown"]["leg4"]),
         num(&s["first_slip"]["leg3"]),
@@ -703,7 +723,7 @@ fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
         run,
         status: s["status"].as_str().unwrap_or("error").to_owned(),
         values,
-        numbers: [
+        numbers: vec![
             num(&s["distance"]),
             num(&s["final_height"]),
             num(&s["peak_torque_max"]),
@@ -715,6 +735,9 @@ fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
             num(&s["steps_per_second"]),
             num(&s["steps"]),
             num(&s["wall_seconds"]),
+            num(&s["max_law_violation"]),
+            num(&s["retried_steps"]),
+            num(&s["substeps"]),
         ],
         kind: IndexKind::Dynamic,
         error: s["error"].as_str().unwrap_or("").replace('\n', " "),
@@ -782,6 +805,21 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         ))
     })?;
     let values = expand(&file, &name).map_err(CliError::Usage)?;
+    for (k, _) in &file.set.0 {
+        for (table, list) in [("vary", &file.vary), ("derive", &file.derive)] {
+            if list.0.iter().any(|(o, _)| o == k) {
+                return Err(CliError::Usage(format!(
+                    "{name}: set.\"{k}\": the key is also in [{table}]"
+                )));
+            }
+        }
+    }
+    let set: Vec<Override> = file
+        .set
+        .0
+        .iter()
+        .map(|(k, v)| Override::new(k.clone(), v.clone()))
+        .collect();
     let keys: Vec<String> = file
         .vary
         .0
@@ -805,13 +843,30 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         }
         None => (String::new(), "the built-in default".to_owned()),
     };
+    // The [set] keys alone on the base: an unknown key or a value of the
+    // wrong type is named once (a value out of range, which may depend on
+    // the varied keys, is reported per run below).
+    for i in 0..set.len() {
+        if let Err(config::ConfigError::Override { key, message, .. }) =
+            config::parse_str(&base_text, &base_name, &set[..=i])
+        {
+            return Err(CliError::Usage(format!(
+                "{name}: set.\"{key}\": {}",
+                message.replace('\n', " ")
+            )));
+        }
+    }
     let mut configs = Vec::with_capacity(values.len());
     let mut trajectories = Vec::with_capacity(values.len());
     for (i, vals) in values.iter().enumerate() {
-        let overrides: Vec<Override> = keys
+        let overrides: Vec<Override> = set
             .iter()
-            .zip(vals)
-            .map(|(k, v)| Override::new(k.clone(), v.clone()))
+            .cloned()
+            .chain(
+                keys.iter()
+                    .zip(vals)
+                    .map(|(k, v)| Override::new(k.clone(), v.clone())),
+            )
             .collect();
         let what = || {
             keys.iter()

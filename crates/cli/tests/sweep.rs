@@ -445,7 +445,7 @@ mode = "grid"
         h.join(","),
         "run,status,terrain.mu_static,control.kp,terrain.mu_dynamic,distance,final_height,\
          peak_torque,peak_foot_n,first_touchdown,foot_slips,events,newton_iterations,\
-         steps_per_second,steps,wall_seconds,error"
+         steps_per_second,steps,wall_seconds,max_law_violation,retried_steps,substeps,error"
     );
     assert_eq!(rows.len(), 4);
     let col = |r: &[String], name: &str| -> String {
@@ -481,6 +481,11 @@ mode = "grid"
         );
         let events = j["events"].as_array().unwrap();
         assert_eq!(num(r, "events"), events.len() as f64);
+        // The run's audit of every step, as summary.json counts it.
+        for c in ["max_law_violation", "retried_steps", "substeps"] {
+            assert_eq!(num(r, c), j[c].as_f64().unwrap(), "{c}");
+        }
+        assert!(num(r, "max_law_violation") < 1e-6 * weight, "{r:?}");
         assert!(num(r, "steps_per_second") > 0.0);
         // Touchdown of the six feet together after the 5 cm drop,
         // √(2·0.05/g) = 0.101 s: the step from 0.1 s puts them down.

@@ -95,9 +95,10 @@ pub struct SpatialSummary {
     /// in the plane a slide kept in ST3 running backwards (the planar
     /// model is not audited: its friction then pushes along the slip).
     pub backward_slides: usize,
-    /// The largest violation of a contact or joint-limit law over the
-    /// written rows (N); never above 1e-7 of the weight: a step that cannot
-    /// be solved that exactly ends the run with an error instead.
+    /// The largest violation of a contact or joint-limit law over every
+    /// step solved (substeps included), written or not (N); never above
+    /// 1e-6 of the weight: a step that cannot be solved that exactly ends
+    /// the run with an error instead.
     pub max_law_violation: f64,
     /// `"hexapod"`.
     pub model: &'static str,

@@ -25,7 +25,9 @@ fn landing(run: usize) -> SpatialModel {
     let fbd_cli::Config::Hexapod(c) = &plan.configs[run] else {
         panic!("a hexapod run")
     };
-    let params = c.spatial_params("landing").expect("a valid run");
+    let mut params = c.spatial_params("landing").expect("a valid run");
+    // Every row (the sweep file's `[set]` writes every 50th).
+    params.stride = 1;
     SpatialModel::new(&params).expect("a valid model")
 }
 

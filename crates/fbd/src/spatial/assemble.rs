@@ -174,6 +174,13 @@ pub struct SpatialFbdData {
     /// This step's solves use fixed states, not complementarity rows
     /// (`fbd_sim`'s last fallback; reset every step).
     pub fixed_states: bool,
+    /// The branches the active-set fallback froze first this step
+    /// (`fbd_sim`'s second active-set attempt starts them again from the
+    /// step's start).
+    pub first_frozen: Vec<Option<rows::Frozen>>,
+    /// Whether this step's active-set fallback has restarted from the
+    /// step's start (reset every step).
+    pub refrozen: bool,
     /// Per limit, whether its complementarity stop row is unloaded at the
     /// last evaluated iterate.
     pub limit_unloaded: Vec<bool>,
@@ -247,6 +254,8 @@ impl SpatialFbdData {
             branch: vec![rows::Branch::default(); mech.contacts.len()],
             frozen: vec![None; mech.contacts.len()],
             fixed_states: false,
+            first_frozen: vec![None; mech.contacts.len()],
+            refrozen: false,
             limit_unloaded: vec![false; mech.limits.len()],
             wrench: vec![Wrench::default(); nb],
             rot_d: vec![Matrix3::zeros(); nb],

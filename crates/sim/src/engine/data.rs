@@ -116,6 +116,10 @@ pub struct RunData<M: Engine> {
     pub(crate) failed_limits: Vec<LimitState>,
     /// The unknowns the (sub)step's search started from (the predictor).
     pub(crate) start_z: Vec<f64>,
+    /// The (sub)step's first start, kept when a fallback moves `start_z`
+    /// (the spatial active-set fallback starts from the failed iterate
+    /// first, then from here).
+    pub(crate) origin_z: Vec<f64>,
     /// The search's least inconsistent trial so far (see
     /// [`super::search`]): its violation (N), unknowns and states.
     pub(crate) best_violation: f64,
@@ -212,6 +216,7 @@ impl<M: Engine> RunData<M> {
             failed_trial: initial_states.clone(),
             failed_limits: free.clone(),
             start_z: vec![0.0; dim],
+            origin_z: vec![0.0; dim],
             best_violation: f64::INFINITY,
             best_z: vec![0.0; dim],
             checked_trial: initial_states.clone(),
@@ -287,6 +292,7 @@ where
             failed_trial: self.failed_trial.clone(),
             failed_limits: self.failed_limits.clone(),
             start_z: self.start_z.clone(),
+            origin_z: self.origin_z.clone(),
             best_violation: self.best_violation,
             best_z: self.best_z.clone(),
             best_trial: self.best_trial.clone(),

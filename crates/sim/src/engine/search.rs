@@ -57,6 +57,7 @@ use fbd_dynamics::LimitState;
 /// `data.z`, kept to start again from after a failed solve).
 pub(crate) fn start_search<M: Engine>(data: &mut RunData<M>) {
     data.start_z.copy_from_slice(&data.z);
+    data.origin_z.copy_from_slice(&data.z);
     data.best_violation = f64::INFINITY;
     data.trial.copy_from_slice(&data.states);
     data.limit_trial.copy_from_slice(&data.limit_states);

@@ -731,6 +731,8 @@ fn hexapod_friction_sweep() {
 /// What the runs of a sweep's `summary.json` say, as
 /// `scripts/landing-figures.py` prints it.
 struct Landings {
+    /// Each run's summary.json.
+    summaries: Vec<serde_json::Value>,
     runs: usize,
     completed: usize,
     retried_runs: usize,
@@ -750,11 +752,15 @@ struct Landings {
 fn landings(name: &str) -> Landings {
     let dir = tempfile::tempdir().unwrap();
     let text = example(&format!("examples/{name}"));
-    let base = root().join("examples/paper.toml");
-    let text = text.replace(
-        "base = \"paper.toml\"",
-        &format!("base = {:?}", base.display().to_string()),
-    );
+    // The base configuration by its absolute path (the sweep file is copied).
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("base = \""))
+        .expect("a base line");
+    let base = root()
+        .join("examples")
+        .join(line.trim_start_matches("base = ").trim_matches('"'));
+    let text = text.replace(line, &format!("base = {:?}", base.display().to_string()));
     let sweep = dir.path().join(name);
     std::fs::write(&sweep, text).unwrap();
     let out = dir.path().join("out");
@@ -802,6 +808,7 @@ fn landings(name: &str) -> Landings {
         (events[m / 2 - 1] + events[m / 2]) as f64 / 2.0
     };
     Landings {
+        summaries: s.clone(),
         runs: s.len(),
         completed: s.iter().filter(|j| j["status"] == "ok").count(),
         retried_runs: s.iter().filter(|j| n(j, "retried_steps") > 0).count(),
@@ -962,5 +969,100 @@ fn landing_sweeps_of_1000_runs() {
         " MB (its `[set]",
         mb1,
         "1 ms sweep size",
+    );
+}
+
+/// The README's paragraph on all 1000 runs of
+/// `examples/sweep_hexapod_landing_1000.toml` (3D landings on feet, knees
+/// and hips): the sweep runs here as the example file writes it (every
+/// 50th row, some 85 MB; about two minutes of both cores), and every
+/// figure of the paragraph but the timings and the stride-1 CSV check
+/// (`scripts/sweep-laws.py`, which exits 1 on a row that breaks a law) is
+/// recomputed from the runs' summary.json.
+#[test]
+fn hexapod_landing_sweep_of_1000_runs() {
+    let r = doc("README.md");
+    let l = landings("sweep_hexapod_landing_1000.toml");
+    let s = &l.summaries;
+    assert_eq!(l.runs, 1000);
+    let what = "3D landings";
+    r.count("**", " of 1000 3D landings complete**", l.completed, what);
+    let steps: u64 = s.iter().map(|j| j["steps"].as_u64().unwrap()).sum();
+    r.count(
+        "every one of their **",
+        " steps** passes",
+        steps as usize,
+        "3D landings: steps",
+    );
+    let worst = s
+        .iter()
+        .map(|j| j["max_law_violation"].as_f64().unwrap())
+        .fold(0.0, f64::max);
+    r.approx(
+        "run's own law audit (worst ",
+        " N; the tolerance",
+        worst,
+        "3D landings: worst audited step",
+    );
+    let weight = 180.504;
+    assert!(worst <= 1e-6 * weight, "{worst} N");
+    let mut per_step: Vec<f64> = s
+        .iter()
+        .map(|j| j["newton_iterations"].as_f64().unwrap() / j["steps"].as_f64().unwrap())
+        .collect();
+    per_step.sort_by(f64::total_cmp);
+    r.figure(
+        "The median run takes ",
+        "\nNewton iterations a step",
+        (per_step[499] + per_step[500]) / 2.0,
+        "3D landings: iterations a step",
+    );
+    r.figure(
+        "Newton iterations a step and writes ",
+        " events",
+        l.median_events,
+        "3D landings: median events",
+    );
+    r.count(
+        "stops; ",
+        " the most, run",
+        l.most_events,
+        "3D landings: most events",
+    );
+    r.count(
+        " the most, run ",
+        "); 828",
+        l.most_events_run,
+        "3D landings: the run with most events",
+    );
+    r.count(
+        "most, run 308); ",
+        " steps were retried",
+        l.retried_steps as usize,
+        "3D landings: retried steps",
+    );
+    r.count(
+        "retried in substeps, in\n",
+        " runs; 31",
+        l.retried_runs,
+        "3D landings: retried runs",
+    );
+    r.count(
+        " runs; ",
+        " steps, in 31 runs, closed",
+        l.cycle_steps as usize,
+        "3D landings: cycle steps",
+    );
+    r.count(
+        " steps, in ",
+        " runs, closed a cycling",
+        l.cycle_runs,
+        "3D landings: cycle runs",
+    );
+    r.count(
+        "tolerance); ",
+        " runs still move\nat 1.5 s",
+        l.moving,
+        "3D landings: still moving",
     );
 }

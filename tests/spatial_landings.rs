@@ -12,7 +12,8 @@
 
 mod common;
 
-use common::spatial::check_contact_laws;
+use common::spatial::{LawReport, check_contact_laws};
+use fbd_sim::RunSummary;
 use fbd_sim::spatial::{SpatialModel, run_collect};
 use std::path::Path;
 
@@ -31,24 +32,32 @@ fn landing(run: usize) -> SpatialModel {
     SpatialModel::new(&params).expect("a valid model")
 }
 
+/// Runs landing `run` to its end; fails unless it completes with every
+/// row within the contact laws (1e-6 of the weight). Its summary and the
+/// law report.
+fn complete_exactly(run: usize) -> (SpatialModel, RunSummary, LawReport) {
+    let model = landing(run);
+    let (rows, summary) = run_collect(&model);
+    if let Some(e) = &summary.error {
+        panic!("run {run}: {e}");
+    }
+    assert_eq!(rows.len(), model.steps, "run {run}");
+    let weight = model.mech.total_mass() * model.params.gravity;
+    let retried: Vec<usize> = summary.retries.iter().map(|r| r.step).collect();
+    let laws = check_contact_laws(&model, &rows, &retried);
+    assert!(
+        laws.worst <= 1e-6 * weight,
+        "run {run}: {:.3e} N at {}",
+        laws.worst,
+        laws.worst_at
+    );
+    (model, summary, laws)
+}
+
 #[test]
 fn landings_that_had_no_exact_solution_complete_exactly() {
     for run in [0, 1, 2, 3, 49, 77, 79, 81] {
-        let model = landing(run);
-        let (rows, summary) = run_collect(&model);
-        if let Some(e) = &summary.error {
-            panic!("run {run}: {e}");
-        }
-        assert_eq!(rows.len(), model.steps, "run {run}");
-        let weight = model.mech.total_mass() * model.params.gravity;
-        let retried: Vec<usize> = summary.retries.iter().map(|r| r.step).collect();
-        let laws = check_contact_laws(&model, &rows, &retried);
-        assert!(
-            laws.worst <= 1e-6 * weight,
-            "run {run}: {:.3e} N at {}",
-            laws.worst,
-            laws.worst_at
-        );
+        let (model, summary, laws) = complete_exactly(run);
         assert!(laws.sliding > 0 && laws.directions > 0, "run {run} slides");
         // Calm at rest: no contact event in the last 0.1 s (they come to
         // rest between 0.6 s and 1.38 s).
@@ -69,21 +78,7 @@ fn landings_that_had_no_exact_solution_complete_exactly() {
 #[test]
 fn landings_that_needed_the_second_active_set_attempt_complete_exactly() {
     for run in [522, 570, 872] {
-        let model = landing(run);
-        let (rows, summary) = run_collect(&model);
-        if let Some(e) = &summary.error {
-            panic!("run {run}: {e}");
-        }
-        assert_eq!(rows.len(), model.steps, "run {run}");
-        let weight = model.mech.total_mass() * model.params.gravity;
-        let retried: Vec<usize> = summary.retries.iter().map(|r| r.step).collect();
-        let laws = check_contact_laws(&model, &rows, &retried);
-        assert!(
-            laws.worst <= 1e-6 * weight,
-            "run {run}: {:.3e} N at {}",
-            laws.worst,
-            laws.worst_at
-        );
+        let (_, summary, _) = complete_exactly(run);
         assert!(summary.newton_fallbacks > 0, "run {run}: no fallback used");
     }
 }

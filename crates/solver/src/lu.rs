@@ -80,8 +80,9 @@
 //!   make the same requests in `O(n²)`: a dense lower triangle whose last
 //!   column is full (`L` as dense, and the full last column's request of
 //!   `U`), then a dense upper triangle (`U` as dense), both diagonally
-//!   dominant so that partial pivoting keeps the diagonal and no column
-//!   updates another. `tests/no_alloc.rs` of this crate checks a
+//!   dominant so that partial pivoting keeps the diagonal (only the full
+//!   last column is updated by the others). `tests/no_alloc.rs` of this
+//!   crate checks a
 //!   re-pivoted refactorisation against it. The storage is shared by the
 //!   patterns of one dimension (the contact states of a run change the
 //!   pattern, seldom the dimension), so that this warm-up is done once per
@@ -369,8 +370,8 @@ impl Factors {
     }
 
     /// Storage for (reduced) dimension `n`, grown to that of a dense
-    /// `n × n` LU by two triangular warm-ups (see the module docs). Allocates; `mem` must hold
-    /// [`Self::scratch`].
+    /// `n × n` LU by two triangular warm-ups (see the module docs).
+    /// Allocates; `mem` must hold [`Self::scratch`].
     pub(crate) fn new(n: usize, mem: &mut MemBuffer) -> Self {
         // The sweeps' streams index rows and columns as `u32`.
         assert!(u32::try_from(n).is_ok(), "dimension {n} beyond u32");

@@ -82,8 +82,8 @@
 //!   `U`), then a dense upper triangle (`U` as dense), both diagonally
 //!   dominant so that partial pivoting keeps the diagonal (only the full
 //!   last column is updated by the others). `tests/no_alloc.rs` of this
-//!   crate checks a
-//!   re-pivoted refactorisation against it. The storage is shared by the
+//!   crate checks a re-pivoted refactorisation against it. The storage is
+//!   shared by the
 //!   patterns of one dimension (the contact states of a run change the
 //!   pattern, seldom the dimension), so that this warm-up is done once per
 //!   dimension rather than once per pattern; it holds the last

@@ -1031,25 +1031,43 @@ fn hexapod_landing_sweep_of_1000_runs() {
     );
     r.count(
         " the most, run ",
-        "); 828",
+        "); 842",
         l.most_events_run,
         "3D landings: the run with most events",
     );
     r.count(
-        "most, run 308); ",
+        "most, run 400); ",
         " steps were retried",
         l.retried_steps as usize,
         "3D landings: retried steps",
     );
     r.count(
         "retried in substeps, in\n",
-        " runs; 31",
+        " runs (one",
         l.retried_runs,
         "3D landings: retried runs",
     );
+    // The steps solved with the reference LU (the last retry).
+    let reference: Vec<usize> = s
+        .iter()
+        .enumerate()
+        .filter(|(_, j)| j["reference_lu_retries"].as_u64().unwrap() > 0)
+        .map(|(i, _)| i)
+        .collect();
+    assert_eq!(
+        reference.len(),
+        1,
+        "runs with reference-LU retries: {reference:?}"
+    );
     r.count(
-        " runs; ",
-        " steps, in 31 runs, closed",
+        " runs (one of them, run ",
+        ", with the reference LU",
+        reference[0],
+        "3D landings: the run retried with the reference LU",
+    );
+    r.count(
+        "LU:\n[docs/reference.md](docs/reference.md#contact-in-3d-dynamic-hexapod-runs));\n",
+        " steps, in 26 runs, closed",
         l.cycle_steps as usize,
         "3D landings: cycle steps",
     );

@@ -975,6 +975,10 @@ pub struct Summary {
     pub newton_fallbacks: usize,
     /// Substeps solved in retries, failed attempts included.
     pub substeps: usize,
+    /// Of `retried_steps`, those solved with faer's reference LU after
+    /// every attempt with the compiled LU had failed (docs/reference.md,
+    /// "Speed").
+    pub reference_lu_retries: usize,
     /// Re-solves that moved a fixed friction direction to the step's own
     /// slip (slides Newton could not solve with the implicit direction).
     pub direction_refinements: usize,

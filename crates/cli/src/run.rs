@@ -210,6 +210,7 @@ fn summary(
         rejected_solutions: run.rejected_solutions,
         newton_fallbacks: run.newton_fallbacks,
         substeps: run.substeps,
+        reference_lu_retries: run.retries.iter().filter(|r| r.reference_lu).count(),
         direction_refinements: run.direction_refinements,
         backward_slides: run.backward_slides,
         max_law_violation: run.max_law_violation,

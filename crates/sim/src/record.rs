@@ -178,4 +178,8 @@ pub struct RetryEvent {
     /// `"cycle"` (the contact-state search found no consistent
     /// combination) or `"non-finite"`.
     pub cause: &'static str,
+    /// Solved with faer's pivoting LU (the reference path) after every
+    /// attempt with the compiled LU had failed (`NewtonParams::compiled_lu`;
+    /// `substeps` is then 1 for the whole step).
+    pub reference_lu: bool,
 }

@@ -102,8 +102,10 @@ pub struct NewtonParams {
     /// compiled, at its first factorisation, into a flat list of
     /// operations on faer's column ordering and the row order of faer's
     /// partial pivoting on those values; later factorisations run the list
-    /// and re-verify each pivot (threshold `0.01` of its column), falling
-    /// back to faer's pivoting LU (and compiling again) when one fails
+    /// and re-verify each pivot (threshold `0.01` of its column); a
+    /// failed pivot is perturbed and the solves corrected to the exact
+    /// system ([`NewtonSolver::lu_corrected`]), or, when that cannot be
+    /// done, the factorisation falls back to faer's pivoting LU
     /// ([`NewtonSolver::lu_fallbacks`]). `false`: every factorisation by
     /// faer's pivoting LU, the reference path. Solutions agree to
     /// round-off. Default: `true`.
@@ -161,6 +163,9 @@ struct Workspace {
     compiled_factorizations: u64,
     /// Compiled factorisations abandoned for faer's (a pivot failed).
     lu_fallbacks: u64,
+    /// Compiled factorisations with perturbed pivots, their solves
+    /// corrected.
+    lu_corrected: u64,
 }
 
 impl Clone for Workspace {
@@ -178,6 +183,7 @@ impl Clone for Workspace {
             numeric_factorizations: self.numeric_factorizations,
             compiled_factorizations: self.compiled_factorizations,
             lu_fallbacks: self.lu_fallbacks,
+            lu_corrected: self.lu_corrected,
         }
     }
 }
@@ -245,6 +251,7 @@ impl NewtonSolver {
                 numeric_factorizations: 0,
                 compiled_factorizations: 0,
                 lu_fallbacks: 0,
+                lu_corrected: 0,
             },
             symbolic_factorizations: 0,
         }
@@ -279,9 +286,16 @@ impl NewtonSolver {
     }
 
     /// Compiled factorisations abandoned because a pivot failed its check
-    /// (each then factored by faer, and the pattern compiled again).
+    /// and could not be perturbed (each then factored by faer).
     pub fn lu_fallbacks(&self) -> u64 {
         self.ws.lu_fallbacks
+    }
+
+    /// Of [`Self::compiled_factorizations`], those whose failed pivots
+    /// were perturbed and whose solves are corrected (see
+    /// [`NewtonParams::compiled_lu`]).
+    pub fn lu_corrected(&self) -> u64 {
+        self.ws.lu_corrected
     }
 
     /// Number of pattern keys currently cached.
@@ -675,9 +689,14 @@ impl Workspace {
                 return Err(SolverError::NonFinite { iter: full });
             }
             negate(&mut self.dx, &self.r);
-            match factors.factor(pattern, &self.values, &mut self.mem, params.compiled_lu)? {
+            let fp = factors.factor(pattern, &self.values, &mut self.mem, params.compiled_lu)?;
+            match fp {
                 FactorPath::Compiled => self.compiled_factorizations += 1,
                 FactorPath::Fallback => self.lu_fallbacks += 1,
+                FactorPath::Corrected => {
+                    self.compiled_factorizations += 1;
+                    self.lu_corrected += 1;
+                }
                 FactorPath::Faer => {}
             }
             factorizations += 1;

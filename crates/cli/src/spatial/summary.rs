@@ -87,6 +87,10 @@ pub struct SpatialSummary {
     pub newton_fallbacks: usize,
     /// Substeps solved in retries, failed attempts included.
     pub substeps: usize,
+    /// Of `retried_steps`, those solved with faer's reference LU after
+    /// every attempt with the compiled LU had failed (docs/reference.md,
+    /// "Speed").
+    pub reference_lu_retries: usize,
     /// Re-solves that moved a fixed friction direction to the step's own
     /// slip (slides Newton could not solve with the implicit direction).
     pub direction_refinements: usize,
@@ -316,6 +320,7 @@ impl Collector {
             rejected_solutions: run.rejected_solutions,
             newton_fallbacks: run.newton_fallbacks,
             substeps: run.substeps,
+            reference_lu_retries: run.retries.iter().filter(|r| r.reference_lu).count(),
             direction_refinements: run.direction_refinements,
             backward_slides: run.backward_slides,
             max_law_violation: run.max_law_violation,

@@ -12,7 +12,12 @@
 //! of all of them. A step that cannot be solved exactly even at
 //! `Δt/max_substeps` (its best solution breaks a contact or limit law,
 //! [`super::search`]) ends the run with [`SimError::Inexact`], naming the
-//! point and the law; the rows before it are kept.
+//! point and the law; the rows before it are kept. Before that, when the
+//! solver runs the compiled LU (`NewtonParams::compiled_lu`), the same
+//! ladder — the whole step, then 2, 4, … substeps — is tried once more
+//! with faer's pivoting LU, the reference path
+//! ([`RetryEvent::reference_lu`]): both solve the same systems to
+//! round-off, and a hard step's state search can turn on round-off.
 
 use super::search::{describe_states, solve, start_search};
 use super::{Engine, RunData};
@@ -50,37 +55,53 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
     save_grid(data);
     data.failed_trial.copy_from_slice(&data.trial);
     data.failed_limits.copy_from_slice(&data.limit_trial);
-    let mut n = 2;
     let mut last = first;
     let mut finest = 1;
-    while n <= model.max_substeps() {
-        // Without exact rows, at the finest subdivision a cycling state
-        // search is closed by its least inconsistent trial, whatever its
-        // violation.
-        data.last_resort = !model.exact() && n == model.max_substeps();
-        let result = substeps(model, data, n);
-        data.last_resort = false;
-        finest = n;
-        data.substeps += n;
-        match result {
-            Ok(iterations) => {
-                data.max_step_iterations = data.max_step_iterations.max(iterations);
-                data.retries.push(RetryEvent {
-                    t,
-                    step: k,
-                    substeps: n,
-                    cause: first.cause(),
-                });
-                data.k += 1;
-                return Ok(());
+    // The compiled LU's attempts, then (when every one failed) the same
+    // ladder from the whole step with faer's reference LU: the two solve
+    // the same systems to round-off, to which a hard step's state search
+    // can be sensitive (see the module docs).
+    let compiled = data.solver.params().compiled_lu;
+    for (reference, start) in [(false, 2), (true, 1)] {
+        if reference {
+            if !compiled {
+                break;
             }
-            Err(f) => {
-                last = f;
-                restore_grid(model, data);
-                n *= 2;
+            data.solver.params_mut().compiled_lu = false;
+        }
+        let mut n = start;
+        while n <= model.max_substeps() {
+            // Without exact rows, at the finest subdivision a cycling state
+            // search is closed by its least inconsistent trial, whatever its
+            // violation.
+            data.last_resort = !model.exact() && n == model.max_substeps();
+            let result = substeps(model, data, n);
+            data.last_resort = false;
+            finest = n;
+            data.substeps += n;
+            match result {
+                Ok(iterations) => {
+                    data.solver.params_mut().compiled_lu = compiled;
+                    data.max_step_iterations = data.max_step_iterations.max(iterations);
+                    data.retries.push(RetryEvent {
+                        t,
+                        step: k,
+                        substeps: n,
+                        cause: first.cause(),
+                        reference_lu: reference,
+                    });
+                    data.k += 1;
+                    return Ok(());
+                }
+                Err(f) => {
+                    last = f;
+                    restore_grid(model, data);
+                    n *= 2;
+                }
             }
         }
     }
+    data.solver.params_mut().compiled_lu = compiled;
     // A step with no exact solution names the law its finest attempt
     // breaks; otherwise the whole step's failure is the error.
     let (failure, states, limits) = match last {

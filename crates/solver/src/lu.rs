@@ -1025,29 +1025,16 @@ mod tests {
         (x, path)
     }
 
-    /// A test system's pattern, its storage and a right-hand side.
-    struct Setup {
-        n: usize,
-        pattern: Pattern,
-        mem: MemBuffer,
-        factors: Factors,
-        b: Vec<f64>,
-    }
-
-    fn setup(triplets: &[(usize, usize, f64)]) -> Setup {
+    /// A test system's dimension, pattern, scratch, storage and a
+    /// right-hand side.
+    fn setup(triplets: &[(usize, usize, f64)]) -> (usize, Pattern, MemBuffer, Factors, Vec<f64>) {
         let n = 1 + triplets.iter().map(|t| t.0.max(t.1)).max().unwrap();
         let mut entries: Vec<(usize, usize)> = triplets.iter().map(|t| (t.0, t.1)).collect();
         let pattern = Pattern::build(0, n, &mut entries);
         let mut mem = MemBuffer::new(Factors::scratch(n));
         let factors = Factors::new(pattern.m, &mut mem);
         let b = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
-        Setup {
-            n,
-            pattern,
-            mem,
-            factors,
-            b,
-        }
+        (n, pattern, mem, factors, b)
     }
 
     #[test]
@@ -1056,13 +1043,7 @@ mod tests {
             .into_iter()
             .flat_map(|(n, seed)| [matrix(n, seed), with_singletons(n, seed)]);
         for triplets in cases {
-            let Setup {
-                n,
-                mut pattern,
-                mut mem,
-                mut factors,
-                b,
-            } = setup(&triplets);
+            let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
             // Values of the pattern, scaled per entry by `1 + eps·sin`.
             let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
             let values_at = |eps: f64| {
@@ -1166,13 +1147,7 @@ mod tests {
         let mut corrected = 0;
         for (n, seed) in [(19, 2), (31, 3), (64, 4), (150, 5)] {
             for triplets in [matrix(n, seed), with_singletons(n, seed)] {
-                let Setup {
-                    n,
-                    mut pattern,
-                    mut mem,
-                    mut factors,
-                    b,
-                } = setup(&triplets);
+                let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
                 let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
                 let draw = |d: u64| {
                     let mut values = vec![0.0; nnz];

@@ -956,6 +956,9 @@ pub struct Summary {
     pub steps_per_second: Option<f64>,
     /// Symbolic LU factorisations performed.
     pub symbolic_factorizations: usize,
+    /// Contact-state patterns evicted from the solver's bounded cache (each
+    /// analysed again if it comes back; docs/reference.md, "Speed").
+    pub evicted_patterns: usize,
     /// Contact, joint-limit and retried-step events, as `events.csv`.
     pub events: Vec<EventJson>,
     /// Steps that could not be solved whole and were solved in substeps

@@ -200,6 +200,7 @@ fn summary(
         wall_seconds: run.wall_seconds,
         steps_per_second,
         symbolic_factorizations: run.symbolic_factorizations,
+        evicted_patterns: run.evicted_patterns,
         events: output::run_events(run, &times)
             .into_iter()
             .map(|e| e.2)

@@ -22,8 +22,12 @@ pub struct RunSummary {
     /// Wall time of the stepping loop alone (s): the loop's time without
     /// the observer's (the time inside [`crate::step()`]).
     pub wall_seconds: f64,
-    /// Symbolic factorisations (one per contact-state pattern met).
+    /// Symbolic factorisations (one per contact-state pattern met, again
+    /// after its eviction).
     pub symbolic_factorizations: usize,
+    /// Patterns evicted from the solver's bounded cache
+    /// (`NewtonParams::max_patterns`).
+    pub evicted_patterns: usize,
     /// Contact events.
     pub events: Vec<Event>,
     /// Why the run stopped early, if it did.

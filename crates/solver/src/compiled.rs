@@ -117,8 +117,8 @@ pub(crate) struct CompiledLu {
     /// The backward sweep's stream `(row, column, slot)`, `U`'s columns
     /// last first, entries above the diagonal.
     pub(crate) upper: Vec<(u32, u32, u32)>,
-    /// Scratch of [`Self::compile`], kept so that a compilation of the
-    /// same dimension does not allocate.
+    /// Scratch of [`Self::compile`] and [`Self::choose_rows`], released
+    /// after the compilation.
     scratch: Scratch,
 }
 
@@ -290,6 +290,9 @@ impl CompiledLu {
         self.row_perm.extend_from_slice(row_perm);
         self.a.clear();
         self.a.resize(self.slots, 0.0);
+        // The scratch (dense m × m arrays) is not needed again: a pattern
+        // is compiled once.
+        self.scratch = Scratch::default();
         true
     }
 

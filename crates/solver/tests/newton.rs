@@ -436,3 +436,43 @@ fn the_renewal_rule_refactors_a_stale_factorisation() {
         "renewal: {chords_on} vs {chords_off} chord steps"
     );
 }
+
+#[test]
+fn the_pattern_cache_is_bounded_and_evicts_the_least_recently_used() {
+    // Three patterns (keys 1, 2, 3; the cubic's tridiagonal pattern at
+    // three sizes) through a cache of two: the third evicts the least
+    // recently used, which is analysed again when it comes back; every
+    // solve converges to the same root as with an unbounded cache.
+    let cubic = |n: usize, key: u64| Cubic {
+        c: (0..n).map(|i| 1.0 + 0.3 * i as f64).collect(),
+        key,
+    };
+    let solve = |solver: &mut NewtonSolver, n: usize, key: u64| {
+        let mut sys = cubic(n, key);
+        let mut x = vec![0.0; n];
+        solver.solve(&mut sys, &mut x).expect("converges");
+        x
+    };
+    let mut unbounded = NewtonSolver::new(NewtonParams {
+        max_patterns: 0,
+        ..NewtonParams::default()
+    });
+    let mut bounded = NewtonSolver::new(NewtonParams {
+        max_patterns: 2,
+        ..NewtonParams::default()
+    });
+    for (n, key) in [(5, 1), (6, 2), (5, 1), (7, 3), (6, 2), (5, 1), (7, 3)] {
+        let a = solve(&mut unbounded, n, key);
+        let b = solve(&mut bounded, n, key);
+        for (p, q) in a.iter().zip(&b) {
+            assert!((p - q).abs() <= 1e-12, "key {key}: {a:?} vs {b:?}");
+        }
+        assert!(bounded.cached_patterns() <= 2);
+    }
+    assert_eq!(unbounded.cached_patterns(), 3);
+    assert_eq!(unbounded.symbolic_factorizations(), 3);
+    assert_eq!(unbounded.evicted_patterns(), 0);
+    // 1, 2 | 1 hit | 3 evicts 2 | 2 evicts 1 | 1 evicts 3 | 3 evicts 2.
+    assert_eq!(bounded.evicted_patterns(), 4);
+    assert_eq!(bounded.symbolic_factorizations(), 6);
+}

@@ -65,6 +65,9 @@ pub struct SpatialSummary {
     pub steps_per_second: Option<f64>,
     /// Symbolic LU factorisations performed.
     pub symbolic_factorizations: usize,
+    /// Contact-state patterns evicted from the solver's bounded cache (each
+    /// analysed again if it comes back; docs/reference.md, "Speed").
+    pub evicted_patterns: usize,
     /// Wall time (s) of the start-up stability check of the joint
     /// controller (before the stepping loop, not in `wall_seconds`); near
     /// zero when an earlier run of the process had the same robot and
@@ -309,6 +312,7 @@ impl Collector {
             wall_seconds: run.wall_seconds,
             steps_per_second: (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds),
             symbolic_factorizations: run.symbolic_factorizations,
+            evicted_patterns: run.evicted_patterns,
             stability_check_seconds: 0.0,
             events: output::run_events(run, &times)
                 .into_iter()

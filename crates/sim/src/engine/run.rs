@@ -66,6 +66,7 @@ fn summary<M: Engine>(
         numeric_factorizations: data.solver.numeric_factorizations(),
         wall_seconds: wall,
         symbolic_factorizations: data.symbolic_factorizations(),
+        evicted_patterns: data.solver.evicted_patterns(),
         events: data.events,
         error,
         limit_events: data.limit_events,

@@ -122,6 +122,8 @@ fn default_run_writes_every_file() {
         "wall_seconds",
         "steps_per_second",
         "symbolic_factorizations",
+        "evicted_patterns",
+        "reference_lu_retries",
         "dt",
         "duration",
         "first_touchdown",

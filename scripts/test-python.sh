@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The Python package's tests, in a fresh virtual environment: installs
 # maturin, NumPy, pytest, pandas (Result.to_pandas), pyarrow (reading
-# trajectory.parquet), matplotlib (the Fig. 7 example), gymnasium (fbd.gym)
-# and dask[distributed] (the Dask LocalCluster example) from PyPI, installs
+# trajectory.parquet), matplotlib (the Fig. 7 example), gymnasium (fbd.gym),
+# dask[distributed] (the Dask LocalCluster example), pin (Pinocchio) and
+# example-robot-data (the imported-robot cross-checks) from PyPI, installs
 # the package with the README's command
 # (`pip install ./crates/python`, which builds the abi3 wheel with maturin),
 # lints the binding's Rust code, runs the pytest suite against the `fbd`
@@ -28,6 +29,9 @@ VPY="$WORK/venv/bin/python"
 "$VPY" -m pip install --quiet --disable-pip-version-check --upgrade pip
 "$VPY" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas pyarrow matplotlib \
   gymnasium "dask[distributed]"
+# Imported robots are checked against Pinocchio on real descriptions
+# (tests/test_robot_import.py), pinned to the versions measured.
+"$VPY" -m pip install --quiet --disable-pip-version-check pin==4.1.0 example-robot-data==6.0.0
 
 echo "== python: pip install ./crates/python"
 "$VPY" -m pip install --quiet --disable-pip-version-check ./crates/python

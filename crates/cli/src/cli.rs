@@ -49,6 +49,11 @@ pub enum Command {
     /// Print the inertial hip, knee and tip of every leg at the
     /// configuration's initial state, as JSON.
     Kinematics(KinematicsArgs),
+    /// Inverse dynamics of an imported robot (`model = "robot"`) by the
+    /// FBD method: every joint's force, moment and torque, and the root's
+    /// external wrench, for the configuration's state and `[inverse]`
+    /// accelerations, as JSON.
+    Inverse(KinematicsArgs),
     /// Run many variations of a configuration in parallel (see
     /// docs/sweep.md): DIR/runs/<i>/, DIR/index.csv, DIR/sweep.svg;
     /// `fbd sweep merge` joins shard directories.
@@ -88,7 +93,7 @@ pub struct RunArgs {
 /// Arguments of `fbd kinematics`.
 #[derive(Debug, Args)]
 pub struct KinematicsArgs {
-    /// TOML configuration (planar or hexapod).
+    /// TOML configuration (planar, hexapod or robot).
     #[arg(value_name = "CONFIG")]
     pub config: PathBuf,
 }
@@ -99,6 +104,7 @@ pub fn dispatch(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         None => crate::run::run_command(None, &cli.out, out),
         Some(Command::Run(a)) => crate::run::run_command(a.config.as_deref(), &a.out, out),
         Some(Command::Kinematics(a)) => crate::kinematics::kinematics_command(&a.config, out),
+        Some(Command::Inverse(a)) => crate::kinematics::inverse_command(&a.config, out),
         Some(Command::Sweep(a)) => crate::sweep::sweep_command(a, out),
         Some(Command::View(a)) => crate::viewer::view::view_command(&a.dir, out),
         Some(Command::Export(f)) => crate::export::export_command(f, out),

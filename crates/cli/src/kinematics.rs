@@ -1,5 +1,7 @@
 //! `fbd kinematics CONFIG`: hip, knee and tip of every leg at the initial
-//! state, inertial frame, as JSON (docs/reference.md, "Command line").
+//! state, inertial frame, as JSON (docs/reference.md, "Command line"); for
+//! an imported robot (`model = "robot"`) every body, joint and contact
+//! point ([`fbd_scenario::robot::RobotKinematics`]).
 
 use std::io::Write;
 use std::path::Path;
@@ -111,11 +113,57 @@ impl Kinematics {
     }
 }
 
+/// `value` (an object) with one key per line and, for an array, one item
+/// per line; each item compact, numbers round-trip exact.
+fn one_item_per_line(value: &serde_json::Value) -> String {
+    let Some(map) = value.as_object() else {
+        return format!("{value}\n");
+    };
+    let fields: Vec<String> = map
+        .iter()
+        .map(|(k, v)| match v.as_array() {
+            Some(items) if !items.is_empty() && items.iter().all(|i| i.is_object()) => {
+                let items: Vec<String> = items.iter().map(|i| format!("    {i}")).collect();
+                format!("  \"{k}\": [\n{}\n  ]", items.join(",\n"))
+            }
+            _ => format!("  \"{k}\": {v}"),
+        })
+        .collect();
+    format!("{{\n{}\n}}\n", fields.join(",\n"))
+}
+
 /// `fbd kinematics CONFIG`.
 pub fn kinematics_command(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
-    let config = config::load(path)?;
-    let json = initial_kinematics(&config).to_json();
+    let text = config::read_text(path)?;
+    let json = if config::robot::is_robot(&text) {
+        let robot = config::robot::load_str(&text, path)?;
+        let value = serde_json::to_value(robot.kinematics())
+            .map_err(|e| CliError::stdout(std::io::Error::other(e)))?;
+        one_item_per_line(&value)
+    } else {
+        initial_kinematics(&config::load(path)?).to_json()
+    };
     out.write_all(json.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(CliError::stdout)
+}
+
+/// `fbd inverse CONFIG` (an imported robot's configuration).
+pub fn inverse_command(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
+    let text = config::read_text(path)?;
+    if !config::robot::is_robot(&text) {
+        return Err(config::ConfigError::Semantic {
+            file: path.display().to_string(),
+            message: "fbd inverse takes a model = \"robot\" configuration (an imported \
+                      URDF or MJCF robot)"
+                .to_owned(),
+        }
+        .into());
+    }
+    let robot = config::robot::load_str(&text, path)?;
+    let value = serde_json::to_value(robot.inverse())
+        .map_err(|e| CliError::stdout(std::io::Error::other(e)))?;
+    out.write_all(one_item_per_line(&value).as_bytes())
         .and_then(|()| out.flush())
         .map_err(CliError::stdout)
 }

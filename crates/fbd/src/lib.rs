@@ -44,6 +44,12 @@
 //! supply their kinematics, joint reactions and rotation rows; loads,
 //! Newton–Euler rows, contact and stop rows ([`rows`]) and every force
 //! column of the Jacobian are shared.
+//!
+//! ## Any robot
+//! [`tree`] writes the same per-body balances for any
+//! [`fbd_robot::RobotModel`] (an imported URDF/MJCF robot or a D-H
+//! instance): inverse dynamics body by body, every joint's force, moment and
+//! torque explicit.
 
 pub mod assemble;
 pub mod assembly;
@@ -52,6 +58,7 @@ pub mod mechanism;
 pub mod rows;
 pub mod space;
 pub mod spatial;
+pub mod tree;
 
 pub use assemble::{
     ContactEquation, FbdData, History, JacobianSink, LimitEquation, LimitState, NoJacobian,

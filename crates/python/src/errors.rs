@@ -59,6 +59,9 @@ pub fn config_error(py: Python<'_>, e: &ConfigError, from_text: bool) -> PyErr {
                 kwargs.set_item("file", file)?;
                 kwargs.set_item("key", key)?;
             }
+            ConfigError::Robot(r) => {
+                kwargs.set_item("file", r.file().display().to_string())?;
+            }
         }
         Ok(())
     };

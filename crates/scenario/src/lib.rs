@@ -69,6 +69,7 @@ pub use gait::{
 };
 mod advice;
 pub mod mjcf;
+pub mod robot;
 mod terrain_map;
 pub use terrain_map::{PatchConfig, read_heights};
 mod spatial;
@@ -149,6 +150,16 @@ pub enum ConfigError {
         /// What is wrong.
         message: String,
     },
+    /// A robot description (`[robot] urdf` / `mjcf`) cannot be loaded: the
+    /// message names its file, line and element.
+    #[error(transparent)]
+    Robot(Box<fbd_robot::RobotError>),
+}
+
+impl From<fbd_robot::RobotError> for ConfigError {
+    fn from(e: fbd_robot::RobotError) -> Self {
+        ConfigError::Robot(Box::new(e))
+    }
 }
 
 impl ConfigError {
@@ -1381,6 +1392,21 @@ fn model_of(table: &toml::Table) -> ModelKind {
     }
 }
 
+/// The error for `model = "robot"` where only the hexapod and the planar
+/// model work so far.
+fn robot_not_yet(table: &toml::Table, file: &str) -> Result<(), ConfigError> {
+    match table.get("model") {
+        Some(toml::Value::String(s)) if s == robot::MODEL => Err(ConfigError::Semantic {
+            file: file.to_owned(),
+            message: "model = \"robot\": an imported URDF/MJCF robot works with \
+                      `fbd kinematics` so far; `fbd run`, `sweep` and `export` take \
+                      model = \"planar\" or \"hexapod\""
+                .to_owned(),
+        }),
+        _ => Ok(()),
+    }
+}
+
 fn from_table(table: &toml::Table) -> Result<Config, toml::de::Error> {
     Ok(match model_of(table) {
         ModelKind::Hexapod => Config::Hexapod(Box::new(table.clone().try_into()?)),
@@ -1408,6 +1434,7 @@ fn load_profile(config: &mut Config, file: &str) -> Result<(), ConfigError> {
 /// default experiment (plus the overrides).
 pub fn parse_str(text: &str, file: &str, overrides: &[Override]) -> Result<Config, ConfigError> {
     let mut table: toml::Table = toml::from_str(text).map_err(|e| syntax_error(file, text, &e))?;
+    robot_not_yet(&table, file)?;
     // Deserialize the text itself so that errors carry its line and column.
     let mut config = match model_of(&table) {
         ModelKind::Hexapod => toml::from_str(text).map(|h| Config::Hexapod(Box::new(h))),
@@ -1443,6 +1470,7 @@ pub fn parse_table(
     overrides: &[Override],
 ) -> Result<Config, ConfigError> {
     let mut table = table.clone();
+    robot_not_yet(&table, file)?;
     for o in overrides {
         apply_override(&mut table, &o.key, o.value.clone()).map_err(|message| {
             ConfigError::Override {

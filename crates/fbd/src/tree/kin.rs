@@ -1,0 +1,327 @@
+//! Kinematics of any robot model ([`fbd_robot::RobotModel`]) at the
+//! generalised coordinates
+//!
+//! ```text
+//! q = (Rx, Ry, Rz, φx, φy, φz, θ_0, …, θ_{n−1})
+//! ```
+//!
+//! `R` the root frame's origin (inertial, `Y` up), `φ` fbd's body pose
+//! (`Rot = Rx(φx)·Rz(φz)·Ry(φy)`, [`fbd_kinematics::pose::BodyPose`]), then
+//! the joint angles in the order of `model.joints` (`θ_j` is `q[6 + j]`).
+//!
+//! [`TreeKin`] is a workspace built once per model; [`TreeKin::eval`]
+//! places every body frame, centre of mass, joint axis and contact point
+//! in one pass from the root without touching the heap. The Jacobians are
+//! analytic and sparse: a point `p` rigidly attached to body `b` moves
+//! with
+//!
+//! ```text
+//! ∂p/∂R_i = e_i,   ∂p/∂φ_k = a_k × (p − R),   ∂p/∂θ_j = u_j × (p − o_j)
+//! ```
+//!
+//! for the ancestor joints `j` of `b` only (`a_k` the base's
+//! [`TreeKin::phi_axes`], `u_j` and `o_j` joint `j`'s axis and origin,
+//! inertial), and the body turns with `ω_b = Σ_k a_k·φ̇_k + Σ_j u_j·θ̇_j`.
+//! Each body's ancestor joints are listed once, at construction.
+
+use fbd_kinematics::pose::BodyPose;
+use fbd_robot::RobotModel;
+use fbd_robot::nalgebra::{Matrix3, Rotation3, Vector3};
+
+/// Number of floating-base coordinates at the front of `q`.
+pub const BASE_DOF: usize = 6;
+
+/// Index of `φx` in `q` (`φy`, `φz` follow).
+pub const PHI: usize = 3;
+
+/// The kinematics of one robot model at one `q` (see the module docs).
+///
+/// Build it once per model with [`TreeKin::new`], then call
+/// [`TreeKin::eval`] at each configuration; the Jacobian methods read the
+/// last evaluation.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreeKin {
+    /// Number of generalised coordinates, `6 + joints`.
+    nq: usize,
+    /// Per body `b`, its ancestor joints (root to `b`, so increasing) are
+    /// `chain[chain_start[b]..chain_start[b + 1]]`.
+    chain_start: Vec<usize>,
+    /// The ancestor joints of every body, concatenated.
+    chain: Vec<usize>,
+    /// The longest chain of joints from the root to a body.
+    max_depth: usize,
+    /// Each body's frame origin (m, inertial); `origin[0]` is `R`.
+    pub origin: Vec<Vector3<f64>>,
+    /// Each body's rotation, body frame → inertial.
+    pub rotation: Vec<Matrix3<f64>>,
+    /// Each body's centre of mass (m, inertial).
+    pub com: Vec<Vector3<f64>>,
+    /// Each joint's axis (inertial, unit).
+    pub axis: Vec<Vector3<f64>>,
+    /// Each joint's origin (m, inertial): its child body's frame origin,
+    /// a point of the axis.
+    pub joint_origin: Vec<Vector3<f64>>,
+    /// Each contact point (sphere centre) (m, inertial).
+    pub contact: Vec<Vector3<f64>>,
+    /// The inertial axes about which `φx, φy, φz` turn the root:
+    /// `ω_root = Σ_k phi_axes[k]·φ̇_k`.
+    pub phi_axes: [Vector3<f64>; 3],
+    /// The body each contact point is on (from the model).
+    contact_body: Vec<usize>,
+}
+
+impl TreeKin {
+    /// A workspace for `model` (every frame at the origin, unrotated,
+    /// until [`TreeKin::eval`] fills it).
+    ///
+    /// # Panics
+    /// If the model breaks the conventions of [`fbd_robot::model`]: body 0
+    /// has a parent joint, another body has none, a joint's child does not
+    /// name it back, or a parent does not come before its child.
+    pub fn new(model: &RobotModel) -> Self {
+        let nb = model.bodies.len();
+        let nj = model.joints.len();
+        assert!(nb >= 1, "a model has a root body");
+        assert!(
+            model.bodies[0].joint.is_none(),
+            "the root has no parent joint"
+        );
+        let mut chain_start = Vec::with_capacity(nb + 1);
+        let mut chain = Vec::new();
+        let mut max_depth = 0;
+        chain_start.push(0);
+        chain_start.push(0);
+        for (b, body) in model.bodies.iter().enumerate().skip(1) {
+            let j = body
+                .joint
+                .unwrap_or_else(|| panic!("body {b} has no parent joint"));
+            let joint = &model.joints[j];
+            assert_eq!(joint.child, b, "joint {j} does not turn body {b}");
+            let p = joint.parent;
+            assert!(p < b, "body {b}'s parent {p} does not come before it");
+            let (s, e) = (chain_start[p], chain_start[p + 1]);
+            for k in s..e {
+                chain.push(chain[k]);
+            }
+            chain.push(j);
+            max_depth = max_depth.max(e - s + 1);
+            chain_start.push(chain.len());
+        }
+        for (j, joint) in model.joints.iter().enumerate() {
+            assert_eq!(
+                model.bodies[joint.child].joint,
+                Some(j),
+                "joint {j}'s child"
+            );
+        }
+        let z = Vector3::zeros();
+        Self {
+            nq: BASE_DOF + nj,
+            chain_start,
+            chain,
+            max_depth,
+            origin: vec![z; nb],
+            rotation: vec![Matrix3::identity(); nb],
+            com: vec![z; nb],
+            axis: vec![z; nj],
+            joint_origin: vec![z; nj],
+            contact: vec![z; model.contacts.len()],
+            phi_axes: [Vector3::x(), Vector3::y(), Vector3::z()],
+            contact_body: model.contacts.iter().map(|c| c.body).collect(),
+        }
+    }
+
+    /// Number of generalised coordinates, `6 + model.joints.len()`.
+    pub fn nq(&self) -> usize {
+        self.nq
+    }
+
+    /// The most joints between the root and a body: a Jacobian has at most
+    /// `6 + max_depth()` columns.
+    pub fn max_depth(&self) -> usize {
+        self.max_depth
+    }
+
+    /// The joints between the root and body `b`, root first (so in
+    /// increasing order); empty for the root.
+    pub fn ancestors(&self, b: usize) -> &[usize] {
+        &self.chain[self.chain_start[b]..self.chain_start[b + 1]]
+    }
+
+    /// Evaluates every frame, centre of mass, joint axis and contact point
+    /// at `q` (module docs for its layout). Does not allocate.
+    ///
+    /// # Panics
+    /// If `q` is not `6 + joints` long or `model` is not the one the
+    /// workspace was built for (its counts differ).
+    pub fn eval(&mut self, model: &RobotModel, q: &[f64]) {
+        assert_eq!(q.len(), self.nq, "q is 6 base coordinates + one per joint");
+        assert!(
+            model.bodies.len() == self.origin.len()
+                && model.joints.len() == self.axis.len()
+                && model.contacts.len() == self.contact.len(),
+            "the workspace was built for another model"
+        );
+        let pose = BodyPose::new([q[0], q[1], q[2]], [q[PHI], q[PHI + 1], q[PHI + 2]]);
+        let rot = pose.rotation();
+        let (sx, cx) = q[PHI].sin_cos();
+        // ω = φ̇x·X + φ̇z·Rx·Z + φ̇y·Rx·Rz·Y, and Rx·Rz·Y = Rot·Y.
+        self.phi_axes = [
+            Vector3::x(),
+            rot.column(1).into(),
+            Vector3::new(0.0, -sx, cx),
+        ];
+        self.origin[0] = pose.position;
+        self.rotation[0] = rot;
+        for (j, joint) in model.joints.iter().enumerate() {
+            let (p, c) = (joint.parent, joint.child);
+            let rp = self.rotation[p];
+            let fixed = rp * joint.origin.rotation.to_rotation_matrix().into_inner();
+            let turn = Rotation3::from_axis_angle(&joint.axis, q[BASE_DOF + j]).into_inner();
+            let o = self.origin[p] + rp * joint.origin.translation.vector;
+            self.rotation[c] = fixed * turn;
+            self.origin[c] = o;
+            self.axis[j] = fixed * joint.axis.into_inner();
+            self.joint_origin[j] = o;
+        }
+        for (b, body) in model.bodies.iter().enumerate() {
+            self.com[b] = self.origin[b] + self.rotation[b] * body.com;
+        }
+        for (k, c) in model.contacts.iter().enumerate() {
+            self.contact[k] = self.origin[c.body] + self.rotation[c.body] * c.position;
+        }
+    }
+
+    /// A point given in body `b`'s frame, in the inertial frame (m).
+    pub fn body_point(&self, b: usize, local: &Vector3<f64>) -> Vector3<f64> {
+        self.origin[b] + self.rotation[b] * local
+    }
+
+    /// Jacobian `∂p/∂q` of a point `p` (inertial, at the evaluated `q`)
+    /// rigidly attached to body `b`.
+    pub fn point_jacobian(&self, b: usize, p: &Vector3<f64>) -> Columns<'_> {
+        Columns {
+            kin: self,
+            joints: self.ancestors(b),
+            point: Some(*p),
+        }
+    }
+
+    /// Jacobian of body `b`'s centre of mass.
+    pub fn com_jacobian(&self, b: usize) -> Columns<'_> {
+        self.point_jacobian(b, &self.com[b])
+    }
+
+    /// Jacobian of contact point `c` (its sphere's centre).
+    pub fn contact_jacobian(&self, c: usize) -> Columns<'_> {
+        self.point_jacobian(self.contact_body[c], &self.contact[c])
+    }
+
+    /// Angular-velocity Jacobian of body `b`: `ω_b = Σ col_i·q̇_i`
+    /// (inertial).
+    pub fn angular_jacobian(&self, b: usize) -> Columns<'_> {
+        Columns {
+            kin: self,
+            joints: self.ancestors(b),
+            point: None,
+        }
+    }
+}
+
+/// A sparse Jacobian with three rows: a point's `∂p/∂q` or a body's
+/// angular-velocity Jacobian, as columns `(q index, 3-vector)`; every
+/// other column is zero.
+///
+/// It is a view of a [`TreeKin`], not a copy: it holds the body's list of
+/// ancestor joints (made at construction) and computes each column when
+/// asked from the evaluated axes and origins (one cross product), so it
+/// has room for any depth without allocating, is `Copy`, and can be
+/// iterated any number of times. The columns come in increasing `q` index:
+/// for a point the base's `e_x, e_y, e_z` (`q` 0–2) and
+/// `phi_axes[k] × (p − R)` (`q` 3–5), then `u_j × (p − o_j)` for each
+/// ancestor joint `j` (`q` `6 + j`); for an angular Jacobian `phi_axes[k]`
+/// (`q` 3–5), then `u_j`. At most `6 + TreeKin::max_depth()` columns.
+#[derive(Clone, Copy, Debug)]
+pub struct Columns<'a> {
+    kin: &'a TreeKin,
+    /// The body's ancestor joints.
+    joints: &'a [usize],
+    /// The point (inertial); `None` for the angular Jacobian.
+    point: Option<Vector3<f64>>,
+}
+
+impl<'a> Columns<'a> {
+    /// The number of columns.
+    pub fn len(&self) -> usize {
+        self.base_columns() + self.joints.len()
+    }
+
+    /// Whether there is no column (never: a body always turns with the
+    /// base).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Columns before the joints': 6 for a point, 3 for an angle.
+    #[inline]
+    fn base_columns(&self) -> usize {
+        if self.point.is_some() { 6 } else { 3 }
+    }
+
+    /// Column `k` (`k < len()`): `(q index, ∂/∂q_index)`.
+    ///
+    /// # Panics
+    /// If `k >= len()`.
+    #[inline]
+    pub fn column(&self, k: usize) -> (usize, Vector3<f64>) {
+        let kin = self.kin;
+        match self.point {
+            Some(p) => match k {
+                0..3 => {
+                    let mut e = Vector3::zeros();
+                    e[k] = 1.0;
+                    (k, e)
+                }
+                3..6 => (k, kin.phi_axes[k - 3].cross(&(p - kin.origin[0]))),
+                _ => {
+                    let j = self.joints[k - 6];
+                    (BASE_DOF + j, kin.axis[j].cross(&(p - kin.joint_origin[j])))
+                }
+            },
+            None => match k {
+                0..3 => (PHI + k, kin.phi_axes[k]),
+                _ => {
+                    let j = self.joints[k - 3];
+                    (BASE_DOF + j, kin.axis[j])
+                }
+            },
+        }
+    }
+
+    /// The columns, in increasing `q` index.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = (usize, Vector3<f64>)> + 'a {
+        let this = *self;
+        (0..self.len()).map(move |k| this.column(k))
+    }
+
+    /// `J·v` for a generalised velocity `v` (`nq` long).
+    pub fn apply(&self, v: &[f64]) -> Vector3<f64> {
+        self.iter().map(|(i, c)| c * v[i]).sum()
+    }
+
+    /// Writes the dense `3 × nq` matrix, row-major, into `out`
+    /// (`out.len() == 3·nq`; zero outside the columns).
+    ///
+    /// # Panics
+    /// If `out` is not `3·nq` long.
+    pub fn dense_into(&self, out: &mut [f64]) {
+        let nq = self.kin.nq;
+        assert_eq!(out.len(), 3 * nq, "a 3 × nq matrix");
+        out.fill(0.0);
+        for (i, c) in self.iter() {
+            for r in 0..3 {
+                out[r * nq + i] = c[r];
+            }
+        }
+    }
+}

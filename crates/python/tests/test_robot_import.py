@@ -1,0 +1,233 @@
+"""Imported robots (``model = "robot"``) against Pinocchio.
+
+``fbd kinematics`` of a URDF robot — real descriptions from PyPI
+``example-robot-data`` and the lab hexapod of ``examples/robots`` — is
+compared with Pinocchio (PyPI ``pin``) loading the same file with a free
+flyer: every body's frame, every foot, every body's mass, centre of mass
+and inertia (fixed links merged), and the total mass and centre of mass.
+fbd's inertial frame is Y-up; a URDF's is Z-up, so fbd places the
+description turned by ``x → −z, y → −x, z → y``.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import json
+import math
+import pathlib
+import subprocess
+
+import numpy as np
+import pytest
+
+import pinocchio as pin  # noqa: E402  (installed by scripts/test-python.sh)
+
+ROOT = pathlib.Path(__file__).resolve().parents[3]
+
+# fbd body frame ← URDF root frame.
+TURN = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])
+
+
+def robots_dir() -> pathlib.Path:
+    dist = importlib.metadata.distribution("example-robot-data")
+    return pathlib.Path(dist.locate_file("cmeel.prefix/share/example-robot-data/robots"))
+
+
+# (name, URDF path, foot links)
+ROBOTS = [
+    ("solo12", "solo_description/robots/solo12.urdf", ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"]),
+    ("anymal_c", "anymal_c_simple_description/urdf/anymal.urdf", ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"]),
+    ("go1", "go1_description/urdf/go1.urdf", ["FR_foot", "FL_foot", "RR_foot", "RL_foot"]),
+    ("a1", "a1_description/urdf/a1.urdf", ["FR_foot", "FL_foot", "RR_foot", "RL_foot"]),
+    ("hyq", "hyq_description/robots/hyq_no_sensors.urdf", ["lf_foot", "rf_foot", "lh_foot", "rh_foot"]),
+    ("bolt", "bolt_description/robots/bolt.urdf", ["FL_FOOT", "FR_FOOT"]),
+]
+
+
+def urdf_path(rel: str) -> pathlib.Path:
+    if rel.startswith("examples/"):
+        return ROOT / rel
+    return robots_dir() / rel
+
+
+def fbd_kinematics(cli, tmp_path, urdf: pathlib.Path, feet, angles_deg, position):
+    joints = ", ".join(f"{name} = {deg!r}" for name, deg in angles_deg.items())
+    cfg = tmp_path / "robot.toml"
+    cfg.write_text(
+        'model = "robot"\n[robot]\n'
+        f'urdf = "{urdf}"\n'
+        f"contacts = {json.dumps(feet)}\n"
+        f"[initial]\nposition = {[float(x) for x in position]}\n"
+        f"joints_deg = {{ {joints} }}\n"
+    )
+    out = subprocess.run([str(cli), "kinematics", str(cfg)], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
+
+
+def random_angles(model, rng):
+    """Joint angles (deg) inside each joint's limits (±2 rad where wide)."""
+    angles = {}
+    for jid in range(2, model.njoints):
+        name = model.names[jid]
+        i = model.joints[jid].idx_q
+        lo = max(model.lowerPositionLimit[i], -2.0)
+        hi = min(model.upperPositionLimit[i], 2.0)
+        if not lo < hi:
+            lo, hi = -2.0, 2.0
+        angles[name] = math.degrees(rng.uniform(lo, hi))
+    return angles
+
+
+@pytest.mark.parametrize("name,rel,feet", ROBOTS + [
+    ("lab_hexapod", "examples/robots/lab_hexapod.urdf",
+     [f"{leg}_foot" for leg in ("lf", "lm", "lr", "rf", "rm", "rr")]),
+])
+def test_imported_urdf_matches_pinocchio(cli, tmp_path, name, rel, feet):
+    path = urdf_path(rel)
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = model.createData()
+    rng = np.random.default_rng(7)
+    position = np.array([0.3, 0.5, -0.2])
+    for trial in range(3):
+        angles = random_angles(model, rng) if trial else {}
+        fbd = fbd_kinematics(cli, tmp_path, path, feet, angles, position)
+
+        q = pin.neutral(model)
+        for jname, deg in angles.items():
+            q[model.joints[model.getJointId(jname)].idx_q] = math.radians(deg)
+        pin.forwardKinematics(model, data, q)
+        pin.updateFramePlacements(model, data)
+
+        def world(p):
+            return position + TURN @ np.asarray(p)
+
+        # Same joints, same bodies.
+        assert sorted(j["name"] for j in fbd["joints"]) == sorted(model.names[2:])
+        bodies = {b["name"]: b for b in fbd["bodies"]}
+        for j in fbd["joints"]:
+            jid = model.getJointId(j["name"])
+            oMi = data.oMi[jid]
+            body = bodies[j["child"]]
+            np.testing.assert_allclose(body["position"], world(oMi.translation), atol=1e-12)
+            np.testing.assert_allclose(np.array(body["rotation"]), TURN @ oMi.rotation, atol=1e-12)
+            axis = TURN @ oMi.rotation @ np.asarray(data.joints[jid].S).reshape(6, -1)[3:, 0]
+            np.testing.assert_allclose(j["axis"], axis, atol=1e-12)
+            # Mass properties, fixed children merged (Pinocchio merges
+            # them into the joint's inertia too).
+            inertia = model.inertias[jid]
+            assert body["mass"] == pytest.approx(inertia.mass, rel=1e-12, abs=1e-15)
+            np.testing.assert_allclose(body["com"], inertia.lever, atol=1e-12)
+            np.testing.assert_allclose(np.array(body["inertia"]), inertia.inertia, atol=1e-12)
+        # The root (turned into fbd's body frame).
+        root = fbd["bodies"][0]
+        inertia = model.inertias[1]
+        assert root["mass"] == pytest.approx(inertia.mass, rel=1e-12)
+        np.testing.assert_allclose(root["com"], TURN @ inertia.lever, atol=1e-12)
+        np.testing.assert_allclose(np.array(root["inertia"]), TURN @ inertia.inertia @ TURN.T, atol=1e-12)
+        # Feet.
+        for c in fbd["contacts"]:
+            fid = model.getFrameId(c["name"])
+            np.testing.assert_allclose(c["position"], world(data.oMf[fid].translation), atol=1e-12)
+        # Whole robot.
+        assert fbd["mass"] == pytest.approx(pin.computeTotalMass(model), rel=1e-12)
+        com = pin.centerOfMass(model, data, q)
+        np.testing.assert_allclose(fbd["com"], world(com), atol=1e-12)
+
+
+def test_a_mesh_only_foot_is_one_clear_error(cli, tmp_path):
+    path = urdf_path(ROBOTS[0][1])
+    cfg = tmp_path / "robot.toml"
+    cfg.write_text(f'model = "robot"\n[robot]\nurdf = "{path}"\n')
+    out = subprocess.run([str(cli), "kinematics", str(cfg)], capture_output=True, text=True)
+    assert out.returncode != 0
+    lines = out.stderr.strip().splitlines()
+    assert len(lines) == 1, out.stderr
+    assert "solo12.urdf:" in lines[0] and "<mesh>" in lines[0] and "a foot whose collision is a mesh" in lines[0]
+    assert "[robot] contacts" in lines[0]
+
+
+def rot_fbd(phi):
+    """fbd's Rot = Rx(φx)·Rz(φz)·Ry(φy)."""
+    (sx, cx), (sy, cy), (sz, cz) = [(math.sin(p), math.cos(p)) for p in phi]
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    return rx @ rz @ ry
+
+
+def toml_table(d):
+    return "{ " + ", ".join(f"{k} = {float(v)!r}" for k, v in d.items()) + " }"
+
+
+def toml_vec(v):
+    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
+
+
+@pytest.mark.parametrize("name,rel,feet", ROBOTS + [
+    ("lab_hexapod", "examples/robots/lab_hexapod.urdf", ["lf_foot"]),
+])
+def test_fbd_inverse_dynamics_matches_pinocchio_rnea(cli, tmp_path, name, rel, feet):
+    """Every joint's force, moment and torque by the FBD method (each body
+    isolated, leaves to root) against Pinocchio's recursive Newton–Euler
+    (``rnea`` and the joint forces ``data.f`` it leaves), for random
+    states: base pose, velocities and accelerations, joint angles, rates
+    and accelerations."""
+    path = urdf_path(rel)
+    model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    data = model.createData()
+    rng = np.random.default_rng(11)
+    for trial in range(3):
+        position = rng.uniform(-1, 1, 3)
+        phi = rng.uniform(-1.5, 1.5, 3)
+        vel, omega = rng.uniform(-1, 1, 3), rng.uniform(-2, 2, 3)
+        acc, alpha = rng.uniform(-5, 5, 3), rng.uniform(-10, 10, 3)
+        angles = random_angles(model, rng)
+        rates = {k: math.degrees(rng.uniform(-3, 3)) for k in angles}
+        accels = {k: math.degrees(rng.uniform(-30, 30)) for k in angles}
+        cfg = tmp_path / "robot.toml"
+        cfg.write_text(
+            f'model = "robot"\n[robot]\nurdf = "{path}"\ncontacts = {json.dumps(feet)}\n'
+            f"[initial]\nposition = {toml_vec(position)}\n"
+            f"phi_deg = {toml_vec(np.degrees(phi))}\n"
+            f"velocity = {toml_vec(vel)}\nomega_deg = {toml_vec(np.degrees(omega))}\n"
+            f"joints_deg = {toml_table(angles)}\nrates_deg = {toml_table(rates)}\n"
+            f"[inverse]\nacceleration = {toml_vec(acc)}\nalpha_deg = {toml_vec(np.degrees(alpha))}\n"
+            f"joints_deg = {toml_table(accels)}\n"
+        )
+        out = subprocess.run([str(cli), "inverse", str(cfg)], capture_output=True, text=True)
+        assert out.returncode == 0, out.stderr
+        fbd = json.loads(out.stdout)
+
+        # Pinocchio's state: its world is fbd's turned back (TURNᵀ).
+        r_pin = TURN.T @ rot_fbd(phi) @ TURN
+        q = pin.neutral(model)
+        q[:3] = TURN.T @ position
+        q[3:7] = pin.Quaternion(r_pin).coeffs()  # x, y, z, w
+        v = np.zeros(model.nv)
+        a = np.zeros(model.nv)
+        v_lin = r_pin.T @ (TURN.T @ vel)
+        w_loc = r_pin.T @ (TURN.T @ omega)
+        v[:3], v[3:6] = v_lin, w_loc
+        a[:3] = r_pin.T @ (TURN.T @ acc) - np.cross(w_loc, v_lin)
+        a[3:6] = r_pin.T @ (TURN.T @ alpha)
+        for jname in angles:
+            jm = model.joints[model.getJointId(jname)]
+            q[jm.idx_q] = math.radians(angles[jname])
+            v[jm.idx_v] = math.radians(rates[jname])
+            a[jm.idx_v] = math.radians(accels[jname])
+        tau = pin.rnea(model, data, q, v, a)
+        pin.forwardKinematics(model, data, q)  # rnea leaves data.oMi as it was
+
+        weight = pin.computeTotalMass(model) * 9.81
+        tol = 1e-9 * (1 + weight)
+        for j in fbd["joints"]:
+            jid = model.getJointId(j["name"])
+            rot = TURN @ data.oMi[jid].rotation
+            f = data.f[jid]
+            np.testing.assert_allclose(j["force"], rot @ f.linear, atol=tol, err_msg=j["name"])
+            np.testing.assert_allclose(j["moment"], rot @ f.angular, atol=tol, err_msg=j["name"])
+            assert j["torque"] == pytest.approx(tau[model.joints[jid].idx_v], abs=tol), j["name"]
+        rot = TURN @ r_pin
+        np.testing.assert_allclose(fbd["base_force"], rot @ tau[:3], atol=tol)
+        np.testing.assert_allclose(fbd["base_moment"], rot @ tau[3:6], atol=tol)

@@ -1,0 +1,534 @@
+//! `model = "robot"`: a robot imported from a URDF or MJCF description.
+//!
+//! ```toml
+//! model = "robot"
+//! [robot]
+//! urdf = "solo12.urdf"        # or mjcf = "robot.xml"; relative to this file
+//! up = "z"                    # optional: the description's up axis, "z" | "y"
+//! contacts = ["FL_FOOT"]      # optional: links, sites or collision spheres;
+//!                             #   default every collision sphere
+//! [initial]
+//! position = [0.0, 0.4, 0.0]  # optional: the root frame's origin (m)
+//! phi_deg = [0.0, 0.0, 0.0]   # optional: φx, φy, φz of the root frame
+//! joints_deg = { FL_KFE = -60.0 }  # optional: joint angles, others 0
+//! ```
+//!
+//! So far `fbd kinematics` takes such a configuration; running it needs the
+//! generic FBD model (see the README).
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use fbd_robot::nalgebra::Isometry3;
+use fbd_robot::{ContactChoice, RobotModel, Up};
+use serde::Deserialize;
+
+use crate::ConfigError;
+
+/// The `model` value of an imported robot.
+pub const MODEL: &str = "robot";
+
+/// `[robot]`.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotSection {
+    /// A URDF file, relative to the configuration's directory.
+    pub urdf: Option<String>,
+    /// An MJCF file, relative to the configuration's directory.
+    pub mjcf: Option<String>,
+    /// The description's up axis, `"z"` (default: ROS and MuJoCo) or
+    /// `"y"` (fbd's own exports).
+    pub up: Option<String>,
+    /// The contact points by name (links, sites, collision spheres);
+    /// default every collision sphere.
+    pub contacts: Option<Vec<String>>,
+}
+
+/// `[initial]` of an imported robot.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotInitial {
+    /// The root frame's origin in the inertial frame (m). Default 0.
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// `(φx, φy, φz)` of the root frame (deg). Default 0.
+    #[serde(default)]
+    pub phi_deg: [f64; 3],
+    /// Joint angles by joint name (deg); joints not named are at 0.
+    #[serde(default)]
+    pub joints_deg: BTreeMap<String, f64>,
+    /// Velocity of the root frame's origin (m/s, inertial). Default 0.
+    #[serde(default)]
+    pub velocity: [f64; 3],
+    /// Angular velocity of the root (deg/s, inertial). Default 0.
+    #[serde(default)]
+    pub omega_deg: [f64; 3],
+    /// Joint rates by joint name (deg/s); others 0.
+    #[serde(default)]
+    pub rates_deg: BTreeMap<String, f64>,
+}
+
+/// `[world]` of an imported robot.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotWorld {
+    /// Gravitational acceleration along −Y (m/s²). Default 9.81.
+    #[serde(default = "default_gravity")]
+    pub gravity: f64,
+}
+
+fn default_gravity() -> f64 {
+    9.81
+}
+
+impl Default for RobotWorld {
+    fn default() -> Self {
+        Self {
+            gravity: default_gravity(),
+        }
+    }
+}
+
+/// `[inverse]`: the accelerations of `fbd inverse`.
+#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotInverse {
+    /// Acceleration of the root frame's origin (m/s², inertial). Default 0.
+    #[serde(default)]
+    pub acceleration: [f64; 3],
+    /// Angular acceleration of the root (deg/s², inertial). Default 0.
+    #[serde(default)]
+    pub alpha_deg: [f64; 3],
+    /// Joint accelerations by joint name (deg/s²); others 0.
+    #[serde(default)]
+    pub joints_deg: BTreeMap<String, f64>,
+}
+
+/// A `model = "robot"` configuration file.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotConfig {
+    /// `"robot"`.
+    pub model: String,
+    /// `[robot]`.
+    pub robot: RobotSection,
+    /// `[initial]`.
+    #[serde(default)]
+    pub initial: RobotInitial,
+    /// `[world]`.
+    #[serde(default)]
+    pub world: RobotWorld,
+    /// `[inverse]`.
+    #[serde(default)]
+    pub inverse: RobotInverse,
+}
+
+/// A loaded robot and its initial state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LoadedRobot {
+    /// The description file, as resolved.
+    pub description: PathBuf,
+    /// The model.
+    pub model: RobotModel,
+    /// The root frame's initial pose.
+    pub base: Isometry3<f64>,
+    /// The initial joint angles (rad), in the model's joint order.
+    pub q: Vec<f64>,
+    /// The initial joint rates (rad/s).
+    pub qd: Vec<f64>,
+    /// The root origin's initial velocity (m/s) and angular velocity
+    /// (rad/s), inertial.
+    pub velocity: [f64; 3],
+    /// The root's initial angular velocity (rad/s, inertial).
+    pub omega: [f64; 3],
+    /// Gravity along −Y (m/s²).
+    pub gravity: f64,
+    /// `[inverse]`: root acceleration (m/s²), angular acceleration
+    /// (rad/s²), joint accelerations (rad/s²).
+    pub acceleration: ([f64; 3], [f64; 3], Vec<f64>),
+}
+
+/// Whether the TOML `text` says `model = "robot"`.
+pub fn is_robot(text: &str) -> bool {
+    toml::from_str::<toml::Table>(text)
+        .ok()
+        .and_then(|t| t.get("model").and_then(|m| m.as_str().map(|s| s == MODEL)))
+        .unwrap_or(false)
+}
+
+fn semantic(file: &str, message: String) -> ConfigError {
+    ConfigError::Semantic {
+        file: file.to_owned(),
+        message,
+    }
+}
+
+/// Parses the configuration `text` of `path` and loads its robot.
+pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
+    let file = path.display().to_string();
+    let config: RobotConfig =
+        toml::from_str(text).map_err(|e| crate::syntax_error(&file, text, &e))?;
+    let r = &config.robot;
+    let (rel, is_urdf) = match (&r.urdf, &r.mjcf) {
+        (Some(u), None) => (u, true),
+        (None, Some(m)) => (m, false),
+        _ => {
+            return Err(semantic(
+                &file,
+                "robot: give exactly one of urdf = \"FILE\" or mjcf = \"FILE\"".to_owned(),
+            ));
+        }
+    };
+    let up = match r.up.as_deref() {
+        None | Some("z") => Up::Z,
+        Some("y") => Up::Y,
+        Some(other) => {
+            return Err(ConfigError::semantic(
+                &file,
+                "robot.up",
+                "unknown up axis",
+                format!("\"{other}\""),
+                "\"z\" or \"y\"",
+            ));
+        }
+    };
+    let contacts = match &r.contacts {
+        None => ContactChoice::CollisionSpheres,
+        Some(names) => ContactChoice::Named(names.clone()),
+    };
+    let base_dir = path.parent().unwrap_or(Path::new(""));
+    let description = base_dir.join(rel);
+    let model = if is_urdf {
+        fbd_robot::urdf::load(&description, up, &contacts)?
+    } else {
+        fbd_robot::mjcf::load(&description, up, &contacts)?
+    };
+    let init = &config.initial;
+    let joints = |table: &str, values: &BTreeMap<String, f64>, limits: bool| {
+        let mut out = vec![0.0; model.joints.len()];
+        for (name, &deg) in values {
+            let Some(j) = model.joint_index(name) else {
+                let known: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+                return Err(semantic(
+                    &file,
+                    format!(
+                        "{table}.{name}: no such joint in {}{}",
+                        description.display(),
+                        suggest_name(name, &known)
+                    ),
+                ));
+            };
+            if !deg.is_finite() {
+                return Err(semantic(&file, format!("{table}.{name}: must be finite")));
+            }
+            let rad = deg.to_radians();
+            if limits
+                && let Some(l) = model.joints[j].limits
+                && !(l.lower <= rad && rad <= l.upper)
+            {
+                return Err(ConfigError::semantic(
+                    &file,
+                    &format!("{table}.{name}"),
+                    "outside the joint's limits",
+                    format!("{deg}°"),
+                    &format!("[{}°, {}°]", l.lower.to_degrees(), l.upper.to_degrees()),
+                ));
+            }
+            out[j] = rad;
+        }
+        Ok(out)
+    };
+    let q = joints("initial.joints_deg", &init.joints_deg, true)?;
+    let qd = joints("initial.rates_deg", &init.rates_deg, false)?;
+    let inv = &config.inverse;
+    let qdd = joints("inverse.joints_deg", &inv.joints_deg, false)?;
+    let vectors = [
+        ("initial.position", init.position),
+        ("initial.phi_deg", init.phi_deg),
+        ("initial.velocity", init.velocity),
+        ("initial.omega_deg", init.omega_deg),
+        ("inverse.acceleration", inv.acceleration),
+        ("inverse.alpha_deg", inv.alpha_deg),
+    ];
+    if let Some((key, _)) = vectors
+        .iter()
+        .find(|(_, v)| v.iter().any(|x| !x.is_finite()))
+    {
+        return Err(semantic(&file, format!("{key}: must be finite")));
+    }
+    let g = config.world.gravity;
+    if !(g.is_finite() && g >= 0.0) {
+        return Err(ConfigError::semantic(
+            &file,
+            "world.gravity",
+            "out of range",
+            g,
+            "≥ 0 m/s²",
+        ));
+    }
+    let base = fbd_robot::forward::base_frame(init.position, init.phi_deg.map(f64::to_radians));
+    Ok(LoadedRobot {
+        description,
+        model,
+        base,
+        q,
+        qd,
+        velocity: init.velocity,
+        omega: init.omega_deg.map(f64::to_radians),
+        gravity: g,
+        acceleration: (inv.acceleration, inv.alpha_deg.map(f64::to_radians), qdd),
+    })
+}
+
+/// Reads `path` and loads its robot ([`load_str`]).
+pub fn load(path: &Path) -> Result<LoadedRobot, ConfigError> {
+    let text = crate::read_text(path)?;
+    load_str(&text, path)
+}
+
+/// ` (did you mean "x"?)` for the closest known name, if close.
+fn suggest_name(name: &str, known: &[&str]) -> String {
+    known
+        .iter()
+        .map(|k| (strsim::damerau_levenshtein(name, k), *k))
+        .filter(|(d, _)| *d <= 3)
+        .min()
+        .map(|(_, k)| format!(" (did you mean \"{k}\"?)"))
+        .unwrap_or_default()
+}
+
+/// One body at the initial state (`fbd kinematics`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct BodyKinematics {
+    /// The body's name.
+    pub name: String,
+    /// Mass (kg).
+    pub mass: f64,
+    /// Centre of mass in the body's frame (m).
+    pub com: [f64; 3],
+    /// Inertia about the centre of mass, body axes, rows (kg·m²).
+    pub inertia: [[f64; 3]; 3],
+    /// The body frame's origin, inertial (m).
+    pub position: [f64; 3],
+    /// The body frame's axes in the inertial frame, rows of the rotation
+    /// matrix (`rotation[i][k]`: inertial component i of body axis k).
+    pub rotation: [[f64; 3]; 3],
+}
+
+/// One joint at the initial state.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct JointKinematics {
+    /// The joint's name.
+    pub name: String,
+    /// The parent body's name.
+    pub parent: String,
+    /// The child body's name.
+    pub child: String,
+    /// The angle (rad).
+    pub angle: f64,
+    /// A point of the axis: the child frame's origin, inertial (m).
+    pub position: [f64; 3],
+    /// The axis, inertial (unit).
+    pub axis: [f64; 3],
+    /// `[lower, upper]` (rad), or null for a continuous joint.
+    pub limits: Option<[f64; 2]>,
+    /// The effort limit (N·m), or null.
+    pub effort: Option<f64>,
+}
+
+/// One contact point at the initial state.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct ContactKinematics {
+    /// The point's name.
+    pub name: String,
+    /// The body carrying it.
+    pub body: String,
+    /// The sphere's centre, inertial (m).
+    pub position: [f64; 3],
+    /// The sphere's radius (m), 0 for a point.
+    pub radius: f64,
+}
+
+/// `fbd kinematics` of an imported robot.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RobotKinematics {
+    /// The robot's name.
+    pub robot: String,
+    /// The description file.
+    pub description: String,
+    /// Total mass (kg).
+    pub mass: f64,
+    /// The whole robot's centre of mass, inertial (m).
+    pub com: [f64; 3],
+    /// Every body, root first.
+    pub bodies: Vec<BodyKinematics>,
+    /// Every revolute joint.
+    pub joints: Vec<JointKinematics>,
+    /// Every contact point.
+    pub contacts: Vec<ContactKinematics>,
+}
+
+fn rows(m: &fbd_robot::nalgebra::Matrix3<f64>) -> [[f64; 3]; 3] {
+    [0, 1, 2].map(|i| [m[(i, 0)], m[(i, 1)], m[(i, 2)]])
+}
+
+impl LoadedRobot {
+    /// Every body, joint and contact point at the initial state.
+    pub fn kinematics(&self) -> RobotKinematics {
+        let m = &self.model;
+        let mut data = fbd_robot::RobotData::new(m);
+        fbd_robot::forward(m, &self.base, &self.q, &mut data);
+        let v = |x: fbd_robot::nalgebra::Vector3<f64>| [x.x, x.y, x.z];
+        RobotKinematics {
+            robot: m.name.clone(),
+            description: self.description.display().to_string(),
+            mass: m.mass(),
+            com: v(data.total_com(m)),
+            bodies: m
+                .bodies
+                .iter()
+                .zip(&data.frames)
+                .map(|(b, f)| BodyKinematics {
+                    name: b.name.clone(),
+                    mass: b.mass,
+                    com: v(b.com),
+                    inertia: rows(&b.inertia),
+                    position: v(f.translation.vector),
+                    rotation: rows(f.rotation.to_rotation_matrix().matrix()),
+                })
+                .collect(),
+            joints: m
+                .joints
+                .iter()
+                .enumerate()
+                .map(|(j, joint)| JointKinematics {
+                    name: joint.name.clone(),
+                    parent: m.bodies[joint.parent].name.clone(),
+                    child: m.bodies[joint.child].name.clone(),
+                    angle: self.q[j],
+                    position: v(data.frames[joint.child].translation.vector),
+                    axis: v(data.axes[j]),
+                    limits: joint.limits.map(|l| [l.lower, l.upper]),
+                    effort: joint.effort,
+                })
+                .collect(),
+            contacts: m
+                .contacts
+                .iter()
+                .zip(&data.contacts)
+                .map(|(c, p)| ContactKinematics {
+                    name: c.name.clone(),
+                    body: m.bodies[c.body].name.clone(),
+                    position: v(*p),
+                    radius: c.radius,
+                })
+                .collect(),
+        }
+    }
+}
+
+/// One joint's share of `fbd inverse`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct JointInverse {
+    /// The joint's name.
+    pub name: String,
+    /// Force of the parent body on the child at the joint (N, inertial).
+    pub force: [f64; 3],
+    /// Moment of the parent on the child about the joint's origin (N·m,
+    /// inertial): `torque·axis + constraint_moment`.
+    pub moment: [f64; 3],
+    /// The torque along the joint's axis (N·m).
+    pub torque: f64,
+    /// The moment across the axis, carried by the joint's structure (N·m).
+    pub constraint_moment: [f64; 3],
+}
+
+/// `fbd inverse`: the forces the state and `[inverse]` accelerations need.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct RobotInverseReport {
+    /// The robot's name.
+    pub robot: String,
+    /// External force the root needs (N, inertial); zero for a motion the
+    /// robot makes on its own in flight.
+    pub base_force: [f64; 3],
+    /// External moment the root needs about its frame's origin (N·m).
+    pub base_moment: [f64; 3],
+    /// Every joint's force, moment and torque.
+    pub joints: Vec<JointInverse>,
+}
+
+impl LoadedRobot {
+    /// Inverse dynamics by the FBD method ([`fbd_dynamics::tree`]).
+    pub fn inverse(&self) -> RobotInverseReport {
+        use fbd_robot::nalgebra::Vector3;
+        let v = |x: Vector3<f64>| [x.x, x.y, x.z];
+        let (acc, alpha, qdd) = &self.acceleration;
+        let motion = fbd_dynamics::tree::TreeMotion {
+            base: self.base,
+            velocity: Vector3::from(self.velocity),
+            omega: Vector3::from(self.omega),
+            acceleration: Vector3::from(*acc),
+            alpha: Vector3::from(*alpha),
+            q: self.q.clone(),
+            qd: self.qd.clone(),
+            qdd: qdd.clone(),
+        };
+        let mut data = fbd_dynamics::tree::TreeData::new(&self.model);
+        fbd_dynamics::tree::inverse(
+            &self.model,
+            &motion,
+            Vector3::new(0.0, -self.gravity, 0.0),
+            &mut data,
+        );
+        RobotInverseReport {
+            robot: self.model.name.clone(),
+            base_force: v(data.base_force),
+            base_moment: v(data.base_moment),
+            joints: (0..self.model.joints.len())
+                .map(|j| JointInverse {
+                    name: self.model.joints[j].name.clone(),
+                    force: v(data.force[j]),
+                    moment: v(data.moment[j]),
+                    torque: data.torque[j],
+                    constraint_moment: v(data.constraint_moment(j)),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The hexapod of `p` as a generic [`RobotModel`], built from its D-H
+/// parameters ([`fbd_robot::dh::hexapod`]): the same geometry, masses,
+/// inertias, legs, joint limits and contact points.
+pub fn hexapod_robot(p: &fbd_sim::spatial::SpatialParams) -> RobotModel {
+    use fbd_robot::JointLimits;
+    use fbd_robot::dh::{HexapodLayout, HexapodMasses, hexapod};
+    let geometry = fbd_kinematics::hexapod::HexapodModel::new(
+        p.side,
+        fbd_kinematics::leg::LegGeometry {
+            a: p.upper_length,
+            c: p.lower_length,
+        },
+        p.upper_com,
+        p.lower_com,
+    );
+    let masses = HexapodMasses {
+        body_mass: p.body_mass,
+        body_inertia: p.body_inertia,
+        upper_mass: p.upper_mass,
+        upper_radius: p.upper_radius,
+        upper_inertia: p.upper_inertia,
+        lower_mass: p.lower_mass,
+        lower_radius: p.lower_radius,
+        lower_inertia: p.lower_inertia,
+    };
+    let l = &p.joint_limits;
+    let limit = |[lower, upper]: [f64; 2]| Some(JointLimits { lower, upper });
+    let layout = HexapodLayout {
+        legs: p.legs.clone(),
+        limits: [limit(l.theta1), limit(l.theta2), limit(l.theta3)],
+        knees: p.contact_points.knees,
+        hips: p.contact_points.hips,
+    };
+    hexapod(&geometry, &masses, &layout)
+}

@@ -2,8 +2,8 @@
 # The Python package's tests, in a fresh virtual environment: installs
 # maturin, NumPy, pytest, pandas (Result.to_pandas), pyarrow (reading
 # trajectory.parquet), matplotlib (the Fig. 7 example), gymnasium (fbd.gym),
-# dask[distributed] (the Dask LocalCluster example), pin (Pinocchio) and
-# example-robot-data (the imported-robot cross-checks) from PyPI, installs
+# dask[distributed] (the Dask LocalCluster example), pin (Pinocchio),
+# example-robot-data and mujoco (the imported-robot cross-checks) from PyPI, installs
 # the package with the README's command
 # (`pip install ./crates/python`, which builds the abi3 wheel with maturin),
 # lints the binding's Rust code, runs the pytest suite against the `fbd`
@@ -30,8 +30,10 @@ VPY="$WORK/venv/bin/python"
 "$VPY" -m pip install --quiet --disable-pip-version-check maturin numpy pytest pandas pyarrow matplotlib \
   gymnasium "dask[distributed]"
 # Imported robots are checked against Pinocchio on real descriptions
-# (tests/test_robot_import.py), pinned to the versions measured.
-"$VPY" -m pip install --quiet --disable-pip-version-check pin==4.1.0 example-robot-data==6.0.0
+# (tests/test_robot_import.py) and against MuJoCo on MJCF files
+# (tests/test_robot_mujoco.py), pinned to the versions measured.
+"$VPY" -m pip install --quiet --disable-pip-version-check pin==4.1.0 example-robot-data==6.0.0 \
+  mujoco==4.0.0
 
 echo "== python: pip install ./crates/python"
 "$VPY" -m pip install --quiet --disable-pip-version-check ./crates/python

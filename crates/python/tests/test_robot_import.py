@@ -12,7 +12,6 @@ description turned by ``x → −z, y → −x, z → y``.
 from __future__ import annotations
 
 import importlib.metadata
-import json
 import math
 import pathlib
 import subprocess
@@ -20,12 +19,11 @@ import subprocess
 import numpy as np
 import pytest
 
-import pinocchio as pin  # noqa: E402  (installed by scripts/test-python.sh)
+import pinocchio as pin  # installed by scripts/test-python.sh
+from robot_state import TURN, fbd_json, write_config
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
 
-# fbd body frame ← URDF root frame.
-TURN = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])
 
 
 def robots_dir() -> pathlib.Path:
@@ -51,18 +49,9 @@ def urdf_path(rel: str) -> pathlib.Path:
 
 
 def fbd_kinematics(cli, tmp_path, urdf: pathlib.Path, feet, angles_deg, position):
-    joints = ", ".join(f"{name} = {deg!r}" for name, deg in angles_deg.items())
-    cfg = tmp_path / "robot.toml"
-    cfg.write_text(
-        'model = "robot"\n[robot]\n'
-        f'urdf = "{urdf}"\n'
-        f"contacts = {json.dumps(feet)}\n"
-        f"[initial]\nposition = {[float(x) for x in position]}\n"
-        f"joints_deg = {{ {joints} }}\n"
-    )
-    out = subprocess.run([str(cli), "kinematics", str(cfg)], capture_output=True, text=True)
-    assert out.returncode == 0, out.stderr
-    return json.loads(out.stdout)
+    cfg = write_config(tmp_path / "robot.toml", urdf, contacts=feet, angles=angles_deg,
+                       position=position)
+    return fbd_json(cli, "kinematics", cfg)
 
 
 def random_angles(model, rng):
@@ -156,13 +145,6 @@ def rot_fbd(phi):
     return rx @ rz @ ry
 
 
-def toml_table(d):
-    return "{ " + ", ".join(f"{k} = {float(v)!r}" for k, v in d.items()) + " }"
-
-
-def toml_vec(v):
-    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
-
 
 @pytest.mark.parametrize("name,rel,feet", ROBOTS + [
     ("lab_hexapod", "examples/robots/lab_hexapod.urdf", ["lf_foot"]),
@@ -185,19 +167,10 @@ def test_fbd_inverse_dynamics_matches_pinocchio_rnea(cli, tmp_path, name, rel, f
         angles = random_angles(model, rng)
         rates = {k: math.degrees(rng.uniform(-3, 3)) for k in angles}
         accels = {k: math.degrees(rng.uniform(-30, 30)) for k in angles}
-        cfg = tmp_path / "robot.toml"
-        cfg.write_text(
-            f'model = "robot"\n[robot]\nurdf = "{path}"\ncontacts = {json.dumps(feet)}\n'
-            f"[initial]\nposition = {toml_vec(position)}\n"
-            f"phi_deg = {toml_vec(np.degrees(phi))}\n"
-            f"velocity = {toml_vec(vel)}\nomega_deg = {toml_vec(np.degrees(omega))}\n"
-            f"joints_deg = {toml_table(angles)}\nrates_deg = {toml_table(rates)}\n"
-            f"[inverse]\nacceleration = {toml_vec(acc)}\nalpha_deg = {toml_vec(np.degrees(alpha))}\n"
-            f"joints_deg = {toml_table(accels)}\n"
-        )
-        out = subprocess.run([str(cli), "inverse", str(cfg)], capture_output=True, text=True)
-        assert out.returncode == 0, out.stderr
-        fbd = json.loads(out.stdout)
+        cfg = write_config(tmp_path / "robot.toml", path, contacts=feet, position=position,
+                           phi=phi, velocity=vel, omega=omega, angles=angles, rates=rates,
+                           acceleration=acc, alpha=alpha, accelerations=accels)
+        fbd = fbd_json(cli, "inverse", cfg)
 
         # Pinocchio's state: its world is fbd's turned back (TURNᵀ).
         r_pin = TURN.T @ rot_fbd(phi) @ TURN

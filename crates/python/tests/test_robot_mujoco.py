@@ -14,7 +14,6 @@ is the rigid-body part).
 
 from __future__ import annotations
 
-import json
 import math
 import pathlib
 import subprocess
@@ -22,17 +21,10 @@ import subprocess
 import mujoco
 import numpy as np
 import pytest
+from robot_state import TURN, fbd_json, write_config
 
 ROOT = pathlib.Path(__file__).resolve().parents[3]
-TURN = np.array([[0.0, -1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]])
 
-
-def toml_vec(v):
-    return "[" + ", ".join(repr(float(x)) for x in v) + "]"
-
-
-def toml_table(d):
-    return "{ " + ", ".join(f'"{k}" = {float(v)!r}' for k, v in d.items()) + " }"
 
 
 def hexapod_xml(cli, tmp_path):
@@ -70,21 +62,11 @@ def test_imported_mjcf_matches_mujoco(cli, tmp_path, which):
             angles[name] = math.degrees(rng.uniform(mid - half, mid + half))
             rates[name] = math.degrees(rng.uniform(-3, 3))
             accels[name] = math.degrees(rng.uniform(-30, 30))
-        cfg = tmp_path / "robot.toml"
-        cfg.write_text(
-            f'model = "robot"\n[robot]\nmjcf = "{path}"\nup = "{up}"\n'
-            f"[initial]\nposition = {toml_vec(position)}\n"
-            f"velocity = {toml_vec(vel)}\nomega_deg = {toml_vec(np.degrees(omega))}\n"
-            f"joints_deg = {toml_table(angles)}\nrates_deg = {toml_table(rates)}\n"
-            f"[inverse]\nacceleration = {toml_vec(acc)}\nalpha_deg = {toml_vec(np.degrees(alpha))}\n"
-            f"joints_deg = {toml_table(accels)}\n"
-        )
-        kin = subprocess.run([str(cli), "kinematics", str(cfg)], capture_output=True, text=True)
-        assert kin.returncode == 0, kin.stderr
-        kin = json.loads(kin.stdout)
-        inv = subprocess.run([str(cli), "inverse", str(cfg)], capture_output=True, text=True)
-        assert inv.returncode == 0, inv.stderr
-        inv = json.loads(inv.stdout)
+        cfg = write_config(tmp_path / "robot.toml", path, kind="mjcf", up=up,
+                           position=position, velocity=vel, omega=omega, angles=angles,
+                           rates=rates, acceleration=acc, alpha=alpha, accelerations=accels)
+        kin = fbd_json(cli, "kinematics", cfg)
+        inv = fbd_json(cli, "inverse", cfg)
 
         # MuJoCo's state: the root at its world origin, unturned; fbd's
         # world is MuJoCo's turned and shifted by `position`.

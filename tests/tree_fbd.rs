@@ -1,0 +1,457 @@
+//! The FBD equations of any robot tree ([`fbd_dynamics::tree::assemble`],
+//! issue 25: one robot model as data):
+//!
+//! * on the paper's hexapod, the mechanism built from the generic model
+//!   ([`fbd_scenario::robot::hexapod_robot`], the two-axis hip a compound
+//!   joint) has the spatial hexapod's layout of unknowns and equations, and
+//!   its residual and analytic Jacobian equal the hexapod-specific
+//!   [`fbd_dynamics::spatial`] assembly's (1e-10 relative) at random
+//!   states: tumbling base, random joint angles, iterates and forces, every
+//!   contact state (free, sticking at an anchor, sliding; fixed-state and
+//!   complementarity rows), stops free and at an end, the first step and a
+//!   later one;
+//! * on the lab hexapod URDF (no compound joint: every joint a reaction of
+//!   3 forces and 2 constraint moments), the analytic Jacobian against
+//!   central differences of the residual through the shared checker
+//!   ([`fbd_kinematics::fd::check_jacobian`]), in flight and with feet in
+//!   contact, and the declared pattern covers every entry.
+
+use std::path::Path;
+
+use fbd_contact::spatial::frame;
+use fbd_contact::{SpatialState, Surface, Terrain};
+use fbd_dynamics::spatial::{self, SpatialContactEquation, SpatialFbdData, SpatialMechanism};
+use fbd_dynamics::tree::assemble as tree;
+use fbd_dynamics::tree::{TreeFbdData, TreeMechanism, contacts_by_kind};
+use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
+use fbd_kinematics::LimitSide;
+use fbd_kinematics::fd::{FdTolerance, check_jacobian};
+use fbd_robot::{ContactChoice, RobotModel, Up};
+use fbd_sim::spatial::{SpatialModel, SpatialParams};
+
+struct Dense<'a> {
+    n: usize,
+    m: &'a mut [f64],
+}
+impl JacobianSink for Dense<'_> {
+    const ACTIVE: bool = true;
+    fn add(&mut self, r: usize, c: usize, v: f64) {
+        self.m[r * self.n + c] += v;
+    }
+}
+
+/// A small deterministic generator (uniform in [−1, 1)).
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+}
+
+/// The hexapod both ways: the spatial model the simulator builds from its
+/// parameters, and the tree mechanism of the same parameters' robot model.
+fn both() -> (SpatialMechanism, TreeMechanism) {
+    let params = SpatialParams::default();
+    let spatial = SpatialModel::new(&params).expect("default parameters").mech;
+    let model = fbd_scenario::robot::hexapod_robot(&params);
+    let tree = TreeMechanism::with_contacts(&model, params.gravity, &contacts_by_kind(&model));
+    (spatial, tree)
+}
+
+/// A random configuration near the standing pose: base tilted and
+/// turned, every joint different.
+fn random_q(rng: &mut Rng, legs: usize) -> Vec<f64> {
+    let mut q = vec![0.0; 6 + 3 * legs];
+    q[0] = 0.2 * rng.next();
+    q[1] = 0.4 + 0.1 * rng.next();
+    q[2] = 0.2 * rng.next();
+    for v in &mut q[3..6] {
+        *v = 0.5 * rng.next();
+    }
+    for s in 0..legs {
+        q[6 + 3 * s] = 0.6 * rng.next();
+        q[7 + 3 * s] = -0.3 + 0.5 * rng.next();
+        q[8 + 3 * s] = 4.3 + 0.4 * rng.next();
+    }
+    q
+}
+
+/// `q` moved a little (a step's worth) at random.
+fn near(rng: &mut Rng, q: &[f64], h: f64) -> Vec<f64> {
+    q.iter().map(|v| v + h * rng.next()).collect()
+}
+
+/// The contact equations of point `c` in a random state.
+fn contact_equation(
+    rng: &mut Rng,
+    surface: &Surface,
+    c: usize,
+    complementarity: bool,
+) -> SpatialContactEquation {
+    let state = match c % 4 {
+        0 => SpatialState::Free,
+        1 => SpatialState::Stick {
+            anchor: [0.3 * rng.next(), 0.01 * rng.next(), 0.3 * rng.next()],
+        },
+        _ => {
+            let a = 3.0 * rng.next();
+            SpatialState::Slide {
+                dir: [a.cos(), a.sin()],
+            }
+        }
+    };
+    SpatialContactEquation {
+        state,
+        frame: frame(surface, 0.3 * rng.next(), 0.3 * rng.next()),
+        mu_dynamic: if complementarity && c % 3 == 0 {
+            1e9
+        } else {
+            0.3 + 0.2 * rng.next().abs()
+        },
+        regularization: 1e-3,
+        mu_static: if c % 3 == 1 { 1e9 } else { 0.5 },
+        complementarity,
+        frozen: None,
+    }
+}
+
+/// Entry by entry within `tol` of the row's scale.
+fn assert_close(what: &str, a: &[f64], b: &[f64], scale: &[f64], tol: f64) {
+    assert_eq!(a.len(), b.len());
+    let mut worst = (0.0, 0);
+    for i in 0..a.len() {
+        let e = (a[i] - b[i]).abs() / scale[i].max(1e-300);
+        if e > worst.0 {
+            worst = (e, i);
+        }
+    }
+    let i = worst.1;
+    assert!(
+        worst.0 <= tol,
+        "{what}: entry {i}: {} vs {} (relative {:e})",
+        a[i],
+        b[i],
+        worst.0
+    );
+}
+
+/// One random state driven through both assemblies with the same calls.
+fn compare_once(seed: u64, surface: &Surface, first_step: bool, complementarity: bool) {
+    let (sm, tm) = both();
+    let lay = sm.layout();
+    let n = lay.dim();
+    let legs = sm.legs.len();
+    let mut rng = Rng(seed);
+    let mut sd = SpatialFbdData::new(&sm);
+    let mut td = TreeFbdData::new(&tm);
+    let q_k = random_q(&mut rng, legs);
+    let q_prev = near(&mut rng, &q_k, 0.01);
+    let q_next = near(&mut rng, &q_k, 0.01);
+    spatial::set_previous(&sm, &mut sd, &q_prev);
+    tree::set_previous(&tm, &mut td, &q_prev);
+    spatial::set_configuration(&sm, &mut sd, &q_k);
+    tree::set_configuration(&tm, &mut td, &q_k);
+    let qdot: Vec<f64> = (0..lay.nq).map(|_| 2.0 * rng.next()).collect();
+    let history = || {
+        if first_step {
+            History::Initial { qdot: &qdot }
+        } else {
+            History::Previous
+        }
+    };
+    let dt = 0.002;
+    spatial::prepare_step(&sm, &mut sd, history(), dt);
+    tree::prepare_step(&tm, &mut td, history(), dt);
+    for s in 0..legs {
+        for j in 0..3 {
+            let t = 5.0 * rng.next();
+            sd.torque[s][j] = t;
+            td.torque[3 * s + j] = t;
+        }
+    }
+    for c in 0..lay.contacts {
+        let eq = contact_equation(&mut rng, surface, c, complementarity);
+        sd.contact[c] = eq;
+        td.contact[c] = eq;
+    }
+    for l in 0..lay.limits {
+        let eq = if l % 3 == 1 {
+            LimitEquation::default()
+        } else {
+            LimitEquation {
+                state: LimitState::At {
+                    side: if l % 2 == 0 {
+                        LimitSide::Lower
+                    } else {
+                        LimitSide::Upper
+                    },
+                    angle: q_k[tm.limits[l].q_index] + 0.01 * rng.next(),
+                },
+                regularization: 1e-3,
+                complementarity,
+            }
+        };
+        sd.limit[l] = eq;
+        td.limit[l] = eq;
+    }
+    let mut z: Vec<f64> = (0..n).map(|_| 50.0 * rng.next()).collect();
+    z[..lay.nq].copy_from_slice(&q_next);
+    if complementarity {
+        for c in (0..lay.contacts).step_by(2) {
+            z[lay.contact_force(c, 1)] = 2e6 * (1.0 + rng.next().abs());
+        }
+    }
+    let (mut rs, mut rt) = (vec![0.0; n], vec![0.0; n]);
+    let (mut js, mut jt) = (vec![0.0; n * n], vec![0.0; n * n]);
+    spatial::eval(&sm, surface, &mut sd, &z, &mut rs, &mut Dense { n, m: &mut js });
+    tree::eval(&tm, surface, &mut td, &z, &mut rt, &mut Dense { n, m: &mut jt });
+    // Row scales: the size of the terms each row is a sum of.
+    let mut r_scale = vec![0.0; n];
+    for i in 0..n {
+        r_scale[i] = rs[i].abs()
+            + (0..n)
+                .map(|j| (js[i * n + j] * z[j]).abs())
+                .sum::<f64>();
+    }
+    let what = format!("seed {seed}, first {first_step}, complementarity {complementarity}");
+    assert_close(&format!("residual ({what})"), &rt, &rs, &r_scale, 1e-10);
+    let mut j_scale = vec![0.0; n * n];
+    for i in 0..n {
+        let m = (0..n).map(|j| js[i * n + j].abs()).fold(0.0, f64::max);
+        j_scale[i * n..(i + 1) * n].fill(m.max(1e-12));
+    }
+    assert_close(&format!("Jacobian ({what})"), &jt, &js, &j_scale, 1e-10);
+    assert_eq!(sd.branch, td.branch, "complementarity branches ({what})");
+    assert_eq!(sd.limit_unloaded, td.limit_unloaded, "stops ({what})");
+    assert_eq!(spatial::pattern_key(&sd), tree::pattern_key(&td));
+    let (mut ps, mut pt) = (Vec::new(), Vec::new());
+    spatial::pattern(&sm, &sd, &mut ps);
+    tree::pattern(&tm, &td, &mut pt);
+    ps.sort_unstable();
+    ps.dedup();
+    pt.sort_unstable();
+    pt.dedup();
+    assert_eq!(ps, pt, "sparsity patterns ({what})");
+    // Residual-only evaluations agree as well.
+    spatial::eval(&sm, surface, &mut sd, &z, &mut rs, &mut NoJacobian);
+    tree::eval(&tm, surface, &mut td, &z, &mut rt, &mut NoJacobian);
+    assert_close(&format!("residual only ({what})"), &rt, &rs, &r_scale, 1e-10);
+
+    // Accept the iterate and take the next step: the carried state agrees.
+    spatial::evaluate_next(&sm, &mut sd, &q_next);
+    tree::evaluate_next(&tm, &mut td, &q_next);
+    spatial::advance(&mut sd);
+    tree::advance(&mut td);
+    spatial::prepare_step(&sm, &mut sd, History::Previous, dt);
+    tree::prepare_step(&tm, &mut td, History::Previous, dt);
+    z[..lay.nq].copy_from_slice(&near(&mut rng, &q_next, 0.01));
+    js.fill(0.0);
+    jt.fill(0.0);
+    spatial::eval(&sm, surface, &mut sd, &z, &mut rs, &mut Dense { n, m: &mut js });
+    tree::eval(&tm, surface, &mut td, &z, &mut rt, &mut Dense { n, m: &mut jt });
+    for i in 0..n {
+        r_scale[i] = rs[i].abs()
+            + (0..n)
+                .map(|j| (js[i * n + j] * z[j]).abs())
+                .sum::<f64>();
+        let m = (0..n).map(|j| js[i * n + j].abs()).fold(0.0, f64::max);
+        j_scale[i * n..(i + 1) * n].fill(m.max(1e-12));
+    }
+    assert_close(&format!("next residual ({what})"), &rt, &rs, &r_scale, 1e-10);
+    assert_close(&format!("next Jacobian ({what})"), &jt, &js, &j_scale, 1e-10);
+}
+
+#[test]
+fn hexapod_layout_is_the_spatial_models() {
+    let (sm, tm) = both();
+    let lay = sm.layout();
+    let dims = fbd_dynamics::assembly::FbdModel::dims(&tm);
+    assert_eq!(dims, lay.dims());
+    assert_eq!(tm.bodies.len(), sm.bodies.len());
+    for (a, b) in tm.bodies.iter().zip(&sm.bodies) {
+        assert_eq!(a.name, b.name);
+        assert_eq!(a.mass, b.mass);
+    }
+    assert_eq!(tm.reactions.len(), 2 * sm.legs.len());
+    for s in 0..sm.legs.len() {
+        let (hip, knee) = (2 * s, 2 * s + 1);
+        assert!(tm.reactions[hip].compound && !tm.reactions[knee].compound);
+        assert_eq!(tm.reaction_force(hip, 0), lay.hip_force(s, 0));
+        assert_eq!(tm.reaction_moment(hip, 0), lay.hip_moment(s));
+        assert_eq!(tm.reaction_force(knee, 0), lay.knee_force(s, 0));
+        assert_eq!(tm.reaction_moment(knee, 0), lay.knee_moment(s, 0));
+        assert_eq!(tm.reaction_moment(knee, 1), lay.knee_moment(s, 1));
+    }
+    let names: Vec<&str> = tm.contacts.iter().map(|c| c.name.as_str()).collect();
+    let spatial: Vec<&str> = sm.contacts.iter().map(|c| c.name.as_str()).collect();
+    assert_eq!(names, spatial);
+    for (a, b) in tm.contacts.iter().zip(&sm.contacts) {
+        assert_eq!(a.body, b.body, "{}", a.name);
+    }
+    let lq: Vec<usize> = tm.limits.iter().map(|l| l.q_index).collect();
+    let sq: Vec<usize> = sm.limits.iter().map(|l| l.q_index).collect();
+    assert_eq!(lq, sq);
+    assert!((tm.length_scale() - sm.length_scale()).abs() < 1e-14);
+}
+
+#[test]
+fn hexapod_equations_equal_the_spatial_models_at_random_states() {
+    let slope = Surface::new(
+        Terrain::Slope {
+            slope: 0.2,
+            height: 0.05,
+        },
+        0.6,
+    );
+    for seed in 1..=4 {
+        for (surface, first) in [(&Surface::default(), false), (&slope, true)] {
+            compare_once(seed, surface, first, false);
+            compare_once(seed + 100, surface, !first, true);
+        }
+    }
+}
+
+fn lab() -> RobotModel {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/robots/lab_hexapod.urdf");
+    fbd_robot::urdf::load(&path, Up::Z, &ContactChoice::CollisionSpheres).expect("lab hexapod")
+}
+
+/// The lab hexapod's residual Jacobian against central differences:
+/// `contact`: the feet in contact (sticking, sliding, complementarity
+/// rows), otherwise in flight; stops at an end with `limits_at`.
+fn check_lab(first_step: bool, contact: bool, complementarity: bool, limits_at: bool) {
+    let model = lab();
+    assert!(model.compound_joints().is_empty());
+    let mech = TreeMechanism::new(&model, 9.81);
+    assert!(mech.reactions.iter().all(|r| r.unknowns() == 5));
+    assert_eq!(mech.reactions.len(), model.joints.len());
+    assert!(!mech.contacts.is_empty() && !mech.limits.is_empty());
+    let dims = mech.dims();
+    let n = dims.dim();
+    let nq = mech.nq();
+    let surface = Surface::new(
+        Terrain::Slope {
+            slope: 0.15,
+            height: 0.02,
+        },
+        0.4,
+    );
+    let mut rng = Rng(7 + u64::from(contact) + 2 * u64::from(first_step));
+    let mut q_k = vec![0.0; nq];
+    q_k[1] = 0.15;
+    for v in &mut q_k[3..6] {
+        *v = 0.4 * rng.next();
+    }
+    for v in &mut q_k[6..] {
+        *v = 0.8 * rng.next();
+    }
+    let q_prev = near(&mut rng, &q_k, 0.01);
+    let q_next = near(&mut rng, &q_k, 0.01);
+    let mut data = TreeFbdData::new(&mech);
+    tree::set_previous(&mech, &mut data, &q_prev);
+    tree::set_configuration(&mech, &mut data, &q_k);
+    let qdot: Vec<f64> = (0..nq).map(|_| rng.next()).collect();
+    let history = if first_step {
+        History::Initial { qdot: &qdot }
+    } else {
+        History::Previous
+    };
+    tree::prepare_step(&mech, &mut data, history, 0.002);
+    for t in &mut data.torque {
+        *t = 0.5 * rng.next();
+    }
+    for c in 0..dims.contacts {
+        data.contact[c] = if contact {
+            contact_equation(&mut rng, &surface, c, complementarity)
+        } else {
+            SpatialContactEquation::default()
+        };
+    }
+    if limits_at {
+        for l in (0..dims.limits).step_by(2) {
+            data.limit[l] = LimitEquation {
+                state: LimitState::At {
+                    side: if l % 4 == 0 {
+                        LimitSide::Lower
+                    } else {
+                        LimitSide::Upper
+                    },
+                    angle: mech.limits[l].range[usize::from(l % 4 != 0)],
+                },
+                regularization: 1e-3,
+                complementarity,
+            };
+        }
+    }
+    let mut z: Vec<f64> = (0..n).map(|_| 5.0 * rng.next()).collect();
+    z[..nq].copy_from_slice(&q_next);
+    if complementarity {
+        for c in (0..dims.contacts).step_by(2) {
+            z[dims.contact_force(c, 1)] = 1e5 * (1.0 + rng.next().abs());
+        }
+    }
+    let mut r = vec![0.0; n];
+    let mut jac = vec![0.0; n * n];
+    tree::eval(
+        &mech,
+        &surface,
+        &mut data,
+        &z,
+        &mut r,
+        &mut Dense { n, m: &mut jac },
+    );
+    let mut entries = Vec::new();
+    tree::pattern(&mech, &data, &mut entries);
+    let mut declared = vec![false; n * n];
+    for (i, j) in entries {
+        declared[i * n + j] = true;
+    }
+    for i in 0..n {
+        for j in 0..n {
+            assert!(
+                declared[i * n + j] || jac[i * n + j] == 0.0,
+                "entry ({i}, {j}) = {} is not in the pattern",
+                jac[i * n + j]
+            );
+        }
+    }
+    // Every body row has its q[k+1] columns: the dynamics are coupled.
+    for b in 0..dims.bodies {
+        let row = dims.body_row(b);
+        assert!((0..nq).any(|j| jac[row * n + j] != 0.0), "body {b}");
+    }
+    let mut work = data.clone();
+    check_jacobian(
+        &z,
+        n,
+        |x, out| tree::eval(&mech, &surface, &mut work, x, out, &mut NoJacobian),
+        |i, j| jac[i * n + j],
+        FdTolerance {
+            step: 1e-6,
+            rel: 1e-6,
+            abs: 2e-3,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+}
+
+#[test]
+fn lab_hexapod_jacobian_in_flight() {
+    check_lab(false, false, false, false);
+    check_lab(true, false, false, true);
+}
+
+#[test]
+fn lab_hexapod_jacobian_with_feet_in_contact() {
+    check_lab(false, true, false, true);
+    check_lab(true, true, false, false);
+}
+
+#[test]
+fn lab_hexapod_jacobian_with_complementarity_rows() {
+    check_lab(false, true, true, true);
+}

@@ -52,8 +52,8 @@ pub enum Command {
     /// Inverse dynamics of an imported robot (`model = "robot"`) by the
     /// FBD method: every joint's force, moment and torque, and the root's
     /// external wrench, for the configuration's state and `[inverse]`
-    /// accelerations, as JSON.
-    Inverse(KinematicsArgs),
+    /// accelerations (JSON), or along a recorded motion (`--motion`, CSV).
+    Inverse(InverseArgs),
     /// Run many variations of a configuration in parallel (see
     /// docs/sweep.md): DIR/runs/<i>/, DIR/index.csv, DIR/sweep.svg;
     /// `fbd sweep merge` joins shard directories.
@@ -98,13 +98,29 @@ pub struct KinematicsArgs {
     pub config: PathBuf,
 }
 
+/// Arguments of `fbd inverse`.
+#[derive(Debug, Args)]
+pub struct InverseArgs {
+    /// TOML configuration of an imported robot (`model = "robot"`).
+    #[arg(value_name = "CONFIG")]
+    pub config: PathBuf,
+    /// A recorded motion (CSV: `t`, one column per joint in rad, optional
+    /// `rx, ry, rz, phi_x, phi_y, phi_z`): the forces at every interior
+    /// sample, velocities and accelerations by central differences, as CSV.
+    #[arg(long, value_name = "FILE")]
+    pub motion: Option<PathBuf>,
+    /// Where the CSV of `--motion` goes (default stdout).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
 /// Runs the parsed command, printing its normal output to `out`.
 pub fn dispatch(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     match cli.command {
         None => crate::run::run_command(None, &cli.out, out),
         Some(Command::Run(a)) => crate::run::run_command(a.config.as_deref(), &a.out, out),
         Some(Command::Kinematics(a)) => crate::kinematics::kinematics_command(&a.config, out),
-        Some(Command::Inverse(a)) => crate::kinematics::inverse_command(&a.config, out),
+        Some(Command::Inverse(a)) => crate::kinematics::inverse_command(&a, out),
         Some(Command::Sweep(a)) => crate::sweep::sweep_command(a, out),
         Some(Command::View(a)) => crate::viewer::view::view_command(&a.dir, out),
         Some(Command::Export(f)) => crate::export::export_command(f, out),

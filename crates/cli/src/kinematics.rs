@@ -148,8 +148,13 @@ pub fn kinematics_command(path: &Path, out: &mut dyn Write) -> Result<(), CliErr
         .map_err(CliError::stdout)
 }
 
-/// `fbd inverse CONFIG` (an imported robot's configuration).
-pub fn inverse_command(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
+/// `fbd inverse CONFIG [--motion FILE [--out FILE]]` (an imported robot's
+/// configuration).
+pub fn inverse_command(
+    args: &crate::cli::InverseArgs,
+    out: &mut dyn Write,
+) -> Result<(), CliError> {
+    let path = args.config.as_path();
     let text = config::read_text(path)?;
     if !config::robot::is_robot(&text) {
         return Err(config::ConfigError::Semantic {
@@ -161,9 +166,44 @@ pub fn inverse_command(path: &Path, out: &mut dyn Write) -> Result<(), CliError>
         .into());
     }
     let robot = config::robot::load_str(&text, path)?;
-    let value = serde_json::to_value(robot.inverse())
-        .map_err(|e| CliError::stdout(std::io::Error::other(e)))?;
-    out.write_all(one_item_per_line(&value).as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(CliError::stdout)
+    let Some(motion_path) = &args.motion else {
+        if args.out.is_some() {
+            return Err(CliError::Usage(
+                "fbd inverse: --out writes the CSV of --motion; give --motion FILE".to_owned(),
+            ));
+        }
+        let value = serde_json::to_value(robot.inverse())
+            .map_err(|e| CliError::stdout(std::io::Error::other(e)))?;
+        return out
+            .write_all(one_item_per_line(&value).as_bytes())
+            .and_then(|()| out.flush())
+            .map_err(CliError::stdout);
+    };
+    let motion_text = config::read_text(motion_path)?;
+    let motion = robot.read_motion(&motion_text, &motion_path.display().to_string())?;
+    let rows = robot.inverse_along(&motion);
+    let mut csv = robot.inverse_columns().join(",");
+    csv.push('\n');
+    for row in &rows {
+        let cells: Vec<String> = row.iter().map(|x| format!("{x}")).collect();
+        csv.push_str(&cells.join(","));
+        csv.push('\n');
+    }
+    match &args.out {
+        Some(dest) => {
+            let dir = dest
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty())
+                .unwrap_or(Path::new("."));
+            let mut tmp = crate::output::temp_in(dir, "inverse.csv")?;
+            tmp.write_all(csv.as_bytes())
+                .and_then(|()| tmp.flush())
+                .map_err(|e| CliError::io(dest.display(), &e))?;
+            crate::output::persist(tmp, dest)
+        }
+        None => out
+            .write_all(csv.as_bytes())
+            .and_then(|()| out.flush())
+            .map_err(CliError::stdout),
+    }
 }

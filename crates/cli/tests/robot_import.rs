@@ -112,3 +112,110 @@ fn robot_configurations_fail_on_one_line_where_they_do_not_work() {
         assert!(e.contains(want), "{e}\n  wanted: {want}");
     }
 }
+
+/// A motion CSV of the lab hexapod: every joint `0.4·sin(2t + j)`, the
+/// base rising `ry = 0.2 + 0.1·t²`, sampled every `dt` for 0.5 s.
+fn lab_motion(dt: f64) -> String {
+    let model = fbd_robot::urdf::load(
+        std::path::Path::new(&example("robots/lab_hexapod.urdf")),
+        fbd_robot::Up::Z,
+        &fbd_robot::ContactChoice::CollisionSpheres,
+    )
+    .unwrap();
+    let mut csv = String::from("t,ry");
+    for j in &model.joints {
+        csv.push(',');
+        csv.push_str(&j.name);
+    }
+    csv.push('\n');
+    let n = (0.5 / dt).round() as usize;
+    for k in 0..=n {
+        let t = k as f64 * dt;
+        csv.push_str(&format!("{t},{}", 0.2 + 0.1 * t * t));
+        for j in 0..model.joints.len() {
+            csv.push_str(&format!(",{}", 0.4 * (2.0 * t + j as f64).sin()));
+        }
+        csv.push('\n');
+    }
+    csv
+}
+
+#[test]
+fn inverse_along_a_motion_converges_at_second_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = example("robots/lab_hexapod.toml");
+    // The femur torque of leg lf at t = 0.25 s, with Δt and Δt/2.
+    let torque_at = |dt: f64| {
+        let motion = write(dir.path(), "motion.csv", &lab_motion(dt));
+        let out = fbd(&["inverse", &cfg, "--motion", s(&motion)]);
+        assert!(out.status.success(), "{}", stderr(&out));
+        let text = String::from_utf8(out.stdout).unwrap();
+        let mut lines = text.lines();
+        let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+        let col = header
+            .iter()
+            .position(|c| *c == "tau_lf_femur_joint")
+            .unwrap();
+        let rows: Vec<Vec<f64>> = lines
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(
+            rows.len(),
+            (0.5 / dt).round() as usize - 1,
+            "interior samples"
+        );
+        let row = rows.iter().find(|r| (r[0] - 0.25).abs() < 1e-9).unwrap();
+        row[col]
+    };
+    let (coarse, fine, finest) = (torque_at(0.01), torque_at(0.005), torque_at(0.0025));
+    let ratio = (coarse - fine) / (fine - finest);
+    assert!(
+        (3.5..4.5).contains(&ratio),
+        "error ratio {ratio}: not second order"
+    );
+}
+
+#[test]
+fn a_bad_motion_is_one_line_naming_the_file_and_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = example("robots/lab_hexapod.toml");
+    let good = lab_motion(0.01);
+    let lines: Vec<String> = good.lines().map(str::to_owned).collect();
+    let cases = [
+        (
+            {
+                let mut l = lines.clone();
+                l[0] = l[0].replace(",lf_coxa_joint", ",lf_coxa");
+                l
+            },
+            "motion.csv:1:1: no column for joint `lf_coxa_joint`",
+        ),
+        (
+            {
+                let mut l = lines.clone();
+                l[5] = l[5].replacen("0.04", "0.045", 1);
+                l
+            },
+            "motion.csv:6:1: t = 0.045: samples must be uniformly spaced",
+        ),
+        (
+            {
+                let mut l = lines.clone();
+                l[3] = l[3].replacen(',', ",x", 1);
+                l
+            },
+            "motion.csv:4:1: column `ry`",
+        ),
+        (
+            lines[..3].to_vec(),
+            "motion.csv:1:1: 2 rows: central differences need at least 3",
+        ),
+    ];
+    for (text, want) in cases {
+        let motion = write(dir.path(), "motion.csv", &(text.join("\n") + "\n"));
+        let e = one_line_error(&fbd(&["inverse", &cfg, "--motion", s(&motion)]), 2);
+        assert!(e.contains(want), "{e}\n  wanted: {want}");
+    }
+    let e = one_line_error(&fbd(&["inverse", &cfg, "--out", "x.csv"]), 2);
+    assert!(e.contains("--motion"), "{e}");
+}

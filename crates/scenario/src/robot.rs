@@ -136,11 +136,12 @@ pub struct LoadedRobot {
     pub q: Vec<f64>,
     /// The initial joint rates (rad/s).
     pub qd: Vec<f64>,
-    /// The root origin's initial velocity (m/s) and angular velocity
-    /// (rad/s), inertial.
+    /// The root origin's initial velocity (m/s, inertial).
     pub velocity: [f64; 3],
     /// The root's initial angular velocity (rad/s, inertial).
     pub omega: [f64; 3],
+    /// The root's initial `(φx, φy, φz)` (rad).
+    pub initial_phi: [f64; 3],
     /// Gravity along −Y (m/s²).
     pub gravity: f64,
     /// `[inverse]`: root acceleration (m/s²), angular acceleration
@@ -275,6 +276,7 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         qd,
         velocity: init.velocity,
         omega: init.omega_deg.map(f64::to_radians),
+        initial_phi: init.phi_deg.map(f64::to_radians),
         gravity: g,
         acceleration: (inv.acceleration, inv.alpha_deg.map(f64::to_radians), qdd),
     })
@@ -531,4 +533,213 @@ pub fn hexapod_robot(p: &fbd_sim::spatial::SpatialParams) -> RobotModel {
         hips: p.contact_points.hips,
     };
     hexapod(&geometry, &masses, &layout)
+}
+
+/// A recorded motion of an imported robot (`fbd inverse --motion`): times,
+/// root poses and joint angles, one row per sample.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Motion {
+    /// Sample times (s), uniformly spaced.
+    pub t: Vec<f64>,
+    /// The root's `(position, φ)` per sample (m, rad).
+    pub base: Vec<([f64; 3], [f64; 3])>,
+    /// Joint angles per sample (rad), the model's joint order.
+    pub q: Vec<Vec<f64>>,
+}
+
+/// The base columns a motion may have (`trajectory.csv`'s names): `rx, ry,
+/// rz` (m) and `phi_x, phi_y, phi_z` (rad).
+pub const MOTION_BASE_COLUMNS: [&str; 6] = ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"];
+
+impl LoadedRobot {
+    /// Reads a motion from CSV `text` (named `file` in errors): a header
+    /// with `t` and one column per joint (rad, by joint name), and
+    /// optionally the base columns [`MOTION_BASE_COLUMNS`] (absent ones
+    /// stay at the configuration's `[initial]` values); other columns are
+    /// ignored. At least three rows, times increasing with one spacing.
+    pub fn read_motion(&self, text: &str, file: &str) -> Result<Motion, ConfigError> {
+        let bad = |line: usize, message: String| ConfigError::Syntax {
+            file: file.to_owned(),
+            line,
+            col: 1,
+            message,
+        };
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        let Some((_, header)) = lines.next() else {
+            return Err(bad(1, "an empty motion: expected a header row".to_owned()));
+        };
+        let names: Vec<&str> = header.split(',').map(str::trim).collect();
+        let column = |name: &str| names.iter().position(|n| *n == name);
+        let Some(t_col) = column("t") else {
+            return Err(bad(1, "no column `t`".to_owned()));
+        };
+        let mut joint_cols = Vec::with_capacity(self.model.joints.len());
+        for joint in &self.model.joints {
+            match column(&joint.name) {
+                Some(c) => joint_cols.push(c),
+                None => {
+                    return Err(bad(
+                        1,
+                        format!(
+                            "no column for joint `{}` (one column per joint, rad)",
+                            joint.name
+                        ),
+                    ));
+                }
+            }
+        }
+        let base_cols: Vec<Option<usize>> = MOTION_BASE_COLUMNS.iter().map(|n| column(n)).collect();
+        let pose0 = {
+            let p = self.base.translation.vector;
+            let phi = self.initial_phi;
+            [p.x, p.y, p.z, phi[0], phi[1], phi[2]]
+        };
+        let mut m = Motion {
+            t: Vec::new(),
+            base: Vec::new(),
+            q: Vec::new(),
+        };
+        for (i, line) in lines {
+            let values: Vec<&str> = line.split(',').map(str::trim).collect();
+            if values.len() != names.len() {
+                return Err(bad(
+                    i + 1,
+                    format!("{} values for {} columns", values.len(), names.len()),
+                ));
+            }
+            let num = |c: usize| {
+                values[c]
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| {
+                        bad(
+                            i + 1,
+                            format!(
+                                "column `{}`: `{}` is not a finite number",
+                                names[c], values[c]
+                            ),
+                        )
+                    })
+            };
+            m.t.push(num(t_col)?);
+            let mut pose = pose0;
+            for (k, c) in base_cols.iter().enumerate() {
+                if let Some(c) = c {
+                    pose[k] = num(*c)?;
+                }
+            }
+            m.base
+                .push(([pose[0], pose[1], pose[2]], [pose[3], pose[4], pose[5]]));
+            m.q.push(
+                joint_cols
+                    .iter()
+                    .map(|&c| num(c))
+                    .collect::<Result<_, _>>()?,
+            );
+            let n = m.t.len();
+            if n >= 2 {
+                let dt = m.t[1] - m.t[0];
+                let step = m.t[n - 1] - m.t[n - 2];
+                if dt <= 0.0 || dt.is_nan() || (step - dt).abs() > 1e-9 * dt.max(m.t[n - 1].abs()) {
+                    return Err(bad(
+                        i + 1,
+                        format!(
+                            "t = {}: samples must be uniformly spaced in time (Δt = {dt} from the first two rows, here {step})",
+                            m.t[n - 1]
+                        ),
+                    ));
+                }
+            }
+        }
+        if m.t.len() < 3 {
+            return Err(bad(
+                1,
+                format!("{} rows: central differences need at least 3", m.t.len()),
+            ));
+        }
+        Ok(m)
+    }
+
+    /// Inverse dynamics along `motion`: for each interior sample `k`, the
+    /// velocities and accelerations by central differences (joint angles
+    /// and the root's position: `(x[k+1] − x[k−1])/2Δt`,
+    /// `(x[k+1] − 2x[k] + x[k−1])/Δt²`; the root's rotation: `ω` at the
+    /// half steps from `log(R[k+1]·R[k]ᵀ)/Δt`, their mean and difference),
+    /// then [`fbd_dynamics::tree::inverse`]. The table's columns are
+    /// [`Self::inverse_columns`].
+    pub fn inverse_along(&self, motion: &Motion) -> Vec<Vec<f64>> {
+        use fbd_robot::nalgebra::{Rotation3, Vector3};
+        let n = self.model.joints.len();
+        let dt = motion.t[1] - motion.t[0];
+        let g = Vector3::new(0.0, -self.gravity, 0.0);
+        let frame = |k: usize| fbd_robot::forward::base_frame(motion.base[k].0, motion.base[k].1);
+        let mut data = fbd_dynamics::tree::TreeData::new(&self.model);
+        let mut rows = Vec::with_capacity(motion.t.len().saturating_sub(2));
+        for k in 1..motion.t.len() - 1 {
+            let (f0, f1, f2) = (frame(k - 1), frame(k), frame(k + 1));
+            let (p0, p1, p2) = (
+                f0.translation.vector,
+                f1.translation.vector,
+                f2.translation.vector,
+            );
+            let half = |a: &fbd_robot::nalgebra::Isometry3<f64>,
+                        b: &fbd_robot::nalgebra::Isometry3<f64>| {
+                let r: Rotation3<f64> = (b.rotation * a.rotation.inverse()).to_rotation_matrix();
+                r.scaled_axis() / dt
+            };
+            let (w_minus, w_plus) = (half(&f0, &f1), half(&f1, &f2));
+            let motion_k = fbd_dynamics::tree::TreeMotion {
+                base: f1,
+                velocity: (p2 - p0) / (2.0 * dt),
+                omega: (w_minus + w_plus) / 2.0,
+                acceleration: (p2 - 2.0 * p1 + p0) / (dt * dt),
+                alpha: (w_plus - w_minus) / dt,
+                q: motion.q[k].clone(),
+                qd: (0..n)
+                    .map(|j| (motion.q[k + 1][j] - motion.q[k - 1][j]) / (2.0 * dt))
+                    .collect(),
+                qdd: (0..n)
+                    .map(|j| {
+                        (motion.q[k + 1][j] - 2.0 * motion.q[k][j] + motion.q[k - 1][j]) / (dt * dt)
+                    })
+                    .collect(),
+            };
+            fbd_dynamics::tree::inverse(&self.model, &motion_k, g, &mut data);
+            let mut row = Vec::with_capacity(7 + 7 * n);
+            row.push(motion.t[k]);
+            row.extend(data.base_force.iter());
+            row.extend(data.base_moment.iter());
+            for j in 0..n {
+                row.push(data.torque[j]);
+                row.extend(data.force[j].iter());
+                row.extend(data.moment[j].iter());
+            }
+            rows.push(row);
+        }
+        rows
+    }
+
+    /// The columns of [`Self::inverse_along`]: `t`, `base_fx … base_mz`,
+    /// then per joint `tau_<joint>`, `<joint>_fx, _fy, _fz` (the parent's
+    /// force on the child) and `<joint>_mx, _my, _mz` (its moment about the
+    /// joint's origin); inertial frame.
+    pub fn inverse_columns(&self) -> Vec<String> {
+        let mut c: Vec<String> = [
+            "t", "base_fx", "base_fy", "base_fz", "base_mx", "base_my", "base_mz",
+        ]
+        .iter()
+        .map(|s| (*s).to_owned())
+        .collect();
+        for j in &self.model.joints {
+            c.push(format!("tau_{}", j.name));
+            for s in ["fx", "fy", "fz", "mx", "my", "mz"] {
+                c.push(format!("{}_{s}", j.name));
+            }
+        }
+        c
+    }
 }

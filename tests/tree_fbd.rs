@@ -14,7 +14,12 @@
 //!   3 forces and 2 constraint moments), the analytic Jacobian against
 //!   central differences of the residual through the shared checker
 //!   ([`fbd_kinematics::fd::check_jacobian`]), in flight and with feet in
-//!   contact, and the declared pattern covers every entry.
+//!   contact, and the declared pattern covers every entry;
+//! * driven by Newton through the stepping entry points (as an engine
+//!   would), the lab hexapod in flight keeps the discrete momentum laws of
+//!   the whole tree (linear momentum changes by `−M·g·Δt`, angular
+//!   momentum by gravity's moment), and every joint's constraint moments
+//!   span the plane across its axis (also at the fallback direction).
 
 use std::path::Path;
 
@@ -107,7 +112,7 @@ fn contact_equation(
     SpatialContactEquation {
         state,
         frame: frame(surface, 0.3 * rng.next(), 0.3 * rng.next()),
-        mu_dynamic: if complementarity && c % 3 == 0 {
+        mu_dynamic: if complementarity && c.is_multiple_of(3) {
             1e9
         } else {
             0.3 + 0.2 * rng.next().abs()
@@ -207,15 +212,26 @@ fn compare_once(seed: u64, surface: &Surface, first_step: bool, complementarity:
     }
     let (mut rs, mut rt) = (vec![0.0; n], vec![0.0; n]);
     let (mut js, mut jt) = (vec![0.0; n * n], vec![0.0; n * n]);
-    spatial::eval(&sm, surface, &mut sd, &z, &mut rs, &mut Dense { n, m: &mut js });
-    tree::eval(&tm, surface, &mut td, &z, &mut rt, &mut Dense { n, m: &mut jt });
+    spatial::eval(
+        &sm,
+        surface,
+        &mut sd,
+        &z,
+        &mut rs,
+        &mut Dense { n, m: &mut js },
+    );
+    tree::eval(
+        &tm,
+        surface,
+        &mut td,
+        &z,
+        &mut rt,
+        &mut Dense { n, m: &mut jt },
+    );
     // Row scales: the size of the terms each row is a sum of.
     let mut r_scale = vec![0.0; n];
     for i in 0..n {
-        r_scale[i] = rs[i].abs()
-            + (0..n)
-                .map(|j| (js[i * n + j] * z[j]).abs())
-                .sum::<f64>();
+        r_scale[i] = rs[i].abs() + (0..n).map(|j| (js[i * n + j] * z[j]).abs()).sum::<f64>();
     }
     let what = format!("seed {seed}, first {first_step}, complementarity {complementarity}");
     assert_close(&format!("residual ({what})"), &rt, &rs, &r_scale, 1e-10);
@@ -225,7 +241,16 @@ fn compare_once(seed: u64, surface: &Surface, first_step: bool, complementarity:
         j_scale[i * n..(i + 1) * n].fill(m.max(1e-12));
     }
     assert_close(&format!("Jacobian ({what})"), &jt, &js, &j_scale, 1e-10);
-    assert_eq!(sd.branch, td.branch, "complementarity branches ({what})");
+    // The same branches of the complementarity rows (their numbers agree
+    // to round-off, checked through the rows above).
+    let flags = |b: &[fbd_dynamics::rows::Branch]| -> Vec<(bool, bool)> {
+        b.iter().map(|b| (b.unloaded, b.sliding)).collect()
+    };
+    assert_eq!(
+        flags(&sd.branch),
+        flags(&td.branch),
+        "complementarity branches ({what})"
+    );
     assert_eq!(sd.limit_unloaded, td.limit_unloaded, "stops ({what})");
     assert_eq!(spatial::pattern_key(&sd), tree::pattern_key(&td));
     let (mut ps, mut pt) = (Vec::new(), Vec::new());
@@ -239,7 +264,13 @@ fn compare_once(seed: u64, surface: &Surface, first_step: bool, complementarity:
     // Residual-only evaluations agree as well.
     spatial::eval(&sm, surface, &mut sd, &z, &mut rs, &mut NoJacobian);
     tree::eval(&tm, surface, &mut td, &z, &mut rt, &mut NoJacobian);
-    assert_close(&format!("residual only ({what})"), &rt, &rs, &r_scale, 1e-10);
+    assert_close(
+        &format!("residual only ({what})"),
+        &rt,
+        &rs,
+        &r_scale,
+        1e-10,
+    );
 
     // Accept the iterate and take the next step: the carried state agrees.
     spatial::evaluate_next(&sm, &mut sd, &q_next);
@@ -251,18 +282,41 @@ fn compare_once(seed: u64, surface: &Surface, first_step: bool, complementarity:
     z[..lay.nq].copy_from_slice(&near(&mut rng, &q_next, 0.01));
     js.fill(0.0);
     jt.fill(0.0);
-    spatial::eval(&sm, surface, &mut sd, &z, &mut rs, &mut Dense { n, m: &mut js });
-    tree::eval(&tm, surface, &mut td, &z, &mut rt, &mut Dense { n, m: &mut jt });
+    spatial::eval(
+        &sm,
+        surface,
+        &mut sd,
+        &z,
+        &mut rs,
+        &mut Dense { n, m: &mut js },
+    );
+    tree::eval(
+        &tm,
+        surface,
+        &mut td,
+        &z,
+        &mut rt,
+        &mut Dense { n, m: &mut jt },
+    );
     for i in 0..n {
-        r_scale[i] = rs[i].abs()
-            + (0..n)
-                .map(|j| (js[i * n + j] * z[j]).abs())
-                .sum::<f64>();
+        r_scale[i] = rs[i].abs() + (0..n).map(|j| (js[i * n + j] * z[j]).abs()).sum::<f64>();
         let m = (0..n).map(|j| js[i * n + j].abs()).fold(0.0, f64::max);
         j_scale[i * n..(i + 1) * n].fill(m.max(1e-12));
     }
-    assert_close(&format!("next residual ({what})"), &rt, &rs, &r_scale, 1e-10);
-    assert_close(&format!("next Jacobian ({what})"), &jt, &js, &j_scale, 1e-10);
+    assert_close(
+        &format!("next residual ({what})"),
+        &rt,
+        &rs,
+        &r_scale,
+        1e-10,
+    );
+    assert_close(
+        &format!("next Jacobian ({what})"),
+        &jt,
+        &js,
+        &j_scale,
+        1e-10,
+    );
 }
 
 #[test]
@@ -454,4 +508,205 @@ fn lab_hexapod_jacobian_with_feet_in_contact() {
 #[test]
 fn lab_hexapod_jacobian_with_complementarity_rows() {
     check_lab(false, true, true, true);
+}
+
+/// One step of a [`TreeMechanism`] as a Newton system (how an engine
+/// drives it, as `fbd_sim`'s spatial step drives the hexapod's).
+struct TreeSystem<'a> {
+    mech: &'a TreeMechanism,
+    surface: &'a Surface,
+    data: &'a mut TreeFbdData,
+}
+
+struct SolverSink<'a, 'b>(&'a mut fbd_solver::JacobianSink<'b>);
+impl JacobianSink for SolverSink<'_, '_> {
+    const ACTIVE: bool = true;
+    fn add(&mut self, r: usize, c: usize, v: f64) {
+        self.0.add(r, c, v);
+    }
+}
+
+impl fbd_solver::NewtonSystem for TreeSystem<'_> {
+    fn dim(&self) -> usize {
+        self.mech.dim()
+    }
+    fn pattern_key(&self) -> u64 {
+        tree::pattern_key(self.data)
+    }
+    fn pattern(&self, entries: &mut Vec<(usize, usize)>) {
+        tree::pattern(self.mech, self.data, entries);
+    }
+    fn eval(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut fbd_solver::JacobianSink<'_>>) {
+        match jac {
+            Some(j) => tree::eval(self.mech, self.surface, self.data, x, r, &mut SolverSink(j)),
+            None => tree::eval(self.mech, self.surface, self.data, x, r, &mut NoJacobian),
+        }
+    }
+}
+
+/// Total linear and angular momentum (about the origin) over the step
+/// from `kin` to `kin_next`: `Σ m·(c[k+1] − c[k])/Δt` and
+/// `Σ m·c[k] × (c[k+1] − c[k])/Δt + L[k+½]`.
+fn momenta(
+    mech: &TreeMechanism,
+    data: &TreeFbdData,
+    dt: f64,
+) -> (
+    fbd_kinematics::nalgebra::Vector3<f64>,
+    fbd_kinematics::nalgebra::Vector3<f64>,
+) {
+    let (mut p, mut h) = (
+        fbd_kinematics::nalgebra::Vector3::zeros(),
+        fbd_kinematics::nalgebra::Vector3::zeros(),
+    );
+    for body in &mech.bodies {
+        let b = body.model_body;
+        let (c0, c1) = (data.kin.com[b], data.kin_next.com[b]);
+        let v = body.mass * (c1 - c0) / dt;
+        p += v;
+        h += c0.cross(&v)
+            + spatial::half_momentum_value(
+                &data.kin.rotation[b],
+                &data.kin_next.rotation[b],
+                &body.inertia,
+                dt,
+            );
+    }
+    (p, h)
+}
+
+/// The lab hexapod in flight, stepped by Newton on its FBD equations
+/// (tumbling base, legs swinging, no torque): over every step the total
+/// linear momentum changes by exactly `−M·g·Δt` along Y and the angular
+/// momentum about the origin by the moment of gravity `Δt·Σ c_b × m_b·g`
+/// (every joint force and moment is internal and cancels), to solver
+/// tolerance: the generic equations are Newton–Euler's for the whole tree.
+#[test]
+fn lab_hexapod_flight_keeps_the_momentum_laws() {
+    let model = lab();
+    let g = 9.81;
+    let mech = TreeMechanism::new(&model, g);
+    let dims = mech.dims();
+    let (n, nq) = (dims.dim(), mech.nq());
+    let surface = Surface::default();
+    let mut data = TreeFbdData::new(&mech);
+    let mut rng = Rng(11);
+    let mut q = vec![0.0; nq];
+    q[1] = 1.0;
+    for v in &mut q[6..] {
+        *v = 0.5 * rng.next();
+    }
+    let qdot: Vec<f64> = (0..nq)
+        .map(|i| {
+            if i < 6 {
+                1.0 * rng.next()
+            } else {
+                3.0 * rng.next()
+            }
+        })
+        .collect();
+    tree::set_configuration(&mech, &mut data, &q);
+    let mut q_prev = q.clone();
+    let mut solver = fbd_solver::NewtonSolver::new(fbd_solver::NewtonParams::default());
+    let dt = 1e-3;
+    let mass = mech.total_mass();
+    let mut z = vec![0.0; n];
+    let mut last: Option<(
+        fbd_kinematics::nalgebra::Vector3<f64>,
+        fbd_kinematics::nalgebra::Vector3<f64>,
+    )> = None;
+    let mut turned: f64 = 0.0;
+    for k in 0..60 {
+        let history = if k == 0 {
+            History::Initial { qdot: &qdot }
+        } else {
+            History::Previous
+        };
+        tree::prepare_step(&mech, &mut data, history, dt);
+        // Guess: q[k] moved on by the last step's motion (forces: the
+        // last step's).
+        for i in 0..nq {
+            z[i] = if k == 0 {
+                q[i] + dt * qdot[i]
+            } else {
+                2.0 * q[i] - q_prev[i]
+            };
+        }
+        let mut sys = TreeSystem {
+            mech: &mech,
+            surface: &surface,
+            data: &mut data,
+        };
+        solver
+            .solve(&mut sys, &mut z)
+            .unwrap_or_else(|e| panic!("step {k}: {e:?}"));
+        tree::evaluate_next(&mech, &mut data, &z[..nq]);
+        let (p, h) = momenta(&mech, &data, dt);
+        if let Some((p0, h0)) = last {
+            let want_p = p0 - mass * g * dt * fbd_kinematics::nalgebra::Vector3::y();
+            assert!(
+                (p - want_p).norm() < 1e-8 * mass * g * dt,
+                "step {k}: linear momentum {p} vs {want_p}"
+            );
+            let mut gravity = fbd_kinematics::nalgebra::Vector3::zeros();
+            for body in &mech.bodies {
+                let c = data.kin.com[body.model_body];
+                gravity += c.cross(&(-body.mass * g * fbd_kinematics::nalgebra::Vector3::y()));
+            }
+            let want_h = h0 + dt * gravity;
+            assert!(
+                (h - want_h).norm() < 1e-8 * (h.norm() + mass * g * dt),
+                "step {k}: angular momentum {h} vs {want_h}"
+            );
+        }
+        last = Some((p, h));
+        turned = turned.max((z[3] - q[3]).abs());
+        q_prev.copy_from_slice(&q);
+        q.copy_from_slice(&z[..nq]);
+        tree::advance(&mut data);
+    }
+    // It did tumble and fall.
+    assert!(q[1] < 1.0 - 0.5 * g * (60.0 * dt).powi(2) * 0.9, "{}", q[1]);
+    assert!(turned > 0.0);
+}
+
+/// Every single joint's two constraint moments are orthonormal and
+/// across its axis (so with `τ·u` they span every moment), also where the
+/// joint sits at its parent's origin (the fallback direction); a compound
+/// joint's one moment is across both axes.
+#[test]
+fn constraint_moments_span_the_plane_across_each_axis() {
+    let mut at_origin = lab();
+    for j in 0..at_origin.joints.len() {
+        if at_origin.joints[j].parent != 0 {
+            at_origin.joints[j].origin.translation.vector.fill(0.0);
+        }
+    }
+    let params = SpatialParams::default();
+    let dh = fbd_scenario::robot::hexapod_robot(&params);
+    for model in [lab(), at_origin, dh] {
+        let mech = TreeMechanism::new(&model, 9.81);
+        let mut data = TreeFbdData::new(&mech);
+        let mut rng = Rng(3);
+        let mut q = vec![0.0; mech.nq()];
+        for v in &mut q[3..] {
+            *v = rng.next();
+        }
+        tree::set_configuration(&mech, &mut data, &q);
+        tree::set_previous(&mech, &mut data, &q);
+        tree::prepare_step(&mech, &mut data, History::Previous, 1e-3);
+        for (i, re) in mech.reactions.iter().enumerate() {
+            let [d1, d2] = data.moment_dir[i];
+            let u = data.kin.axis[re.joints[0]];
+            assert!((d1.norm() - 1.0).abs() < 1e-12, "{}: {i}", model.name);
+            assert!(d1.dot(&u).abs() < 1e-12, "{}: {i}", model.name);
+            if re.compound {
+                let u2 = data.kin.axis[re.joints[1]];
+                assert!(d1.dot(&u2).abs() < 1e-12, "{}: {i}", model.name);
+            } else {
+                assert!((d2.norm() - 1.0).abs() < 1e-12, "{}: {i}", model.name);
+                assert!(d2.dot(&u).abs() < 1e-12 && d2.dot(&d1).abs() < 1e-12);
+            }
+        }
+    }
 }

@@ -49,7 +49,10 @@
 //! [`tree`] writes the same per-body balances for any
 //! [`fbd_robot::RobotModel`] (an imported URDF/MJCF robot or a D-H
 //! instance): inverse dynamics body by body, every joint's force, moment and
-//! torque explicit.
+//! torque explicit ([`tree::inverse`]); the kinematics with analytic
+//! Jacobians ([`tree::kin`]); and the step's residual and Jacobian as one
+//! more [`assembly::FbdModel`] ([`tree::mechanism`], [`tree::assemble`]),
+//! equal to the 3D hexapod's for the hexapod built from its D-H rows.
 
 pub mod assemble;
 pub mod assembly;

@@ -170,7 +170,10 @@ fn moment_directions(mech: &TreeMechanism, kin: &TreeKin, i: usize) -> [Vector3<
     let re = &mech.reactions[i];
     let [j1, j2] = re.joints;
     if re.compound {
-        return [kin.axis[j1].cross(&kin.axis[j2]).normalize(), Vector3::zeros()];
+        return [
+            kin.axis[j1].cross(&kin.axis[j2]).normalize(),
+            Vector3::zeros(),
+        ];
     }
     let u = kin.axis[j1];
     let parent = mech.model.joints[j1].parent;
@@ -294,10 +297,7 @@ pub fn eval<S: JacobianSink>(
 }
 
 #[inline]
-fn columns(
-    cols: impl Iterator<Item = (usize, Vector3<f64>)>,
-    mut f: impl FnMut(usize, &[f64; 3]),
-) {
+fn columns(cols: impl Iterator<Item = (usize, Vector3<f64>)>, mut f: impl FnMut(usize, &[f64; 3])) {
     for (i, v) in cols {
         f(i, &[v.x, v.y, v.z]);
     }

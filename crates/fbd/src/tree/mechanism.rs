@@ -136,7 +136,10 @@ pub struct TreeMechanism {
 /// `tip{n}`, `knee{n}`, `hip{n}` leg by leg) that is every tip, then every
 /// knee, then every hip: the order of [`crate::spatial::SpatialMechanism`].
 pub fn contacts_by_kind(model: &RobotModel) -> Vec<usize> {
-    let stem = |name: &str| name.trim_end_matches(|c: char| c.is_ascii_digit()).to_owned();
+    let stem = |name: &str| {
+        name.trim_end_matches(|c: char| c.is_ascii_digit())
+            .to_owned()
+    };
     let mut stems: Vec<String> = Vec::new();
     for c in &model.contacts {
         let s = stem(&c.name);

@@ -143,6 +143,53 @@ pub fn load(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Loade
     })
 }
 
+/// The robot of a `model = "robot"` configuration (a path, TOML text or a
+/// dict; a description path in text or a dict is relative to the working
+/// directory), `None` for the paper's models.
+pub fn load_robot(
+    py: Python<'_>,
+    config: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Option<fbd_scenario::robot::LoadedRobot>> {
+    use fbd_scenario::robot::{is_robot, load_str};
+    let Some(obj) = config.filter(|c| !c.is_none()) else {
+        return Ok(None);
+    };
+    let err =
+        |e: fbd_scenario::ConfigError, from_text| crate::errors::config_error(py, &e, from_text);
+    if let Ok(d) = obj.cast::<PyDict>() {
+        let table = to_table(d, "")?;
+        if table.get("model").and_then(|m| m.as_str()) != Some(fbd_scenario::robot::MODEL) {
+            return Ok(None);
+        }
+        let text = toml::to_string(&table)
+            .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))?;
+        return load_str(&text, std::path::Path::new(DICT_SOURCE))
+            .map(Some)
+            .map_err(|e| err(e, false));
+    }
+    if let Ok(s) = obj.cast::<PyString>() {
+        let s: String = s.extract()?;
+        if is_toml_text(&s) {
+            if !is_robot(&s) {
+                return Ok(None);
+            }
+            return load_str(&s, std::path::Path::new(STRING_SOURCE))
+                .map(Some)
+                .map_err(|e| err(e, true));
+        }
+    }
+    let Ok(path) = obj.extract::<PathBuf>() else {
+        return Ok(None); // `load` gives the error
+    };
+    let Ok(text) = fbd_scenario::read_text(&path) else {
+        return Ok(None); // `load` gives the error
+    };
+    if !is_robot(&text) {
+        return Ok(None);
+    }
+    load_str(&text, &path).map(Some).map_err(|e| err(e, true))
+}
+
 /// `config_toml(config=None) -> str`: the complete configuration with every
 /// key, as `fbd run` writes it to `config.toml`.
 #[pyfunction]

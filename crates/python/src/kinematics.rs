@@ -64,8 +64,74 @@ fn check_width(name: &str, q: &PyReadonlyArray2<'_, f64>, width: usize) -> PyRes
 #[pyo3(signature = (config=None))]
 pub fn kinematics_json(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<String> {
     guard(|| {
+        if let Some(robot) = crate::config::load_robot(py, config)? {
+            return serde_json::to_string(&robot.kinematics())
+                .map_err(|e| PyValueError::new_err(e.to_string()));
+        }
         let loaded = crate::config::load(py, config)?;
         Ok(fbd_cli::kinematics::initial_kinematics(&loaded.config).to_json())
+    })
+}
+
+/// The robot of `config`, or the error saying that only an imported
+/// robot has inverse dynamics.
+fn robot_of(
+    py: Python<'_>,
+    config: Option<&Bound<'_, PyAny>>,
+) -> PyResult<fbd_scenario::robot::LoadedRobot> {
+    crate::config::load_robot(py, config)?.ok_or_else(|| {
+        PyValueError::new_err(
+            "inverse: takes a model = \"robot\" configuration (an imported URDF or MJCF robot)",
+        )
+    })
+}
+
+/// `inverse_json(config) -> str`: `fbd inverse CONFIG` (the state's
+/// inverse dynamics by the FBD method) as JSON.
+#[pyfunction]
+pub fn inverse_json(py: Python<'_>, config: &Bound<'_, PyAny>) -> PyResult<String> {
+    guard(|| {
+        serde_json::to_string(&robot_of(py, Some(config))?.inverse())
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    })
+}
+
+/// `inverse_motion(config, columns, values) -> (names, table)`: `fbd
+/// inverse CONFIG --motion` of the motion with these column names and
+/// values (shape `(N, len(columns))`).
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+pub fn inverse_motion<'py>(
+    py: Python<'py>,
+    config: &Bound<'py, PyAny>,
+    columns: Vec<String>,
+    values: PyReadonlyArray2<'py, f64>,
+) -> PyResult<(Vec<String>, Bound<'py, PyArray2<f64>>)> {
+    guard(|| {
+        let robot = robot_of(py, Some(config))?;
+        check_width("motion", &values, columns.len())?;
+        // The same reader as the CLI's (one set of rules): the values as
+        // CSV, each written exactly (shortest round-trip decimals).
+        let v = values.as_array();
+        let mut text = columns.join(",");
+        text.push('\n');
+        for row in v.rows() {
+            let cells: Vec<String> = row.iter().map(|x| format!("{x}")).collect();
+            text.push_str(&cells.join(","));
+            text.push('\n');
+        }
+        let motion = robot
+            .read_motion(&text, "<motion>")
+            .map_err(|e| crate::errors::config_error(py, &e, false))?;
+        let rows = robot.inverse_along(&motion);
+        let names = robot.inverse_columns();
+        let mut out = Array2::<f64>::zeros((rows.len(), names.len()));
+        for (i, r) in rows.iter().enumerate() {
+            for (j, x) in r.iter().enumerate() {
+                out[(i, j)] = *x;
+            }
+        }
+        Ok((names, PyArray2::from_owned_array(py, out)))
     })
 }
 

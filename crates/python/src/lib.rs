@@ -29,6 +29,8 @@ fn _fbd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run::run, m)?)?;
     m.add_function(wrap_pyfunction!(sweep::sweep, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::kinematics_json, m)?)?;
+    m.add_function(wrap_pyfunction!(kinematics::inverse_json, m)?)?;
+    m.add_function(wrap_pyfunction!(kinematics::inverse_motion, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::planar_fk, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::hexapod_fk, m)?)?;
     m.add_function(wrap_pyfunction!(kinematics::leg_ik, m)?)?;

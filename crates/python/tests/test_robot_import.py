@@ -284,3 +284,43 @@ def test_fbd_inverse_along_a_motion_matches_pinocchio(cli, tmp_path):
         rb = TURN @ r_pin
         np.testing.assert_allclose([got[f"base_f{c}"] for c in "xyz"], rb @ tau[:3], atol=tol)
         np.testing.assert_allclose([got[f"base_m{c}"] for c in "xyz"], rb @ tau[3:6], atol=tol)
+
+
+def test_the_python_api_gives_what_the_cli_gives(cli, tmp_path):
+    """``fbd.kinematics``, ``fbd.inverse`` and ``fbd.inverse(motion=…)`` on
+    an imported robot equal ``fbd kinematics``, ``fbd inverse`` and ``fbd
+    inverse --motion`` (one library under both), for a path, TOML text and
+    a dict."""
+    import fbd
+    import pandas as pd
+
+    lab = ROOT / "examples/robots/lab_hexapod.toml"
+    for command, call in (("kinematics", fbd.kinematics), ("inverse", fbd.inverse)):
+        want = fbd_json(cli, command, lab)
+        assert call(lab) == want
+        assert call(str(lab)) == want
+        text = lab.read_text().replace('urdf = "lab_hexapod.urdf"', f'urdf = "{lab.parent / "lab_hexapod.urdf"}"')
+        assert call(text) == want
+    d = {"model": "robot", "robot": {"urdf": str(lab.parent / "lab_hexapod.urdf")}}
+    assert fbd.kinematics(d)["mass"] == pytest.approx(3.76)
+
+    t = np.arange(12) * 0.02
+    motion = pd.DataFrame({"t": t, "ry": 0.2 + 0.1 * t})
+    for i, j in enumerate(fbd.kinematics(lab)["joints"]):
+        motion[j["name"]] = 0.3 * np.sin(3 * t + i)
+    motion_csv = tmp_path / "motion.csv"
+    motion.to_csv(motion_csv, index=False, float_format="%.17g")
+    out = subprocess.run([str(cli), "inverse", str(lab), "--motion", str(motion_csv)],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    want = pd.read_csv(__import__("io").StringIO(out.stdout))
+    got = fbd.inverse(lab, motion)
+    assert list(got) == list(want.columns)
+    for c in want.columns:
+        np.testing.assert_array_equal(got[c], want[c].to_numpy(), err_msg=c)
+    got_dict = fbd.inverse(lab, {c: motion[c].to_numpy() for c in motion.columns})
+    np.testing.assert_array_equal(got_dict["tau_lf_femur_joint"], got["tau_lf_femur_joint"])
+    with pytest.raises(fbd.ConfigError, match="samples must be uniformly spaced"):
+        fbd.inverse(lab, motion.assign(t=t * t))
+    with pytest.raises(ValueError, match="model = \"robot\""):
+        fbd.inverse(ROOT / "examples/paper.toml")

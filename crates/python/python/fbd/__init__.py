@@ -38,6 +38,7 @@ __all__ = [
     "SweepResult",
     "config_toml",
     "hexapod_fk",
+    "inverse",
     "kinematics",
     "leg_ik",
     "planar_fk",
@@ -174,8 +175,32 @@ def kinematics(config: ConfigLike = None) -> Dict[str, Any]:
     """Hip, knee and tip of every leg at the configuration's initial state,
     inertial frame (m): the JSON of ``fbd kinematics`` as Python objects,
     ``{"legs": [{"leg": 3, "hip": [x, y, z], "knee": ..., "tip": ...}, ...]}``.
+    For an imported robot (``model = "robot"``): every body, joint and
+    contact point (``{"robot", "mass", "com", "bodies", "joints",
+    "contacts", ...}``, docs/reference.md).
     """
     return _json.loads(_fbd.kinematics_json(config))
+
+
+def inverse(config: ConfigLike, motion: Any = None) -> Dict[str, Any]:
+    """Inverse dynamics of an imported robot (``model = "robot"``) by the FBD
+    method, as ``fbd inverse``.
+
+    Without ``motion``: for the configuration's state and ``[inverse]``
+    accelerations, ``{"base_force", "base_moment", "joints": [{"name",
+    "force", "moment", "torque", "constraint_moment"}, ...]}`` (N, N·m,
+    inertial frame). With ``motion`` (a mapping of column name to values,
+    e.g. a pandas DataFrame: ``t``, one column per joint in rad, optionally
+    ``rx, ry, rz, phi_x, phi_y, phi_z``): the forces at every interior
+    sample as a dict of NumPy columns (``t``, ``base_fx`` …, ``tau_<joint>``,
+    ``<joint>_fx`` …), velocities and accelerations by central differences.
+    """
+    if motion is None:
+        return _json.loads(_fbd.inverse_json(config))
+    columns = [str(c) for c in (motion.keys() if isinstance(motion, _Mapping) else motion.columns)]
+    values = _np.column_stack([_np.asarray(motion[c], dtype=_np.float64) for c in columns])
+    names, table = _fbd.inverse_motion(config, columns, values)
+    return {name: table[:, i] for i, name in enumerate(names)}
 
 
 def _rows(a: Any, width: int, name: str) -> Tuple[_np.ndarray, bool]:

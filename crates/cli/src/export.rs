@@ -42,6 +42,11 @@ pub fn export_command(format: ExportFormat, out: &mut dyn Write) -> Result<(), C
 /// `fbd export mjcf CONFIG [--out FILE]`.
 pub fn mjcf_command(path: &Path, dest: Option<&Path>, out: &mut dyn Write) -> Result<(), CliError> {
     let file = path.display().to_string();
+    let text = config::read_text(path)?;
+    if config::robot::is_robot(&text) {
+        let robot = config::robot::load_str(&text, path)?;
+        return write_out(&robot.mjcf(), dest, out);
+    }
     let hexapod = match config::load(path)? {
         Config::Hexapod(h) => h,
         Config::Planar(_) => {
@@ -53,6 +58,11 @@ pub fn mjcf_command(path: &Path, dest: Option<&Path>, out: &mut dyn Write) -> Re
     };
     let params = hexapod.spatial_params(&file)?;
     let xml = config::mjcf::mjcf(&params, &file)?;
+    write_out(&xml, dest, out)
+}
+
+/// Writes `xml` to `dest` (all or nothing) or to `out`.
+fn write_out(xml: &str, dest: Option<&Path>, out: &mut dyn Write) -> Result<(), CliError> {
     match dest {
         None => out
             .write_all(xml.as_bytes())

@@ -219,3 +219,32 @@ fn a_bad_motion_is_one_line_naming_the_file_and_line() {
     let e = one_line_error(&fbd(&["inverse", &cfg, "--out", "x.csv"]), 2);
     assert!(e.contains("--motion"), "{e}");
 }
+
+#[test]
+fn export_mjcf_writes_an_imported_robot_all_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let dest = dir.path().join("lab.xml");
+    let out = fbd(&[
+        "export",
+        "mjcf",
+        &example("robots/lab_hexapod.toml"),
+        "--out",
+        s(&dest),
+    ]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let xml = std::fs::read_to_string(&dest).unwrap();
+    // Read back, it is the robot the configuration names.
+    let model = fbd_robot::mjcf::parse(&dest, &xml)
+        .and_then(|t| {
+            t.build(
+                fbd_robot::Up::Y,
+                &fbd_robot::ContactChoice::CollisionSpheres,
+            )
+        })
+        .unwrap();
+    assert_eq!(model.joints.len(), 18);
+    assert!((model.mass() - 3.76).abs() < 1e-12);
+    assert_eq!(model.contacts.len(), 6);
+    // Nothing but the file in the directory (no temporary left).
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}

@@ -1,5 +1,8 @@
 """Imported MJCF robots against MuJoCo loading the same file.
 
+Also ``fbd export mjcf`` of imported URDF robots (the lab hexapod, Solo-12):
+MuJoCo and fbd read the exported file alike.
+
 ``fbd kinematics`` and ``fbd inverse`` of an MJCF description — the
 hexapod that ``fbd export mjcf`` writes and a small quadruped with
 defaults, classes, Euler angles, two hinges at different points of one
@@ -39,7 +42,31 @@ def quadruped_xml(cli, tmp_path):
     return ROOT / "crates/robot/tests/data/mjcf_quadruped.xml", "z"
 
 
-@pytest.mark.parametrize("which", [hexapod_xml, quadruped_xml])
+def exported(cli, tmp_path, config):
+    out = tmp_path / "exported.xml"
+    r = subprocess.run([str(cli), "export", "mjcf", str(config), "--out", str(out)],
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    return out, "y"
+
+
+def lab_export_xml(cli, tmp_path):
+    """``fbd export mjcf`` of an imported URDF robot (the lab hexapod)."""
+    return exported(cli, tmp_path, ROOT / "examples/robots/lab_hexapod.toml")
+
+
+def solo_export_xml(cli, tmp_path):
+    """``fbd export mjcf`` of Solo-12 from example-robot-data (feet named)."""
+    import importlib.metadata
+
+    dist = importlib.metadata.distribution("example-robot-data")
+    urdf = dist.locate_file("cmeel.prefix/share/example-robot-data/robots/solo_description/robots/solo12.urdf")
+    cfg = write_config(tmp_path / "solo.toml", urdf,
+                       contacts=["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"])
+    return exported(cli, tmp_path, cfg)
+
+
+@pytest.mark.parametrize("which", [hexapod_xml, quadruped_xml, lab_export_xml, solo_export_xml])
 def test_imported_mjcf_matches_mujoco(cli, tmp_path, which):
     path, up = which(cli, tmp_path)
     turn = TURN if up == "z" else np.eye(3)

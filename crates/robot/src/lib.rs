@@ -9,6 +9,8 @@
 //!   line and element for anything fbd does not model;
 //! * [`dh`] builds a model from Denavit–Hartenberg rows, and the paper's
 //!   hexapod ([`dh::hexapod`]) from its D-H parameters;
+//! * [`mjcf_export::to_mjcf`] writes any model as a MuJoCo model in fbd's
+//!   frames;
 //! * [`forward()`] places every body, joint axis and contact point for a
 //!   floating-base pose and joint angles.
 //!
@@ -19,6 +21,7 @@ pub mod dh;
 pub mod error;
 pub mod forward;
 pub mod mjcf;
+pub mod mjcf_export;
 pub mod model;
 pub mod tree;
 pub mod urdf;

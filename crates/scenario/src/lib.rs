@@ -1399,8 +1399,8 @@ fn robot_not_yet(table: &toml::Table, file: &str) -> Result<(), ConfigError> {
         Some(toml::Value::String(s)) if s == robot::MODEL => Err(ConfigError::Semantic {
             file: file.to_owned(),
             message: "model = \"robot\": an imported URDF/MJCF robot works with \
-                      `fbd kinematics` so far; `fbd run`, `sweep` and `export` take \
-                      model = \"planar\" or \"hexapod\""
+                      `fbd kinematics`, `fbd inverse` and `fbd export mjcf` so far; \
+                      `fbd run` and `sweep` take model = \"planar\" or \"hexapod\""
                 .to_owned(),
         }),
         _ => Ok(()),

@@ -375,6 +375,17 @@ fn rows(m: &fbd_robot::nalgebra::Matrix3<f64>) -> [[f64; 3]; 3] {
 }
 
 impl LoadedRobot {
+    /// The robot as a MuJoCo model in fbd's frames, its root at the initial
+    /// pose (`fbd export mjcf`, [`fbd_robot::mjcf_export`]).
+    pub fn mjcf(&self) -> String {
+        fbd_robot::mjcf_export::to_mjcf(
+            &self.model,
+            self.gravity,
+            fbd_robot::mjcf_export::TIMESTEP,
+            &self.base,
+        )
+    }
+
     /// Every body, joint and contact point at the initial state.
     pub fn kinematics(&self) -> RobotKinematics {
         let m = &self.model;

@@ -248,3 +248,52 @@ fn export_mjcf_writes_an_imported_robot_all_or_nothing() {
     // Nothing but the file in the directory (no temporary left).
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
+
+#[test]
+fn contacts_at_places_the_feet_by_inverse_kinematics() {
+    let v = json(&fbd(&[
+        "kinematics",
+        &example("robots/lab_hexapod_stand.toml"),
+    ]));
+    let text = std::fs::read_to_string(example("robots/lab_hexapod_stand.toml")).unwrap();
+    let table: toml::Table = toml::from_str(&text).unwrap();
+    let targets = table["initial"]["contacts_at"].as_table().unwrap();
+    for f in v["contacts"].as_array().unwrap() {
+        let want = targets[f["name"].as_str().unwrap()].as_array().unwrap();
+        for k in 0..3 {
+            let (got, want) = (
+                f["position"][k].as_f64().unwrap(),
+                want[k].as_float().unwrap(),
+            );
+            assert!((got - want).abs() <= 1e-10, "{f}");
+        }
+    }
+    // Every joint inside its limits.
+    for j in v["joints"].as_array().unwrap() {
+        let (a, l) = (j["angle"].as_f64().unwrap(), &j["limits"]);
+        assert!(
+            l[0].as_f64().unwrap() <= a && a <= l[1].as_f64().unwrap(),
+            "{j}"
+        );
+    }
+    // A foot out of reach names itself and the distance left.
+    let dir = tempfile::tempdir().unwrap();
+    let far = text.replace(
+        "rm_foot_sphere = [0.23, 0.01, 0.0]",
+        "rm_foot_sphere = [0.9, 0.01, 0.0]",
+    );
+    let cfg = write(
+        dir.path(),
+        "far.toml",
+        &far.replace(
+            "\"lab_hexapod.urdf\"",
+            &format!("\"{}\"", example("robots/lab_hexapod.urdf")),
+        ),
+    );
+    let e = one_line_error(&fbd(&["kinematics", s(&cfg)]), 2);
+    assert!(
+        e.contains("initial.contacts_at.rm_foot_sphere: out of reach")
+            && e.contains(" m from its target"),
+        "{e}"
+    );
+}

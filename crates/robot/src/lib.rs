@@ -9,6 +9,8 @@
 //!   line and element for anything fbd does not model;
 //! * [`dh`] builds a model from Denavit–Hartenberg rows, and the paper's
 //!   hexapod ([`dh::hexapod`]) from its D-H parameters;
+//! * [`ik::solve`] finds joint angles that put contact points at targets
+//!   (damped least squares, joint limits respected);
 //! * [`mjcf_export::to_mjcf`] writes any model as a MuJoCo model in fbd's
 //!   frames;
 //! * [`forward()`] places every body, joint axis and contact point for a
@@ -20,6 +22,7 @@
 pub mod dh;
 pub mod error;
 pub mod forward;
+pub mod ik;
 pub mod mjcf;
 pub mod mjcf_export;
 pub mod model;

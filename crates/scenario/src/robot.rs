@@ -66,6 +66,11 @@ pub struct RobotInitial {
     /// Joint rates by joint name (deg/s); others 0.
     #[serde(default)]
     pub rates_deg: BTreeMap<String, f64>,
+    /// Contact points placed at inertial positions (m) by numeric inverse
+    /// kinematics of their chains ([`fbd_robot::ik`]), starting from
+    /// `joints_deg`; the root stays at `position`, `phi_deg`.
+    #[serde(default)]
+    pub contacts_at: BTreeMap<String, [f64; 3]>,
 }
 
 /// `[world]` of an imported robot.
@@ -239,7 +244,7 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         }
         Ok(out)
     };
-    let q = joints("initial.joints_deg", &init.joints_deg, true)?;
+    let mut q = joints("initial.joints_deg", &init.joints_deg, true)?;
     let qd = joints("initial.rates_deg", &init.rates_deg, false)?;
     let inv = &config.inverse;
     let qdd = joints("inverse.joints_deg", &inv.joints_deg, false)?;
@@ -268,6 +273,36 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         ));
     }
     let base = fbd_robot::forward::base_frame(init.position, init.phi_deg.map(f64::to_radians));
+    if !init.contacts_at.is_empty() {
+        let mut targets = Vec::with_capacity(init.contacts_at.len());
+        for (name, p) in &init.contacts_at {
+            let Some(c) = model.contacts.iter().position(|c| &c.name == name) else {
+                let known: Vec<&str> = model.contacts.iter().map(|c| c.name.as_str()).collect();
+                return Err(semantic(
+                    &file,
+                    format!(
+                        "initial.contacts_at.{name}: no such contact point{}",
+                        suggest_name(name, &known)
+                    ),
+                ));
+            };
+            if p.iter().any(|x| !x.is_finite()) {
+                return Err(semantic(
+                    &file,
+                    format!("initial.contacts_at.{name}: must be finite"),
+                ));
+            }
+            targets.push((c, fbd_robot::nalgebra::Vector3::from(*p)));
+        }
+        q = fbd_robot::ik::solve(&model, &base, &q, &targets, &Default::default()).map_err(
+            |e| {
+                semantic(
+                    &file,
+                    format!("initial.contacts_at.{}: out of reach: {e}", e.point),
+                )
+            },
+        )?;
+    }
     Ok(LoadedRobot {
         description,
         model,

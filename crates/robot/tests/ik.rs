@@ -59,14 +59,7 @@ fn a_foot_out_of_reach_is_an_error_naming_it() {
         .iter()
         .position(|c| c.name == "rm_foot_sphere")
         .unwrap();
-    let err = solve(
-        &model,
-        &base,
-        &vec![0.0; 18],
-        &[(c, far)],
-        &IkParams::default(),
-    )
-    .unwrap_err();
+    let err = solve(&model, &base, &[0.0; 18], &[(c, far)], &IkParams::default()).unwrap_err();
     assert_eq!(err.point, "rm_foot_sphere");
     assert!(err.distance > 0.5, "{err}");
     assert!(err.to_string().contains("rm_foot_sphere"));

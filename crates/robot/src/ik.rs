@@ -75,7 +75,7 @@ pub fn solve(
     model: &RobotModel,
     base: &Isometry3<f64>,
     q: &[f64],
-    targets: &[(usize, Vector3<f64>)],
+    targets: &[Target],
     params: &IkParams,
 ) -> Result<Vec<f64>, IkError> {
     // Points whose chains share no joint are solved apart (a leg each).
@@ -110,7 +110,7 @@ fn solve_group(
     model: &RobotModel,
     base: &Isometry3<f64>,
     q: &[f64],
-    targets: &[(usize, Vector3<f64>)],
+    targets: &[Target],
     params: &IkParams,
 ) -> Result<Vec<f64>, IkError> {
     let mut best: Option<IkError> = None;
@@ -183,7 +183,7 @@ fn attempt(
     model: &RobotModel,
     base: &Isometry3<f64>,
     q: &[f64],
-    targets: &[(usize, Vector3<f64>)],
+    targets: &[Target],
     params: &IkParams,
 ) -> Result<Vec<f64>, IkError> {
     let joints = moved_joints(model, targets);

@@ -29,8 +29,9 @@ pub const TIMESTEP: f64 = 0.001;
 /// Radius of the sphere written for a contact point of radius 0 (m).
 pub const POINT_RADIUS: f64 = 0.005;
 
-/// Shortest round-trip decimal of `x`.
-fn num(x: f64) -> String {
+/// Shortest round-trip decimal of `x` (what `f64` parsing gives back
+/// exactly; `{:?}` switches to exponents for tiny and huge values).
+pub fn num(x: f64) -> String {
     if x == 0.0 {
         return "0".to_owned();
     }
@@ -38,7 +39,8 @@ fn num(x: f64) -> String {
     s.strip_suffix(".0").map(str::to_owned).unwrap_or(s)
 }
 
-fn nums(xs: &[f64]) -> String {
+/// Space-separated numbers ([`num`]).
+pub fn nums(xs: &[f64]) -> String {
     xs.iter().map(|&x| num(x)).collect::<Vec<_>>().join(" ")
 }
 

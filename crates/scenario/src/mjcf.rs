@@ -64,21 +64,7 @@ pub const SPHERE_RADIUS: f64 = 0.01;
 /// The name of the keyframe holding the initial state.
 pub const KEYFRAME: &str = "initial";
 
-/// Shortest round-trip decimal of `x` (what `f64` parsing gives back
-/// exactly).
-fn num(x: f64) -> String {
-    // `{:?}` is exact and switches to exponents for tiny and huge values.
-    if x == 0.0 {
-        return "0".to_owned();
-    }
-    let s = format!("{x:?}");
-    s.strip_suffix(".0").map(str::to_owned).unwrap_or(s)
-}
-
-/// Space-separated numbers.
-fn nums(xs: &[f64]) -> String {
-    xs.iter().map(|&x| num(x)).collect::<Vec<_>>().join(" ")
-}
+use fbd_robot::mjcf_export::{num, nums};
 
 /// `w x y z` of a rotation matrix.
 fn quat(m: &Matrix3<f64>) -> String {

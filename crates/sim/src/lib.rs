@@ -11,6 +11,8 @@
 //! * [`run`] — the whole loop with per-row callback and a [`RunSummary`].
 //! * [`simulator`] — the stepping API for controllers outside the
 //!   simulator, every model: actions, state save/restore, readouts.
+//! * [`tree`] — a flight stepper (no ground, no joint stops) for any
+//!   robot model on the generic FBD equations of `fbd_dynamics::tree`.
 //! * [`gait`] — the kinematic gait of the 24-DOF hexapod (gait schedule,
 //!   body path, footholds, swing, IK with rates and accelerations, static
 //!   stability), with its own model/workspace pair and run loop.
@@ -42,6 +44,7 @@ pub mod simulator;
 pub mod spatial;
 pub mod step;
 mod system;
+pub mod tree;
 
 pub use control::{Control, LegTrajectory};
 pub use data::Data;

@@ -22,6 +22,7 @@ pub mod interrupt;
 pub mod kinematics;
 pub mod output;
 pub mod plot;
+pub mod robot_run;
 pub mod run;
 pub mod spatial;
 pub mod steptime;

@@ -431,6 +431,13 @@ pub fn run_command(
     out_dir: &Path,
     out: &mut dyn Write,
 ) -> Result<(), CliError> {
+    if let Some(p) = config_path {
+        let text = config::read_text(p)?;
+        if config::robot::is_robot(&text) {
+            // An imported robot in flight: every file in `robot_run`.
+            return crate::robot_run::run_command(&text, p, out_dir, out);
+        }
+    }
     let (config, source) = match config_path {
         Some(p) => (config::load(p)?, p.display().to_string()),
         None => (Config::default(), "the built-in default".to_owned()),

@@ -1398,9 +1398,11 @@ fn robot_not_yet(table: &toml::Table, file: &str) -> Result<(), ConfigError> {
     match table.get("model") {
         Some(toml::Value::String(s)) if s == robot::MODEL => Err(ConfigError::Semantic {
             file: file.to_owned(),
-            message: "model = \"robot\": an imported URDF/MJCF robot works with \
-                      `fbd kinematics`, `fbd inverse` and `fbd export mjcf` so far; \
-                      `fbd run` and `sweep` take model = \"planar\" or \"hexapod\""
+            message: "model = \"robot\": an imported URDF/MJCF robot works with the \
+                      commands `fbd run` (in flight), `fbd kinematics`, `fbd inverse` and \
+                      `fbd export mjcf`, and with Python's fbd.kinematics and fbd.inverse, \
+                      so far; sweeps, fbd.run and fbd.Simulator take model = \"planar\" \
+                      or \"hexapod\""
                 .to_owned(),
         }),
         _ => Ok(()),

@@ -11,17 +11,24 @@
 //! position = [0.0, 0.4, 0.0]  # optional: the root frame's origin (m)
 //! phi_deg = [0.0, 0.0, 0.0]   # optional: φx, φy, φz of the root frame
 //! joints_deg = { FL_KFE = -60.0 }  # optional: joint angles, others 0
+//! [time]
+//! dt = 0.001                  # optional: the step (s)
+//! duration = 1.0              # optional (s)
+//! [terrain]
+//! kind = "none"               # only "none" (flight) so far
+//! [output]
+//! stride = 1                  # optional: every stride-th step is written
 //! ```
 //!
-//! So far `fbd kinematics` takes such a configuration; running it needs the
-//! generic FBD model (see the README).
+//! `fbd kinematics`, `fbd inverse`, `fbd export mjcf` take such a
+//! configuration, and `fbd run` simulates it in flight ([`LoadedRobot::run_flight`]).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use fbd_robot::nalgebra::Isometry3;
 use fbd_robot::{ContactChoice, RobotModel, Up};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
 use crate::ConfigError;
 
@@ -29,23 +36,27 @@ use crate::ConfigError;
 pub const MODEL: &str = "robot";
 
 /// `[robot]`.
-#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RobotSection {
     /// A URDF file, relative to the configuration's directory.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub urdf: Option<String>,
     /// An MJCF file, relative to the configuration's directory.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub mjcf: Option<String>,
     /// The description's up axis, `"z"` (default: ROS and MuJoCo) or
     /// `"y"` (fbd's own exports).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub up: Option<String>,
     /// The contact points by name (links, sites, collision spheres);
     /// default every collision sphere.
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub contacts: Option<Vec<String>>,
 }
 
 /// `[initial]` of an imported robot.
-#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RobotInitial {
     /// The root frame's origin in the inertial frame (m). Default 0.
@@ -74,7 +85,7 @@ pub struct RobotInitial {
 }
 
 /// `[world]` of an imported robot.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RobotWorld {
     /// Gravitational acceleration along −Y (m/s²). Default 9.81.
@@ -95,7 +106,7 @@ impl Default for RobotWorld {
 }
 
 /// `[inverse]`: the accelerations of `fbd inverse`.
-#[derive(Clone, Debug, Default, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RobotInverse {
     /// Acceleration of the root frame's origin (m/s², inertial). Default 0.
@@ -109,8 +120,79 @@ pub struct RobotInverse {
     pub joints_deg: BTreeMap<String, f64>,
 }
 
+/// `[time]` of an imported robot.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotTime {
+    /// The time step Δt (s). Default 0.001.
+    #[serde(default = "default_dt")]
+    pub dt: f64,
+    /// The simulated time (s). Default 1.0.
+    #[serde(default = "default_duration")]
+    pub duration: f64,
+}
+
+fn default_dt() -> f64 {
+    0.001
+}
+
+fn default_duration() -> f64 {
+    1.0
+}
+
+impl Default for RobotTime {
+    fn default() -> Self {
+        Self {
+            dt: default_dt(),
+            duration: default_duration(),
+        }
+    }
+}
+
+/// `[terrain]` of an imported robot: only `"none"` (flight) so far.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotTerrain {
+    /// `"none"` (default): no ground.
+    #[serde(default = "default_terrain")]
+    pub kind: String,
+}
+
+fn default_terrain() -> String {
+    "none".to_owned()
+}
+
+impl Default for RobotTerrain {
+    fn default() -> Self {
+        Self {
+            kind: default_terrain(),
+        }
+    }
+}
+
+/// `[output]` of an imported robot.
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotOutput {
+    /// Every `stride`-th step is written (≥ 1). Default 1.
+    #[serde(default = "default_stride")]
+    pub stride: usize,
+}
+
+fn default_stride() -> usize {
+    1
+}
+
+impl Default for RobotOutput {
+    fn default() -> Self {
+        Self {
+            stride: default_stride(),
+        }
+    }
+}
+
 /// A `model = "robot"` configuration file.
-#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct RobotConfig {
     /// `"robot"`.
@@ -126,6 +208,23 @@ pub struct RobotConfig {
     /// `[inverse]`.
     #[serde(default)]
     pub inverse: RobotInverse,
+    /// `[time]`.
+    #[serde(default)]
+    pub time: RobotTime,
+    /// `[terrain]`.
+    #[serde(default)]
+    pub terrain: RobotTerrain,
+    /// `[output]`.
+    #[serde(default)]
+    pub output: RobotOutput,
+}
+
+impl RobotConfig {
+    /// The configuration as TOML (every key, defaults filled when it comes
+    /// from [`LoadedRobot::config`]).
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("a robot configuration serializes to TOML")
+    }
 }
 
 /// A loaded robot and its initial state.
@@ -152,6 +251,9 @@ pub struct LoadedRobot {
     /// `[inverse]`: root acceleration (m/s²), angular acceleration
     /// (rad/s²), joint accelerations (rad/s²).
     pub acceleration: ([f64; 3], [f64; 3], Vec<f64>),
+    /// The complete configuration: every default filled, the description
+    /// given by its canonical path (`config.toml` of a run repeats it).
+    pub config: RobotConfig,
 }
 
 /// Whether the TOML `text` says `model = "robot"`.
@@ -272,6 +374,43 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
             "≥ 0 m/s²",
         ));
     }
+    let t = &config.time;
+    if !(t.dt.is_finite() && t.dt > 0.0) {
+        return Err(ConfigError::semantic(
+            &file,
+            "time.dt",
+            "out of range",
+            t.dt,
+            "> 0 s, finite",
+        ));
+    }
+    if !(t.duration.is_finite() && t.duration >= 0.0) {
+        return Err(ConfigError::semantic(
+            &file,
+            "time.duration",
+            "out of range",
+            t.duration,
+            "≥ 0 s, finite",
+        ));
+    }
+    if config.terrain.kind != "none" {
+        return Err(semantic(
+            &file,
+            format!(
+                "terrain.kind: ground contact for imported robots is not built yet (got \"{}\", expected \"none\")",
+                config.terrain.kind
+            ),
+        ));
+    }
+    if config.output.stride < 1 {
+        return Err(ConfigError::semantic(
+            &file,
+            "output.stride",
+            "out of range",
+            config.output.stride,
+            "≥ 1",
+        ));
+    }
     let base = fbd_robot::forward::base_frame(init.position, init.phi_deg.map(f64::to_radians));
     if !init.contacts_at.is_empty() {
         let mut targets = Vec::with_capacity(init.contacts_at.len());
@@ -303,6 +442,7 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
             },
         )?;
     }
+    let config = complete(&config, &description);
     Ok(LoadedRobot {
         description,
         model,
@@ -314,7 +454,25 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         initial_phi: init.phi_deg.map(f64::to_radians),
         gravity: g,
         acceleration: (inv.acceleration, inv.alpha_deg.map(f64::to_radians), qdd),
+        config,
     })
+}
+
+/// `config` with every default filled and its description given by its
+/// canonical (absolute) path.
+fn complete(config: &RobotConfig, description: &Path) -> RobotConfig {
+    let mut c = config.clone();
+    let path = std::fs::canonicalize(description)
+        .unwrap_or_else(|_| description.to_path_buf())
+        .display()
+        .to_string();
+    if c.robot.urdf.is_some() {
+        c.robot.urdf = Some(path);
+    } else {
+        c.robot.mjcf = Some(path);
+    }
+    c.robot.up.get_or_insert_with(|| "z".to_owned());
+    c
 }
 
 /// Reads `path` and loads its robot ([`load_str`]).
@@ -787,5 +945,133 @@ impl LoadedRobot {
             }
         }
         c
+    }
+}
+
+/// How a flight run of an imported robot ended ([`LoadedRobot::run_flight`]).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct FlightRun {
+    /// Steps solved.
+    pub steps: usize,
+    /// Steps planned: `round(duration/Δt) + 1`.
+    pub steps_planned: usize,
+    /// Newton iterations over the run.
+    pub newton_iterations: usize,
+    /// The simulator's error (names the step, time and joint), if any.
+    pub error: Option<String>,
+    /// Whether `stop` ended the run early.
+    pub interrupted: bool,
+    /// Time in the stepping loop (s).
+    pub wall_seconds: f64,
+}
+
+impl LoadedRobot {
+    /// `q0` and `q̇0` of the flight stepper ([`fbd_sim::tree`]): the root's
+    /// position and `φ`, then the joint angles; the root's velocity, `φ̇ =
+    /// E(φ)⁻¹·ω` ([`crate::spatial::euler_rate_matrix`]; 0 at the
+    /// singularity), then the joint rates.
+    pub fn flight_state(&self) -> (Vec<f64>, Vec<f64>) {
+        use fbd_robot::nalgebra::Vector3;
+        let p = self.base.translation.vector;
+        let phi = self.initial_phi;
+        let phi_dot = crate::spatial::euler_rate_matrix(phi)
+            .try_inverse()
+            .map(|e| e * Vector3::from(self.omega))
+            .unwrap_or_else(Vector3::zeros);
+        let mut q0 = vec![p.x, p.y, p.z, phi[0], phi[1], phi[2]];
+        q0.extend(&self.q);
+        let mut qd0 = self.velocity.to_vec();
+        qd0.extend(phi_dot.iter());
+        qd0.extend(&self.qd);
+        (q0, qd0)
+    }
+
+    /// The flight stepper of this configuration (`[time]`, `[world]`).
+    ///
+    /// # Errors
+    /// An invalid step or duration (validated on loading already).
+    pub fn flight(&self) -> Result<fbd_sim::tree::TreeFlight, fbd_sim::SimError> {
+        let t = &self.config.time;
+        fbd_sim::tree::TreeFlight::new(&self.model, t.dt, t.duration, self.gravity)
+    }
+
+    /// The columns of a flight's `trajectory.csv`: `t, rx, ry, rz, phi_x,
+    /// phi_y, phi_z`, one per joint angle (rad, the joint's name), per
+    /// reaction of `flight` `<joint>_fx, _fy, _fz` (force of the parent on
+    /// the child, N, inertial) and `<joint>_mx, _my, _mz` (its moment on
+    /// the child about the joint's origin, N·m), named by the reaction's
+    /// first joint; then `kinetic, potential, newton_iterations`.
+    pub fn flight_columns(&self, flight: &fbd_sim::tree::TreeFlight) -> Vec<String> {
+        let mut c: Vec<String> = MOTION_BASE_COLUMNS
+            .iter()
+            .map(|s| (*s).to_owned())
+            .collect();
+        c.insert(0, "t".to_owned());
+        c.extend(self.model.joints.iter().map(|j| j.name.clone()));
+        for r in &flight.mech.reactions {
+            let name = &self.model.joints[r.joints[0]].name;
+            for s in ["fx", "fy", "fz", "mx", "my", "mz"] {
+                c.push(format!("{name}_{s}"));
+            }
+        }
+        c.extend(["kinetic", "potential", "newton_iterations"].map(str::to_owned));
+        c
+    }
+
+    /// The values of one record in the order of [`Self::flight_columns`]
+    /// (`newton_iterations` as a float), into `row` (cleared first).
+    pub fn flight_row(record: &fbd_sim::tree::TreeFlightRecord, row: &mut Vec<f64>) {
+        row.clear();
+        row.push(record.t);
+        row.extend(&record.q);
+        for (f, m) in record.reaction_force.iter().zip(&record.reaction_moment) {
+            row.extend(f);
+            row.extend(m);
+        }
+        row.extend([
+            record.kinetic,
+            record.potential,
+            record.newton_iterations as f64,
+        ]);
+    }
+
+    /// Simulates the robot in passive flight (zero joint torques) from its
+    /// initial state over `[time]`, handing every solved step's record to
+    /// `on_record`; stops before the next step once `stop` is set. A
+    /// failing step (Newton, a joint leaving its limits) ends the run with
+    /// its message in [`FlightRun::error`]; the steps before were handed on.
+    ///
+    /// # Errors
+    /// An invalid step or duration (validated on loading already).
+    pub fn run_flight(
+        &self,
+        stop: &std::sync::atomic::AtomicBool,
+        on_record: &mut dyn FnMut(&fbd_sim::tree::TreeFlightRecord),
+    ) -> Result<FlightRun, fbd_sim::SimError> {
+        use fbd_sim::tree::{TreeFlightData, step};
+        let flight = self.flight()?;
+        let (q0, qd0) = self.flight_state();
+        let mut data = TreeFlightData::new(&flight, &q0, &qd0);
+        let torques = vec![0.0; self.model.joints.len()];
+        let mut run = FlightRun {
+            steps_planned: flight.steps,
+            ..FlightRun::default()
+        };
+        let start = std::time::Instant::now();
+        for _ in 0..flight.steps {
+            if stop.load(std::sync::atomic::Ordering::Relaxed) {
+                run.interrupted = true;
+                break;
+            }
+            if let Err(e) = step(&flight, &mut data, &torques) {
+                run.error = Some(e.to_string());
+                break;
+            }
+            run.steps += 1;
+            run.newton_iterations += data.record.newton_iterations;
+            on_record(&data.record);
+        }
+        run.wall_seconds = start.elapsed().as_secs_f64();
+        Ok(run)
     }
 }

@@ -1,0 +1,322 @@
+//! `fbd run` of an imported robot in flight: the lab hexapod tossed upward
+//! and tumbling with passive joints (examples/robots/lab_hexapod_flight.toml).
+
+mod common;
+
+use std::path::Path;
+
+use common::{example, fbd, s, stderr, write};
+use fbd_robot::nalgebra::Vector3;
+
+const G: f64 = 9.81;
+
+/// The example's text with its URDF given by an absolute path, so that it
+/// can be written elsewhere.
+fn flight_text() -> String {
+    let text = std::fs::read_to_string(example("robots/lab_hexapod_flight.toml")).unwrap();
+    text.replace(
+        "urdf = \"lab_hexapod.urdf\"",
+        &format!("urdf = \"{}\"", example("robots/lab_hexapod.urdf")),
+    )
+}
+
+fn run_ok(config: &str, out: &Path) {
+    let o = fbd(&["run", config, "--out", s(out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+}
+
+fn read(p: &Path) -> String {
+    std::fs::read_to_string(p).unwrap()
+}
+
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&read(&dir.join("summary.json"))).unwrap()
+}
+
+/// The header and the rows of a trajectory.
+fn table(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = read(&dir.join("trajectory.csv"));
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+#[test]
+fn a_tumbling_flight_writes_every_file_and_its_centre_of_mass_falls_at_g() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("flight");
+    run_ok(&example("robots/lab_hexapod_flight.toml"), &out);
+    for f in [
+        "trajectory.csv",
+        "events.csv",
+        "summary.json",
+        "config.toml",
+    ] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+    assert_eq!(read(&out.join("events.csv")).lines().count(), 1);
+    let sm = summary(&out);
+    assert_eq!(sm["status"], "ok");
+    assert_eq!(sm["model"], "robot");
+    assert_eq!(sm["robot"], "lab_hexapod");
+    assert!(sm["error"].is_null());
+    assert_eq!(sm["steps"], 501);
+    assert_eq!(sm["events"], serde_json::json!([]));
+    assert!(sm["newton_iterations"].as_u64().unwrap() > 0);
+
+    let (header, rows) = table(&out);
+    assert_eq!(rows.len(), 501);
+    assert_eq!(
+        &header[..8],
+        [
+            "t",
+            "rx",
+            "ry",
+            "rz",
+            "phi_x",
+            "phi_y",
+            "phi_z",
+            "lf_coxa_joint"
+        ]
+    );
+    assert!(header.contains(&"rr_tibia_joint_mz".to_owned()));
+    assert_eq!(
+        &header[header.len() - 3..],
+        ["kinetic", "potential", "newton_iterations"]
+    );
+    assert!(rows.iter().all(|r| r.len() == header.len()));
+
+    // The whole robot's centre of mass, recomputed from each row's root
+    // pose and joint angles, falls at exactly g: the scheme's momentum law
+    // (M·(C[k+1] − 2C[k] + C[k−1])/Δt² = M·g), to Newton's tolerance.
+    let model = fbd_robot::urdf::load(
+        Path::new(&example("robots/lab_hexapod.urdf")),
+        fbd_robot::Up::Z,
+        &fbd_robot::ContactChoice::CollisionSpheres,
+    )
+    .unwrap();
+    let nj = model.joints.len();
+    for (j, joint) in model.joints.iter().enumerate() {
+        assert_eq!(header[7 + j], joint.name);
+    }
+    let mut data = fbd_robot::RobotData::new(&model);
+    let com: Vec<Vector3<f64>> = rows
+        .iter()
+        .map(|r| {
+            let base = fbd_robot::forward::base_frame([r[1], r[2], r[3]], [r[4], r[5], r[6]]);
+            fbd_robot::forward(&model, &base, &r[7..7 + nj], &mut data);
+            data.total_com(&model)
+        })
+        .collect();
+    let dt = rows[1][0] - rows[0][0];
+    let mut worst: f64 = 0.0;
+    for k in 1..rows.len() - 1 {
+        let a = (com[k + 1] - 2.0 * com[k] + com[k - 1]) / (dt * dt);
+        worst = worst.max((a + Vector3::new(0.0, G, 0.0)).norm());
+    }
+    eprintln!("centre of mass: |a + g| up to {worst:e} m/s²");
+    assert!(worst < 1e-6, "|a + g| up to {worst} m/s²");
+    // It tumbles, its joints swing, and they stay within their limits.
+    let last = rows.last().unwrap();
+    assert!(
+        (last[5] - rows[0][5]).abs() > 0.3,
+        "φy {} → {}",
+        rows[0][5],
+        last[5]
+    );
+    let swing = (0..nj)
+        .map(|j| {
+            let (lo, hi) = rows.iter().fold((f64::MAX, f64::MIN), |(lo, hi), r| {
+                (lo.min(r[7 + j]), hi.max(r[7 + j]))
+            });
+            hi - lo
+        })
+        .fold(0.0, f64::max);
+    assert!(swing > 0.3, "largest joint swing {swing} rad");
+    // The kinetic and potential energies: the total is kept to O(Δt²).
+    let ek = header.len() - 3;
+    let e0 = rows[1][ek] + rows[1][ek + 1];
+    for r in &rows[1..] {
+        assert!((r[ek] + r[ek + 1] - e0).abs() < 1e-3 * e0.abs().max(1.0));
+    }
+}
+
+#[test]
+fn a_flight_repeats_byte_for_byte_also_from_its_config_toml() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = example("robots/lab_hexapod_flight.toml");
+    let (a, b, c) = (
+        dir.path().join("a"),
+        dir.path().join("b"),
+        dir.path().join("c"),
+    );
+    run_ok(&cfg, &a);
+    run_ok(&cfg, &b);
+    let traj = read(&a.join("trajectory.csv"));
+    assert_eq!(traj, read(&b.join("trajectory.csv")));
+    assert_eq!(read(&a.join("config.toml")), read(&b.join("config.toml")));
+    // The copy names every key, the description by an absolute path.
+    let copy = read(&a.join("config.toml"));
+    for key in [
+        "dt = 0.001",
+        "duration = 0.5",
+        "kind = \"none\"",
+        "stride = 1",
+        "gravity = 9.81",
+    ] {
+        assert!(copy.contains(key), "{key} in {copy}");
+    }
+    let urdf = std::fs::canonicalize(example("robots/lab_hexapod.urdf")).unwrap();
+    assert!(
+        copy.contains(&format!("urdf = \"{}\"", urdf.display())),
+        "{copy}"
+    );
+    run_ok(s(&a.join("config.toml")), &c);
+    assert_eq!(traj, read(&c.join("trajectory.csv")));
+    assert_eq!(copy, read(&c.join("config.toml")));
+}
+
+#[test]
+fn every_stride_th_step_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let full = dir.path().join("full");
+    run_ok(&example("robots/lab_hexapod_flight.toml"), &full);
+    let cfg = write(
+        dir.path(),
+        "stride.toml",
+        &format!("{}\n[output]\nstride = 7\n", flight_text()),
+    );
+    let out = dir.path().join("stride");
+    run_ok(s(&cfg), &out);
+    let all = read(&full.join("trajectory.csv"));
+    let all: Vec<&str> = all.lines().collect();
+    let some = read(&out.join("trajectory.csv"));
+    let some: Vec<&str> = some.lines().collect();
+    // 501 steps: rows 0, 7, …, 497.
+    assert_eq!(some.len() - 1, 501usize.div_ceil(7));
+    assert_eq!(some[0], all[0]);
+    for (i, line) in some[1..].iter().enumerate() {
+        assert_eq!(*line, all[1 + 7 * i]);
+    }
+    assert_eq!(summary(&out)["steps"], 501);
+}
+
+#[test]
+fn ground_contact_and_bad_keys_are_one_line_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            flight_text().replace("kind = \"none\"", "kind = \"flat\""),
+            "terrain.kind: ground contact for imported robots is not built yet (got \"flat\", expected \"none\")",
+        ),
+        (flight_text().replace("dt = 0.001", "dt = 0.0"), "time.dt"),
+        (
+            flight_text().replace("duration = 0.5", "duration = -1.0"),
+            "time.duration",
+        ),
+        (
+            format!("{}\n[output]\nstride = 0\n", flight_text()),
+            "output.stride",
+        ),
+    ];
+    for (i, (text, want)) in cases.iter().enumerate() {
+        let cfg = write(dir.path(), &format!("bad{i}.toml"), text);
+        let out = dir.path().join(format!("out{i}"));
+        let o = fbd(&["run", s(&cfg), "--out", s(&out)]);
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        let e = stderr(&o);
+        assert_eq!(e.lines().count(), 1, "{e}");
+        assert!(e.contains(want), "{e}");
+        assert!(!out.join("trajectory.csv").exists());
+    }
+}
+
+#[test]
+fn a_joint_leaving_its_limits_ends_the_run_with_the_rows_so_far() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = flight_text().replace("lf_coxa_joint = 40.0", "lf_coxa_joint = 2000.0");
+    let cfg = write(dir.path(), "wild.toml", &text);
+    let out = dir.path().join("out");
+    let o = fbd(&["run", s(&cfg), "--out", s(&out)]);
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let e = stderr(&o);
+    assert!(e.contains("lf_coxa_joint") && e.contains("limits"), "{e}");
+    let sm = summary(&out);
+    assert_eq!(sm["status"], "error");
+    let msg = sm["error"].as_str().unwrap();
+    assert!(
+        msg.contains("lf_coxa_joint") && msg.contains("step "),
+        "{msg}"
+    );
+    let steps = sm["steps"].as_u64().unwrap() as usize;
+    assert!(steps > 0 && steps < 501, "{steps}");
+    let (_, rows) = table(&out);
+    assert_eq!(rows.len(), steps);
+    // 2000°/s from 0 reaches the 60° limit after about 30 ms.
+    let t_end = rows.last().unwrap()[0];
+    assert!((0.02..0.05).contains(&t_end), "{t_end}");
+    assert!(out.join("config.toml").is_file() && out.join("events.csv").is_file());
+}
+
+#[test]
+fn sigint_stops_a_flight_and_writes_every_file() {
+    use std::process::{Command, Stdio};
+    use std::time::{Duration, Instant};
+    let dir = tempfile::tempdir().unwrap();
+    // At rest in free fall: the joints stay at 0 for as long as it runs.
+    let text = format!(
+        "model = \"robot\"\n[robot]\nurdf = \"{}\"\n[time]\nduration = 100000.0\n[output]\nstride = 1000\n",
+        example("robots/lab_hexapod.urdf")
+    );
+    let cfg = write(dir.path(), "long.toml", &text);
+    let out = dir.path().join("out");
+    let child = Command::new(env!("CARGO_BIN_EXE_fbd"))
+        .args(["run", s(&cfg), "--out", s(&out)])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let temporaries = |d: &Path| {
+        std::fs::read_dir(d).map_or(0, |r| {
+            r.filter(|e| {
+                e.as_ref()
+                    .unwrap()
+                    .file_name()
+                    .to_string_lossy()
+                    .ends_with(".tmp")
+            })
+            .count()
+        })
+    };
+    let start = Instant::now();
+    while temporaries(&out) == 0 {
+        assert!(start.elapsed() < Duration::from_secs(60), "never started");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    std::thread::sleep(Duration::from_millis(300));
+    let killed = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let o = child.wait_with_output().unwrap();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    assert!(stderr(&o).contains("interrupted after "), "{}", stderr(&o));
+    assert_eq!(temporaries(&out), 0);
+    let sm = summary(&out);
+    assert_eq!(sm["status"], "interrupted");
+    assert!(sm["error"].as_str().unwrap().contains("interrupted"));
+    let steps = sm["steps"].as_u64().unwrap() as usize;
+    assert!(steps > 0);
+    let (_, rows) = table(&out);
+    assert_eq!(rows.len(), (steps - 1) / 1000 + 1);
+    assert!(out.join("config.toml").is_file() && out.join("events.csv").is_file());
+}

@@ -243,6 +243,18 @@ pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
+/// The closing line every run prints: `solved 101 steps, 214 Newton
+/// iterations, 0.001 s` (or `stopped after …` when the run did not finish).
+pub fn solved_line(stopped: bool, steps: usize, newton_iterations: usize, wall: f64) -> String {
+    format!(
+        "{} {}, {}, {:.3} s\n",
+        if stopped { "stopped after" } else { "solved" },
+        count(steps, "step", "steps"),
+        count(newton_iterations, "Newton iteration", "Newton iterations"),
+        wall
+    )
+}
+
 /// How a run ended, for [`conclude`]: `Ok` or the message of its error.
 pub enum Ending {
     /// Every step was solved.

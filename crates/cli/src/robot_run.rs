@@ -202,20 +202,11 @@ pub fn run_command(
         summary,
         io_error,
     } = simulate(&robot, &source, out_dir, crate::interrupt::flag())?;
-    let text = format!(
-        "{} {}, {}, {:.3} s\n",
-        if run.error.is_some() || run.interrupted {
-            "stopped after"
-        } else {
-            "solved"
-        },
-        output::count(run.steps, "step", "steps"),
-        output::count(
-            run.newton_iterations,
-            "Newton iteration",
-            "Newton iterations"
-        ),
-        run.wall_seconds
+    let text = output::solved_line(
+        run.error.is_some() || run.interrupted,
+        run.steps,
+        run.newton_iterations,
+        run.wall_seconds,
     );
     let ending = if let Some(e) = &run.error {
         Ending::Failed {

@@ -445,20 +445,11 @@ pub fn run_command(
         text.push_str(&crate::run::event_line(&times.string(step, t), &e));
         text.push('\n');
     }
-    text.push_str(&format!(
-        "{} {}, {}, {:.3} s\n",
-        if run.error.is_some() || run.interrupted {
-            "stopped after"
-        } else {
-            "solved"
-        },
-        output::count(run.steps, "step", "steps"),
-        output::count(
-            run.newton_iterations,
-            "Newton iteration",
-            "Newton iterations"
-        ),
-        run.wall_seconds
+    text.push_str(&output::solved_line(
+        run.error.is_some() || run.interrupted,
+        run.steps,
+        run.newton_iterations,
+        run.wall_seconds,
     ));
     if let Some(h) = summary.final_height {
         text.push_str(&format!(

@@ -1,4 +1,4 @@
-//! The flight stepper of any robot model ([`fbd_sim::tree`]):
+//! Any robot model in flight ([`fbd_sim::robot`] with no terrain):
 //!
 //! * on the paper's hexapod built as a generic robot model
 //!   ([`fbd_scenario::robot::hexapod_robot`]), a passive tumbling flight
@@ -12,8 +12,8 @@
 //!   in Δt;
 //! * a constant joint torque is internal: the angular momentum about the
 //!   centre of mass is still conserved, while the joint does move;
-//! * a joint that leaves its limits ends the flight with an error naming
-//!   the joint (stops are not modelled).
+//! * a joint driven onto an end of its range is held there by its stop
+//!   (a limit event, the angle never beyond the end, the stop pushing).
 
 use std::path::Path;
 
@@ -21,9 +21,35 @@ use fbd_contact::{Surface, Terrain};
 use fbd_kinematics::JointLimits;
 use fbd_kinematics::nalgebra::Vector3;
 use fbd_robot::{ContactChoice, RobotModel, Up};
-use fbd_sim::SimError;
+use fbd_sim::robot::{RobotData, RobotParams, RobotSim, step};
 use fbd_sim::spatial::{SpatialModel, SpatialParams, run_collect};
-use fbd_sim::tree::{TreeFlight, TreeFlightData, step};
+
+/// `model` in flight (no terrain) from `q0`, `qdot0`, at `dt` for
+/// `duration` under 9.81 m/s² (or `gravity`), passive.
+fn in_flight(
+    model: &RobotModel,
+    dt: f64,
+    duration: f64,
+    gravity: f64,
+    q0: &[f64],
+    qdot0: &[f64],
+) -> RobotSim {
+    let mut p = RobotParams::new(q0.len());
+    p.dt = dt;
+    p.duration = duration;
+    p.gravity = gravity;
+    p.q0 = q0.to_vec();
+    p.qdot0 = qdot0.to_vec();
+    p.terrain = None;
+    RobotSim::new(model, &p).expect("valid parameters")
+}
+
+/// A workspace stepping with the constant joint `torques`.
+fn data_with(sim: &RobotSim, torques: &[f64]) -> RobotData {
+    let mut data = RobotData::new(sim);
+    data.external_torque = Some(torques.to_vec());
+    data
+}
 
 /// The tumbling hexapod of `tests/spatial_flight.rs`: tilted body
 /// spinning about all three axes, every joint moving, no ground, no stops.
@@ -69,13 +95,20 @@ fn the_hexapod_flies_as_the_spatial_engine_flies_it() {
     assert!(summary.error.is_none(), "{:?}", summary.error);
 
     let robot = fbd_scenario::robot::hexapod_robot(&params);
-    let mut flight = TreeFlight::new(&robot, params.dt, params.duration, params.gravity).unwrap();
+    let mut flight = in_flight(
+        &robot,
+        params.dt,
+        params.duration,
+        params.gravity,
+        &params.q0,
+        &params.qdot0,
+    );
     assert_eq!(flight.steps, model.steps);
     assert_eq!(rows.len(), flight.steps);
     flight.newton.residual_tol = TOL;
     assert!(flight.mech.limits.is_empty());
-    let mut data = TreeFlightData::new(&flight, &params.q0, &params.qdot0);
     let torques = vec![0.0; robot.joints.len()];
+    let mut data = data_with(&flight, &torques);
     // The reactions of each leg's hip (the compound joint θ1, θ2) and knee
     // (θ3), by joint name.
     let reaction = |name: String| {
@@ -99,7 +132,7 @@ fn the_hexapod_flies_as_the_spatial_engine_flies_it() {
     let (mut dq, mut df, mut dm): (f64, f64, f64) = (0.0, 0.0, 0.0);
     let mut largest_force: f64 = 0.0;
     for (k, row) in rows.iter().enumerate() {
-        step(&flight, &mut data, &torques).unwrap_or_else(|e| panic!("{e}"));
+        step(&flight, &mut data).unwrap_or_else(|e| panic!("{e}"));
         let rec = &data.record;
         assert_eq!(rec.step, k);
         assert_eq!(rec.t, row.t);
@@ -177,16 +210,16 @@ fn lab_start(model: &RobotModel) -> (Vec<f64>, Vec<f64>) {
 type Sample = (f64, Vector3<f64>, Vector3<f64>, Vector3<f64>, f64);
 
 /// Flies `model` for `duration` at `dt` with constant `torques`.
-fn fly(model: &RobotModel, dt: f64, duration: f64, torques: &[f64]) -> (TreeFlight, Vec<Sample>) {
-    let mut flight = TreeFlight::new(model, dt, duration, 9.81).unwrap();
+fn fly(model: &RobotModel, dt: f64, duration: f64, torques: &[f64]) -> (RobotSim, Vec<Sample>) {
+    let (q0, qdot0) = lab_start(model);
+    let mut flight = in_flight(model, dt, duration, 9.81, &q0, &qdot0);
     // Conservation is to the solver's tolerance: a hundredth of the
     // default.
     flight.newton.residual_tol = TOL;
-    let (q0, qdot0) = lab_start(model);
-    let mut data = TreeFlightData::new(&flight, &q0, &qdot0);
+    let mut data = data_with(&flight, torques);
     let mut out = Vec::with_capacity(flight.steps);
     for _ in 0..flight.steps {
-        step(&flight, &mut data, torques).unwrap_or_else(|e| panic!("{e}"));
+        step(&flight, &mut data).unwrap_or_else(|e| panic!("{e}"));
         let r = &data.record;
         out.push((
             r.t,
@@ -295,11 +328,11 @@ fn a_joint_torque_is_internal() {
     // The torque did something: the joint's angle differs from the
     // passive flight's.
     let angle = |torques: &[f64]| {
-        let flight = TreeFlight::new(&model, 1e-3, 0.1, 9.81).unwrap();
         let (q0, qdot0) = lab_start(&model);
-        let mut data = TreeFlightData::new(&flight, &q0, &qdot0);
+        let flight = in_flight(&model, 1e-3, 0.1, 9.81, &q0, &qdot0);
+        let mut data = data_with(&flight, torques);
         for _ in 0..flight.steps {
-            step(&flight, &mut data, torques).unwrap();
+            step(&flight, &mut data).unwrap();
         }
         data.q[6 + j]
     };
@@ -311,32 +344,35 @@ fn a_joint_torque_is_internal() {
     );
 }
 
-/// A joint driven past its limit ends the flight with an error naming the
-/// joint, the step and the missing stops.
+/// A joint driven onto an end of its range is held by its stop: a limit
+/// event, the angle never beyond the end (to the stop rows' tolerance),
+/// the stop's moment pushing the joint back into its range.
 #[test]
-fn a_joint_leaving_its_limits_is_an_error() {
+fn a_joint_driven_onto_its_limit_is_held_by_its_stop() {
     let model = lab();
-    let flight = TreeFlight::new(&model, 1e-3, 0.5, 9.81).unwrap();
-    let (mut q0, mut qdot0) = lab_start(&model);
     let j = 0;
     let upper = model.joints[j].limits.unwrap().upper;
+    let (mut q0, mut qdot0) = lab_start(&model);
     q0[6 + j] = upper - 0.01;
     qdot0[6 + j] = 5.0;
-    let mut data = TreeFlightData::new(&flight, &q0, &qdot0);
-    let torques = vec![0.0; model.joints.len()];
-    let err = (0..flight.steps)
-        .find_map(|_| step(&flight, &mut data, &torques).err())
-        .expect("the joint must leave its range");
-    let k = data.k;
-    match &err {
-        SimError::Control { step, message, .. } => {
-            assert_eq!(*step, k);
-            assert!(k > 0 && k < 10, "step {k}");
-            assert!(message.contains(&model.joints[j].name), "{message}");
-            assert!(message.contains("stops are not modelled"), "{message}");
+    let flight = in_flight(&model, 1e-3, 0.1, 9.81, &q0, &qdot0);
+    let mut data = data_with(&flight, &vec![0.0; model.joints.len()]);
+    let mut held = 0;
+    for _ in 0..flight.steps {
+        step(&flight, &mut data).unwrap_or_else(|e| panic!("{e}"));
+        let r = &data.record;
+        assert!(r.q[6 + j] <= upper + 1e-9, "beyond the end: {}", r.q[6 + j]);
+        if r.limit[j] == fbd_sim::LimitCode::Max {
+            held += 1;
+            assert!(r.stop[j] <= 1e-9, "the stop pulls: {} N·m", r.stop[j]);
         }
-        e => panic!("unexpected error {e}"),
     }
-    // The state stays at the last accepted step, inside the range.
-    assert!(data.q[6 + j] <= upper);
+    let arrival = data
+        .limit_events
+        .iter()
+        .find(|e| e.joint_index == j)
+        .expect("a limit event");
+    assert!(arrival.step < 10, "arrives at step {}", arrival.step);
+    assert_eq!(arrival.to, fbd_sim::LimitCode::Max);
+    assert!(held > 0);
 }

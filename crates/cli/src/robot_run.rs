@@ -1,9 +1,9 @@
-//! `fbd run` of an imported robot (`model = "robot"`) in flight: the run
-//! itself is [`fbd_scenario::robot::LoadedRobot::run_flight`]; this module
+//! `fbd run` of an imported robot (`model = "robot"`): the run itself is
+//! [`fbd_scenario::robot::LoadedRobot::run`] (the generic FBD model on its
+//! terrain, or in flight with `[terrain] kind = "none"`); this module
 //! writes `trajectory.csv` (streamed, every `[output] stride`-th step),
-//! `events.csv` (header only: no contact yet), `summary.json` and
-//! `config.toml`, each all-or-nothing, also after a simulation error or an
-//! interruption.
+//! `events.csv`, `summary.json` and `config.toml`, each all-or-nothing,
+//! also after a simulation error or an interruption.
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -11,8 +11,9 @@ use std::path::Path;
 use serde::Serialize;
 
 use crate::CliError;
-use crate::config::robot::{FlightRun, LoadedRobot};
-use crate::output::{self, Ending};
+use crate::config::robot::{ColumnKind, LoadedRobot, RobotRun};
+use crate::output::{self, Ending, IterationsPerStep};
+use crate::steptime::StepTimes;
 
 /// The files of a robot's run, in the order they are written.
 pub const FILES: [&str; 4] = [
@@ -22,8 +23,23 @@ pub const FILES: [&str; 4] = [
     "config.toml",
 ];
 
-/// `events.csv` of a flight: the header alone.
-pub const EVENTS_HEADER: &str = "t,contact,from,to\n";
+/// `events.csv`'s header for a robot.
+pub const EVENTS_HEADER: &str = "t,point,from,to\n";
+
+/// An event of a robot's run (`events.csv`, `summary.json`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobotEvent {
+    /// Start of the first step solved in the new state (s).
+    pub t: f64,
+    /// The contact point's name; `<joint>_limit` for a joint reaching
+    /// (`free` → `min`/`max`) or leaving an end of its range; `substeps`
+    /// for a step solved again in substeps (`1` → `n`).
+    pub point: String,
+    /// Previous state.
+    pub from: String,
+    /// New state.
+    pub to: String,
+}
 
 /// `summary.json` of a robot's run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -36,27 +52,46 @@ pub struct RobotSummary {
     pub model: &'static str,
     /// The robot's name (from its description).
     pub robot: String,
+    /// Time step (s).
+    pub dt: f64,
+    /// Simulated time asked for (s).
+    pub duration: f64,
     /// Steps solved.
     pub steps: usize,
     /// Steps planned (`round(duration/Δt) + 1`).
     pub steps_planned: usize,
+    /// `[output] stride`.
+    pub stride: usize,
     /// Rows of `trajectory.csv`.
     pub rows_written: usize,
+    /// The contact points, in the order of their columns (none in flight).
+    pub contact_points: Vec<String>,
     /// Newton iterations over the run.
     pub newton_iterations: usize,
+    /// Mean and largest Newton iterations of one step.
+    pub newton_iterations_per_step: IterationsPerStep,
     /// Time in the stepping loop (s).
     pub wall_seconds: f64,
     /// `steps / wall_seconds` (null when not measurable).
     pub steps_per_second: Option<f64>,
-    /// Contact events: none in flight.
-    pub events: Vec<()>,
+    /// Symbolic LU analyses (one per contact-state pattern).
+    pub symbolic_factorizations: usize,
+    /// Contact, joint-limit and retried-step events, as `events.csv`.
+    pub events: Vec<RobotEvent>,
+    /// Steps solved again in substeps.
+    pub retried_steps: usize,
+    /// State searches closed by their least inconsistent combination.
+    pub resolved_cycles: usize,
+    /// The largest violation of a contact or limit law over the accepted
+    /// solutions (N; at most the cycle tolerance, 1e-7 of the weight).
+    pub max_law_violation: f64,
 }
 
 /// What [`simulate`] did.
 #[derive(Debug)]
 pub struct RobotRunOutput {
     /// How the run ended.
-    pub run: FlightRun,
+    pub run: RobotRun,
     /// `summary.json`'s content.
     pub summary: RobotSummary,
     /// The first error writing the files, if any.
@@ -71,8 +106,57 @@ fn write_number(w: &mut impl Write, x: f64, buf: &mut ryu::Buffer) -> std::io::R
     }
 }
 
-/// Simulates `robot` in flight and writes its files in `out_dir` (created
-/// if needed; files of an earlier run that this one does not write are
+/// Every event of a robot's run in time order (contact events first at
+/// equal times), named for `events.csv`, with each one's step.
+pub fn robot_events(
+    robot: &LoadedRobot,
+    sim: &fbd_sim::robot::RobotSim,
+    run: &fbd_sim::RunSummary,
+    times: &StepTimes,
+) -> Vec<(usize, f64, RobotEvent)> {
+    let mut all: Vec<(usize, f64, RobotEvent)> = Vec::new();
+    for e in &run.events {
+        all.push((
+            e.step,
+            e.t,
+            RobotEvent {
+                t: times.value(e.step, e.t),
+                point: sim.mech.contacts[e.contact].name.clone(),
+                from: e.from.as_str().to_owned(),
+                to: e.to.as_str().to_owned(),
+            },
+        ));
+    }
+    for e in &run.limit_events {
+        all.push((
+            e.step,
+            e.t,
+            RobotEvent {
+                t: times.value(e.step, e.t),
+                point: format!("{}_limit", robot.model.joints[e.joint_index].name),
+                from: e.from.as_str().to_owned(),
+                to: e.to.as_str().to_owned(),
+            },
+        ));
+    }
+    for e in &run.retries {
+        all.push((
+            e.step,
+            e.t,
+            RobotEvent {
+                t: times.value(e.step, e.t),
+                point: output::RETRY_POINT.to_owned(),
+                from: "1".to_owned(),
+                to: e.substeps.to_string(),
+            },
+        ));
+    }
+    all.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    all
+}
+
+/// Simulates `robot` and writes its files in `out_dir` (created if
+/// needed; files of an earlier run that this one does not write are
 /// removed). The run stops before its next step once `stop` is set.
 pub fn simulate(
     robot: &LoadedRobot,
@@ -80,44 +164,39 @@ pub fn simulate(
     out_dir: &Path,
     stop: &std::sync::atomic::AtomicBool,
 ) -> Result<RobotRunOutput, CliError> {
-    output::prepare_dir(out_dir)?;
-    let flight = robot.flight().map_err(|e| crate::ConfigError::Semantic {
+    let sim = robot.sim().map_err(|e| crate::ConfigError::Semantic {
         file: source.to_owned(),
         message: e.to_string(),
     })?;
-    let columns = robot.flight_columns(&flight);
-    let stride = robot.config.output.stride;
+    output::prepare_dir(out_dir)?;
+    let columns = robot.columns(&sim);
     let dest = out_dir.join("trajectory.csv");
     let tmp = output::temp_in(out_dir, "trajectory.csv")?;
     let mut w = BufWriter::new(tmp);
-    let mut io: std::io::Result<()> = w.write_all(format!("{}\n", columns.join(",")).as_bytes());
+    let mut io: std::io::Result<()> =
+        w.write_all(format!("{}\n", columns.names.join(",")).as_bytes());
     let mut rows = 0;
-    let mut row = Vec::with_capacity(columns.len());
+    let mut row = Vec::with_capacity(columns.names.len());
     let mut buf = ryu::Buffer::new();
-    let last = columns.len() - 1;
-    let run = robot
-        .run_flight(stop, &mut |r| {
-            if r.step % stride != 0 || io.is_err() {
-                return;
-            }
-            LoadedRobot::flight_row(r, &mut row);
-            rows += 1;
-            io = (|| {
-                for (i, &x) in row.iter().enumerate() {
-                    if i == last {
-                        write!(w, "{}", r.newton_iterations)?;
-                    } else {
-                        write_number(&mut w, x, &mut buf)?;
-                    }
-                    w.write_all(if i == last { b"\n" } else { b"," })?;
+    let last = columns.names.len() - 1;
+    let run = robot.run_sim(&sim, stop, &mut |r| {
+        if io.is_err() {
+            return;
+        }
+        LoadedRobot::row(r, &mut row);
+        rows += 1;
+        io = (|| {
+            for (i, (&x, kind)) in row.iter().zip(&columns.kinds).enumerate() {
+                match kind {
+                    ColumnKind::Number => write_number(&mut w, x, &mut buf)?,
+                    ColumnKind::State => write!(w, "ST{}", x as u8)?,
+                    ColumnKind::Count => write!(w, "{}", x as usize)?,
                 }
-                Ok(())
-            })();
-        })
-        .map_err(|e| crate::ConfigError::Semantic {
-            file: source.to_owned(),
-            message: e.to_string(),
-        })?;
+                w.write_all(if i == last { b"\n" } else { b"," })?;
+            }
+            Ok(())
+        })();
+    });
     let mut io_error = None;
     let mut keep = |r: Result<std::path::PathBuf, CliError>| {
         if let Err(e) = r
@@ -138,39 +217,60 @@ pub fn simulate(
         });
     keep(trajectory);
     let dt = robot.config.time.dt;
-    let times = crate::steptime::StepTimes::new(dt);
+    let times = StepTimes::new(dt);
+    let s = &run.summary;
+    let events = robot_events(robot, &sim, s, &times);
+    let mut events_csv = String::from(EVENTS_HEADER);
+    for (step, t, e) in &events {
+        events_csv.push_str(&format!(
+            "{},{},{},{}\n",
+            times.string(*step, *t),
+            e.point,
+            e.from,
+            e.to
+        ));
+    }
     let interrupted = format!(
         "interrupted after {} of {} steps (t = {} s)",
-        run.steps,
+        s.steps,
         run.steps_planned,
-        times.string(run.steps, run.steps as f64 * dt)
+        times.string(s.steps, s.steps as f64 * dt)
     );
     let summary = RobotSummary {
-        status: if run.error.is_some() {
+        status: if s.error.is_some() {
             "error"
-        } else if run.interrupted {
+        } else if s.interrupted {
             "interrupted"
         } else {
             "ok"
         },
-        error: match (&run.error, run.interrupted) {
-            (Some(e), _) => Some(e.clone()),
+        error: match (&s.error, s.interrupted) {
+            (Some(e), _) => Some(e.to_string()),
             (None, true) => Some(interrupted),
             (None, false) => None,
         },
         model: crate::config::robot::MODEL,
         robot: robot.model.name.clone(),
-        steps: run.steps,
+        dt,
+        duration: robot.config.time.duration,
+        steps: s.steps,
         steps_planned: run.steps_planned,
+        stride: robot.config.output.stride,
         rows_written: rows,
-        newton_iterations: run.newton_iterations,
-        wall_seconds: run.wall_seconds,
-        steps_per_second: (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds),
-        events: Vec::new(),
+        contact_points: sim.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+        newton_iterations: s.newton_iterations,
+        newton_iterations_per_step: IterationsPerStep::of(s),
+        wall_seconds: s.wall_seconds,
+        steps_per_second: (s.wall_seconds > 0.0).then(|| s.steps as f64 / s.wall_seconds),
+        symbolic_factorizations: s.symbolic_factorizations,
+        events: events.into_iter().map(|(_, _, e)| e).collect(),
+        retried_steps: s.retries.len(),
+        resolved_cycles: s.resolved_cycles,
+        max_law_violation: s.max_law_violation,
     };
     output::write_run_files(
         out_dir,
-        EVENTS_HEADER,
+        &events_csv,
         &summary,
         &robot.config.to_toml(),
         &mut keep,
@@ -202,19 +302,20 @@ pub fn run_command(
         summary,
         io_error,
     } = simulate(&robot, &source, out_dir, crate::interrupt::flag())?;
+    let s = &run.summary;
     let text = output::solved_line(
-        run.error.is_some() || run.interrupted,
-        run.steps,
-        run.newton_iterations,
-        run.wall_seconds,
+        s.error.is_some() || s.interrupted,
+        s.steps,
+        s.newton_iterations,
+        s.wall_seconds,
     );
-    let ending = if let Some(e) = &run.error {
+    let ending = if let Some(e) = &s.error {
         Ending::Failed {
-            error: e.clone(),
+            error: e.to_string(),
             source,
             advice: None,
         }
-    } else if run.interrupted {
+    } else if s.interrupted {
         Ending::Interrupted(summary.error.clone().unwrap_or_default())
     } else {
         Ending::Completed

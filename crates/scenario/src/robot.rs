@@ -77,6 +77,10 @@ pub struct RobotInitial {
     /// Joint rates by joint name (deg/s); others 0.
     #[serde(default)]
     pub rates_deg: BTreeMap<String, f64>,
+    /// Lowers (or raises) the root so that the lowest contact point touches
+    /// the terrain (after `contacts_at`). Default false.
+    #[serde(default)]
+    pub rest_on_ground: bool,
     /// Contact points placed at inertial positions (m) by numeric inverse
     /// kinematics of their chains ([`fbd_robot::ik`]), starting from
     /// `joints_deg`; the root stays at `position`, `phi_deg`.
@@ -149,25 +153,52 @@ impl Default for RobotTime {
     }
 }
 
-/// `[terrain]` of an imported robot: only `"none"` (flight) so far.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
+/// How the joints of an imported robot are driven (`[control] kind`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum RobotControlKind {
+    /// Passive joints (zero torque).
+    #[default]
+    None,
+    /// PD to fixed joint angles.
+    Pd,
+    /// PD along piecewise-linear joint trajectories.
+    Trajectory,
+}
+
+/// `[control]` of an imported robot: `τ = kp·(θ* − θ[k]) + kd·(θ̇* −
+/// θ̇[k])` on every joint, clamped to the joint's effort limit and to
+/// `torque_limit`.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
-pub struct RobotTerrain {
-    /// `"none"` (default): no ground.
-    #[serde(default = "default_terrain")]
-    pub kind: String,
-}
-
-fn default_terrain() -> String {
-    "none".to_owned()
-}
-
-impl Default for RobotTerrain {
-    fn default() -> Self {
-        Self {
-            kind: default_terrain(),
-        }
-    }
+pub struct RobotControlConfig {
+    /// `"none"` (default), `"pd"` or `"trajectory"`.
+    #[serde(default)]
+    pub kind: RobotControlKind,
+    /// Position gain of every joint (N·m/rad). Default 0.
+    #[serde(default)]
+    pub kp: f64,
+    /// Rate gain of every joint (N·m·s/rad). Default 0.
+    #[serde(default)]
+    pub kd: f64,
+    /// Per-joint gains `{ joint = [kp, kd] }` replacing `kp`, `kd`.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub gains: BTreeMap<String, [f64; 2]>,
+    /// `|τ| ≤ torque_limit` (N·m) on every joint, besides each joint's
+    /// effort limit from the description.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub torque_limit: Option<f64>,
+    /// `pd`: target angles by joint (deg); joints not named hold their
+    /// initial angle.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub target_deg: BTreeMap<String, f64>,
+    /// `trajectory`: the knots' times (s), strictly increasing.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub times: Vec<f64>,
+    /// `trajectory`: per knot, joint angles by name (deg); joints not
+    /// named hold their initial angle.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub targets_deg: Vec<BTreeMap<String, f64>>,
 }
 
 /// `[output]` of an imported robot.
@@ -211,9 +242,13 @@ pub struct RobotConfig {
     /// `[time]`.
     #[serde(default)]
     pub time: RobotTime,
-    /// `[terrain]`.
+    /// `[terrain]`: the hexapod's table (every kind; `"none"` for a run
+    /// in flight). Default flat ground at `y = 0`.
     #[serde(default)]
-    pub terrain: RobotTerrain,
+    pub terrain: crate::TerrainConfig,
+    /// `[control]`.
+    #[serde(default)]
+    pub control: RobotControlConfig,
     /// `[output]`.
     #[serde(default)]
     pub output: RobotOutput,
@@ -251,6 +286,8 @@ pub struct LoadedRobot {
     /// `[inverse]`: root acceleration (m/s²), angular acceleration
     /// (rad/s²), joint accelerations (rad/s²).
     pub acceleration: ([f64; 3], [f64; 3], Vec<f64>),
+    /// The joint controller of `[control]`, per joint in radians.
+    pub control: fbd_sim::robot::RobotControl,
     /// The complete configuration: every default filled, the description
     /// given by its canonical path (`config.toml` of a run repeats it).
     pub config: RobotConfig,
@@ -274,8 +311,22 @@ fn semantic(file: &str, message: String) -> ConfigError {
 /// Parses the configuration `text` of `path` and loads its robot.
 pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
     let file = path.display().to_string();
-    let config: RobotConfig =
+    let mut config: RobotConfig =
         toml::from_str(text).map_err(|e| crate::syntax_error(&file, text, &e))?;
+    config.terrain.resolve_kind();
+    config.terrain.load_profile_file(&file)?;
+    config.terrain.load_map(&file)?;
+    if !config.terrain.height.is_finite() {
+        return Err(ConfigError::semantic(
+            &file,
+            "terrain.height",
+            "must be finite",
+            config.terrain.height,
+            "a finite value",
+        ));
+    }
+    config.terrain.validate_kind(&file)?;
+    config.terrain.patches(&file)?;
     let r = &config.robot;
     let (rel, is_urdf) = match (&r.urdf, &r.mjcf) {
         (Some(u), None) => (u, true),
@@ -305,7 +356,8 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         Some(names) => ContactChoice::Named(names.clone()),
     };
     let base_dir = path.parent().unwrap_or(Path::new(""));
-    let description = base_dir.join(rel);
+    let key = if is_urdf { "robot.urdf" } else { "robot.mjcf" };
+    let description = resolve_description(rel, base_dir, &file, key)?;
     let model = if is_urdf {
         fbd_robot::urdf::load(&description, up, &contacts)?
     } else {
@@ -393,15 +445,6 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
             "≥ 0 s, finite",
         ));
     }
-    if config.terrain.kind != "none" {
-        return Err(semantic(
-            &file,
-            format!(
-                "terrain.kind: ground contact for imported robots is not built yet (got \"{}\", expected \"none\")",
-                config.terrain.kind
-            ),
-        ));
-    }
     if config.output.stride < 1 {
         return Err(ConfigError::semantic(
             &file,
@@ -442,6 +485,27 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
             },
         )?;
     }
+    let mut base = base;
+    if init.rest_on_ground {
+        if config.terrain.kind == crate::TerrainKind::None || model.contacts.is_empty() {
+            return Err(semantic(
+                &file,
+                "initial.rest_on_ground: needs a terrain (not kind = \"none\") and contact points"
+                    .to_owned(),
+            ));
+        }
+        let surface = config.terrain.surface();
+        let mut d = fbd_robot::forward::RobotData::new(&model);
+        fbd_robot::forward::forward(&model, &base, &q, &mut d);
+        let lowest = model
+            .contacts
+            .iter()
+            .zip(&d.contacts)
+            .map(|(c, p)| p.y - c.radius - surface.height(p.x, p.z))
+            .fold(f64::INFINITY, f64::min);
+        base.translation.vector.y -= lowest;
+    }
+    let control = resolve_control(&config.control, &model, &q, &file, &description)?;
     let config = complete(&config, &description);
     Ok(LoadedRobot {
         description,
@@ -454,7 +518,175 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         initial_phi: init.phi_deg.map(f64::to_radians),
         gravity: g,
         acceleration: (inv.acceleration, inv.alpha_deg.map(f64::to_radians), qdd),
+        control,
         config,
+    })
+}
+
+/// The environment variable listing the folders that `package://NAME/…`
+/// paths are looked up in (`:`-separated, as ROS and Pinocchio use it).
+pub const PACKAGE_PATH_VAR: &str = "ROS_PACKAGE_PATH";
+
+/// A description's path: `package://NAME/REST` is `DIR/NAME/REST` for the
+/// first folder `DIR` of `ROS_PACKAGE_PATH` that holds it (or `DIR/REST`
+/// when `DIR` is itself named `NAME`); any other path is relative to the
+/// configuration's folder `base_dir`.
+fn resolve_description(
+    rel: &str,
+    base_dir: &Path,
+    file: &str,
+    key: &str,
+) -> Result<PathBuf, ConfigError> {
+    let Some(uri) = rel.strip_prefix("package://") else {
+        return Ok(base_dir.join(rel));
+    };
+    let (name, rest) = uri.split_once('/').unwrap_or((uri, ""));
+    let dirs = std::env::var(PACKAGE_PATH_VAR).unwrap_or_default();
+    for dir in dirs.split(':').filter(|d| !d.is_empty()) {
+        let dir = Path::new(dir);
+        let mut candidates = vec![dir.join(name).join(rest)];
+        if dir.file_name().is_some_and(|n| n == name) {
+            candidates.push(dir.join(rest));
+        }
+        if let Some(found) = candidates.into_iter().find(|c| c.is_file()) {
+            return Ok(found);
+        }
+    }
+    Err(semantic(
+        file,
+        format!(
+            "{key}: \"{rel}\" not found: no folder {name} holding {rest} in {PACKAGE_PATH_VAR} ({}); \
+             set {PACKAGE_PATH_VAR} to the folder that holds {name} (for example-robot-data: \
+             pip install example-robot-data, then {PACKAGE_PATH_VAR}=<site-packages>/cmeel.prefix/share/example-robot-data/robots)",
+            if dirs.is_empty() {
+                "unset".to_owned()
+            } else {
+                format!("\"{dirs}\"")
+            }
+        ),
+    ))
+}
+
+/// `[control]` per joint in radians: gains (`kp`, `kd`, `gains`), targets
+/// (`pd`: `target_deg`, others at `q`; `trajectory`: `times`,
+/// `targets_deg`). Errors name the key.
+fn resolve_control(
+    c: &RobotControlConfig,
+    model: &RobotModel,
+    q: &[f64],
+    file: &str,
+    description: &Path,
+) -> Result<fbd_sim::robot::RobotControl, ConfigError> {
+    use fbd_sim::robot::{JointTrajectory, RobotControl};
+    let nj = model.joints.len();
+    let joint = |key: &str, name: &str| {
+        model.joint_index(name).ok_or_else(|| {
+            let known: Vec<&str> = model.joints.iter().map(|j| j.name.as_str()).collect();
+            semantic(
+                file,
+                format!(
+                    "{key}.{name}: no such joint in {}{}",
+                    description.display(),
+                    suggest_name(name, &known)
+                ),
+            )
+        })
+    };
+    let finite = |key: String, v: f64| {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(semantic(file, format!("{key}: must be finite (got {v})")))
+        }
+    };
+    let mut kp = vec![c.kp; nj];
+    let mut kd = vec![c.kd; nj];
+    for (name, [p, d]) in &c.gains {
+        let j = joint("control.gains", name)?;
+        kp[j] = *p;
+        kd[j] = *d;
+    }
+    let angles = |key: &str, table: &BTreeMap<String, f64>| {
+        let mut out = q.to_vec();
+        for (name, &deg) in table {
+            let j = joint(key, name)?;
+            out[j] = finite(format!("{key}.{name}"), deg)?.to_radians();
+        }
+        Ok::<_, ConfigError>(out)
+    };
+    let unused = |key: &str, used: bool| {
+        if used {
+            Err(semantic(
+                file,
+                format!(
+                    "control.{key}: not used by kind = \"{}\"",
+                    match c.kind {
+                        RobotControlKind::None => "none",
+                        RobotControlKind::Pd => "pd",
+                        RobotControlKind::Trajectory => "trajectory",
+                    }
+                ),
+            ))
+        } else {
+            Ok(())
+        }
+    };
+    Ok(match c.kind {
+        RobotControlKind::None => {
+            unused("target_deg", !c.target_deg.is_empty())?;
+            unused("times", !c.times.is_empty())?;
+            RobotControl::None
+        }
+        RobotControlKind::Pd => {
+            unused("times", !c.times.is_empty())?;
+            unused("targets_deg", !c.targets_deg.is_empty())?;
+            RobotControl::Pd {
+                kp,
+                kd,
+                target: angles("control.target_deg", &c.target_deg)?,
+                torque_limit: c.torque_limit,
+            }
+        }
+        RobotControlKind::Trajectory => {
+            unused("target_deg", !c.target_deg.is_empty())?;
+            if c.times.is_empty() || c.times.len() != c.targets_deg.len() {
+                return Err(semantic(
+                    file,
+                    format!(
+                        "control.times: one time per entry of control.targets_deg, at least one (got {} times, {} targets)",
+                        c.times.len(),
+                        c.targets_deg.len()
+                    ),
+                ));
+            }
+            for (i, &t) in c.times.iter().enumerate() {
+                finite(format!("control.times[{i}]"), t)?;
+            }
+            if let Some(i) = c.times.windows(2).position(|w| w[0] >= w[1]) {
+                return Err(semantic(
+                    file,
+                    format!(
+                        "control.times: must increase strictly (times[{i}] = {} ≥ times[{}] = {})",
+                        c.times[i],
+                        i + 1,
+                        c.times[i + 1]
+                    ),
+                ));
+            }
+            let mut knots = Vec::with_capacity(c.times.len());
+            for (i, t) in c.targets_deg.iter().enumerate() {
+                knots.push(angles(&format!("control.targets_deg[{i}]"), t)?);
+            }
+            RobotControl::Trajectory {
+                kp,
+                kd,
+                trajectory: JointTrajectory {
+                    times: c.times.clone(),
+                    angles: knots,
+                },
+                torque_limit: c.torque_limit,
+            }
+        }
     })
 }
 
@@ -948,25 +1180,38 @@ impl LoadedRobot {
     }
 }
 
-/// How a flight run of an imported robot ended ([`LoadedRobot::run_flight`]).
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct FlightRun {
-    /// Steps solved.
-    pub steps: usize,
+/// A column of a robot's `trajectory.csv` ([`RobotColumns`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColumnKind {
+    /// A number (f64, written shortest round-trip).
+    Number,
+    /// A contact state, written `ST1`, `ST2` or `ST3` (1, 2, 3 in the row).
+    State,
+    /// A count (written as an integer).
+    Count,
+}
+
+/// The columns of a robot's `trajectory.csv`: their names and kinds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotColumns {
+    /// Column names, in order.
+    pub names: Vec<String>,
+    /// Each column's kind.
+    pub kinds: Vec<ColumnKind>,
+}
+
+/// How a run of an imported robot ended ([`LoadedRobot::run`]).
+#[derive(Clone, Debug)]
+pub struct RobotRun {
+    /// The engine's summary: steps, Newton iterations, events, retries,
+    /// the error (naming the step, time, point or joint and law) if any.
+    pub summary: fbd_sim::RunSummary,
     /// Steps planned: `round(duration/Δt) + 1`.
     pub steps_planned: usize,
-    /// Newton iterations over the run.
-    pub newton_iterations: usize,
-    /// The simulator's error (names the step, time and joint), if any.
-    pub error: Option<String>,
-    /// Whether `stop` ended the run early.
-    pub interrupted: bool,
-    /// Time in the stepping loop (s).
-    pub wall_seconds: f64,
 }
 
 impl LoadedRobot {
-    /// `q0` and `q̇0` of the flight stepper ([`fbd_sim::tree`]): the root's
+    /// `q0` and `q̇0` of a run ([`fbd_sim::robot`]): the root's
     /// position and `φ`, then the joint angles; the root's velocity, `φ̇ =
     /// E(φ)⁻¹·ω` ([`crate::spatial::euler_rate_matrix`]; 0 at the
     /// singularity), then the joint rates.
@@ -986,41 +1231,81 @@ impl LoadedRobot {
         (q0, qd0)
     }
 
-    /// The flight stepper of this configuration (`[time]`, `[world]`).
-    ///
-    /// # Errors
-    /// An invalid step or duration (validated on loading already).
-    pub fn flight(&self) -> Result<fbd_sim::tree::TreeFlight, fbd_sim::SimError> {
-        let t = &self.config.time;
-        fbd_sim::tree::TreeFlight::new(&self.model, t.dt, t.duration, self.gravity)
+    /// The simulator's parameters of this configuration.
+    pub fn params(&self) -> fbd_sim::robot::RobotParams {
+        let (q0, qdot0) = self.flight_state();
+        let c = &self.config;
+        fbd_sim::robot::RobotParams {
+            dt: c.time.dt,
+            duration: c.time.duration,
+            gravity: self.gravity,
+            q0,
+            qdot0,
+            terrain: (c.terrain.kind != crate::TerrainKind::None).then(|| c.terrain.surface()),
+            friction: c.terrain.friction(),
+            contact: fbd_contact::ContactParams::default(),
+            stride: c.output.stride,
+            control: self.control.clone(),
+        }
     }
 
-    /// The columns of a flight's `trajectory.csv`: `t, rx, ry, rz, phi_x,
-    /// phi_y, phi_z`, one per joint angle (rad, the joint's name), per
-    /// reaction of `flight` `<joint>_fx, _fy, _fz` (force of the parent on
-    /// the child, N, inertial) and `<joint>_mx, _my, _mz` (its moment on
-    /// the child about the joint's origin, N·m), named by the reaction's
-    /// first joint; then `kinetic, potential, newton_iterations`.
-    pub fn flight_columns(&self, flight: &fbd_sim::tree::TreeFlight) -> Vec<String> {
-        let mut c: Vec<String> = MOTION_BASE_COLUMNS
+    /// The simulator of this configuration: the robot on its terrain (no
+    /// contact points with `[terrain] kind = "none"`).
+    ///
+    /// # Errors
+    /// A parameter out of its domain, a contact point starting below the
+    /// ground ([`fbd_sim::SimError`], naming the key or point).
+    pub fn sim(&self) -> Result<fbd_sim::robot::RobotSim, fbd_sim::SimError> {
+        fbd_sim::robot::RobotSim::new(&self.model, &self.params())
+    }
+
+    /// The columns of `trajectory.csv` of a run of `sim`: `t, rx, ry, rz,
+    /// phi_x, phi_y, phi_z`, one per joint angle (rad, the joint's name);
+    /// per reaction `<joint>_fx, _fy, _fz` (force of the parent on the
+    /// child at the joint's origin, N, inertial) and `<joint>_mx, _my,
+    /// _mz` (its moment on the child about that point: constraint moments,
+    /// actuator torques and stops, N·m), named by the reaction's first
+    /// joint; `tau_<joint>` per joint (N·m); per contact point `<c>`:
+    /// `<c>_state`, `<c>_x, _y, _z` (where it touches, m), `<c>_fx, _fy,
+    /// _fz` (the ground's force on it, N, inertial) and `<c>_n` (its normal
+    /// component); then `com_x, com_y, com_z, kinetic, potential,
+    /// newton_iterations`.
+    pub fn columns(&self, sim: &fbd_sim::robot::RobotSim) -> RobotColumns {
+        let mut names: Vec<String> = MOTION_BASE_COLUMNS
             .iter()
             .map(|s| (*s).to_owned())
             .collect();
-        c.insert(0, "t".to_owned());
-        c.extend(self.model.joints.iter().map(|j| j.name.clone()));
-        for r in &flight.mech.reactions {
+        names.insert(0, "t".to_owned());
+        names.extend(self.model.joints.iter().map(|j| j.name.clone()));
+        for r in &sim.mech.reactions {
             let name = &self.model.joints[r.joints[0]].name;
             for s in ["fx", "fy", "fz", "mx", "my", "mz"] {
-                c.push(format!("{name}_{s}"));
+                names.push(format!("{name}_{s}"));
             }
         }
-        c.extend(["kinetic", "potential", "newton_iterations"].map(str::to_owned));
-        c
+        names.extend(self.model.joints.iter().map(|j| format!("tau_{}", j.name)));
+        let mut kinds = vec![ColumnKind::Number; names.len()];
+        for c in &sim.mech.contacts {
+            names.push(format!("{}_state", c.name));
+            kinds.push(ColumnKind::State);
+            for s in ["x", "y", "z", "fx", "fy", "fz", "n"] {
+                names.push(format!("{}_{s}", c.name));
+                kinds.push(ColumnKind::Number);
+            }
+        }
+        for s in ["com_x", "com_y", "com_z", "kinetic", "potential"] {
+            names.push(s.to_owned());
+            kinds.push(ColumnKind::Number);
+        }
+        names.push("newton_iterations".to_owned());
+        kinds.push(ColumnKind::Count);
+        RobotColumns { names, kinds }
     }
 
-    /// The values of one record in the order of [`Self::flight_columns`]
-    /// (`newton_iterations` as a float), into `row` (cleared first).
-    pub fn flight_row(record: &fbd_sim::tree::TreeFlightRecord, row: &mut Vec<f64>) {
+    /// The values of one record in the order of [`Self::columns`] (states
+    /// as 1, 2, 3; `newton_iterations` as a float), into `row` (cleared
+    /// first).
+    pub fn row(record: &fbd_sim::robot::RobotRecord, row: &mut Vec<f64>) {
         row.clear();
         row.push(record.t);
         row.extend(&record.q);
@@ -1028,6 +1313,14 @@ impl LoadedRobot {
             row.extend(f);
             row.extend(m);
         }
+        row.extend(&record.torque);
+        for c in &record.contacts {
+            row.push(f64::from(c.state as u8 + 1));
+            row.extend(c.point);
+            row.extend(c.force);
+            row.push(c.normal);
+        }
+        row.extend(record.com);
         row.extend([
             record.kinetic,
             record.potential,
@@ -1035,43 +1328,35 @@ impl LoadedRobot {
         ]);
     }
 
-    /// Simulates the robot in passive flight (zero joint torques) from its
-    /// initial state over `[time]`, handing every solved step's record to
-    /// `on_record`; stops before the next step once `stop` is set. A
-    /// failing step (Newton, a joint leaving its limits) ends the run with
-    /// its message in [`FlightRun::error`]; the steps before were handed on.
+    /// Simulates the robot from its initial state over `[time]`, handing
+    /// every `[output] stride`-th step's record to `on_record`; stops
+    /// before the next step once `stop` is set. A failing step ends the
+    /// run with its error in the summary; the steps before were handed on.
     ///
     /// # Errors
-    /// An invalid step or duration (validated on loading already).
-    pub fn run_flight(
+    /// A parameter out of its domain or a point starting below the ground
+    /// ([`Self::sim`]).
+    pub fn run(
         &self,
         stop: &std::sync::atomic::AtomicBool,
-        on_record: &mut dyn FnMut(&fbd_sim::tree::TreeFlightRecord),
-    ) -> Result<FlightRun, fbd_sim::SimError> {
-        use fbd_sim::tree::{TreeFlightData, step};
-        let flight = self.flight()?;
-        let (q0, qd0) = self.flight_state();
-        let mut data = TreeFlightData::new(&flight, &q0, &qd0);
-        let torques = vec![0.0; self.model.joints.len()];
-        let mut run = FlightRun {
-            steps_planned: flight.steps,
-            ..FlightRun::default()
-        };
-        let start = std::time::Instant::now();
-        for _ in 0..flight.steps {
-            if stop.load(std::sync::atomic::Ordering::Relaxed) {
-                run.interrupted = true;
-                break;
-            }
-            if let Err(e) = step(&flight, &mut data, &torques) {
-                run.error = Some(e.to_string());
-                break;
-            }
-            run.steps += 1;
-            run.newton_iterations += data.record.newton_iterations;
-            on_record(&data.record);
+        on_record: &mut dyn FnMut(&fbd_sim::robot::RobotRecord),
+    ) -> Result<RobotRun, fbd_sim::SimError> {
+        let sim = self.sim()?;
+        Ok(self.run_sim(&sim, stop, on_record))
+    }
+
+    /// [`Self::run`] with the simulator built already.
+    pub fn run_sim(
+        &self,
+        sim: &fbd_sim::robot::RobotSim,
+        stop: &std::sync::atomic::AtomicBool,
+        on_record: &mut dyn FnMut(&fbd_sim::robot::RobotRecord),
+    ) -> RobotRun {
+        let data = fbd_sim::robot::RobotData::new(sim);
+        let summary = fbd_sim::engine::run::run_until(sim, data, stop, on_record);
+        RobotRun {
+            summary,
+            steps_planned: sim.steps,
         }
-        run.wall_seconds = start.elapsed().as_secs_f64();
-        Ok(run)
     }
 }

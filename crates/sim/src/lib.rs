@@ -11,8 +11,9 @@
 //! * [`run`] — the whole loop with per-row callback and a [`RunSummary`].
 //! * [`simulator`] — the stepping API for controllers outside the
 //!   simulator, every model: actions, state save/restore, readouts.
-//! * [`tree`] — a flight stepper (no ground, no joint stops) for any
-//!   robot model on the generic FBD equations of `fbd_dynamics::tree`.
+//! * [`robot`] — any imported robot (URDF, MJCF, D-H rows) on the generic
+//!   FBD equations of `fbd_dynamics::tree`, on its terrain or in flight,
+//!   with the same step, contact machinery and law audit as the hexapod.
 //! * [`gait`] — the kinematic gait of the 24-DOF hexapod (gait schedule,
 //!   body path, footholds, swing, IK with rates and accelerations, static
 //!   stability), with its own model/workspace pair and run loop.
@@ -38,13 +39,13 @@ mod model;
 mod params;
 pub mod predictor;
 pub mod record;
+pub mod robot;
 mod rules;
 mod run;
 pub mod simulator;
 pub mod spatial;
 pub mod step;
 mod system;
-pub mod tree;
 
 pub use control::{Control, LegTrajectory};
 pub use data::Data;

@@ -5,7 +5,7 @@
 
 use crate::SimError;
 use fbd_dynamics::{JacobianSink, LimitState};
-use fbd_kinematics::{Joint, JointLimits};
+use fbd_kinematics::LimitSide;
 
 /// Most solves of one (sub)step's state search: a search that has not
 /// settled by then is treated as a cycle (the step is retried in
@@ -41,14 +41,21 @@ pub(crate) fn regularization(base: f64, h: f64) -> f64 {
 /// A free joint whose trial angle crosses an end of its range (by more
 /// than [`LIMIT_ANGLE_TOL`]) is held at that end: the state to solve in.
 #[inline]
-pub(crate) fn limit_arrival(limits: &JointLimits, joint: Joint, angle: f64) -> Option<LimitState> {
-    limits
-        .violated(joint, angle - LIMIT_ANGLE_TOL)
-        .and(limits.violated(joint, angle + LIMIT_ANGLE_TOL))
-        .map(|side| LimitState::At {
-            side,
-            angle: limits.end(joint, side),
+pub(crate) fn limit_arrival(range: [f64; 2], angle: f64) -> Option<LimitState> {
+    let [lo, hi] = range;
+    if angle + LIMIT_ANGLE_TOL < lo {
+        Some(LimitState::At {
+            side: LimitSide::Lower,
+            angle: lo,
         })
+    } else if angle - LIMIT_ANGLE_TOL > hi {
+        Some(LimitState::At {
+            side: LimitSide::Upper,
+            angle: hi,
+        })
+    } else {
+        None
+    }
 }
 
 /// How strongly a stop at `state` pulls its joint towards the end instead

@@ -62,7 +62,6 @@ impl Engine for Model {
             ground: &self.params.terrain,
             friction: &self.params.friction,
             contact: &self.contact,
-            joint_limits: &self.params.joint_limits,
         }
     }
     fn limit(&self, l: usize) -> LimitInfo {
@@ -72,6 +71,7 @@ impl Engine for Model {
             joint_index: j,
             joint: self.limit_joint[l],
             leg: self.limit_leg[l],
+            range: self.params.joint_limits.range(self.limit_joint[l]),
         }
     }
     fn limit_name(&self, l: usize) -> String {

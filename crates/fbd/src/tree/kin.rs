@@ -61,8 +61,16 @@ pub struct TreeKin {
     /// Each joint's origin (m, inertial): its child body's frame origin,
     /// a point of the axis.
     pub joint_origin: Vec<Vector3<f64>>,
-    /// Each contact point (sphere centre) (m, inertial).
+    /// Each contact point where it touches the ground (m, inertial): a
+    /// point's own position; for a sphere its lowest point, the centre
+    /// minus the radius along `Y` (the point of a sphere that touches a
+    /// level ground). It moves with the sphere's centre, whose Jacobian it
+    /// has ([`Self::contact_jacobian`]).
     pub contact: Vec<Vector3<f64>>,
+    /// Each contact sphere's centre (a point's own position) (m, inertial).
+    pub contact_center: Vec<Vector3<f64>>,
+    /// Each contact sphere's radius (0 for a point) (m).
+    contact_radius: Vec<f64>,
     /// The inertial axes about which `φx, φy, φz` turn the root:
     /// `ω_root = Σ_k phi_axes[k]·φ̇_k`.
     pub phi_axes: [Vector3<f64>; 3],
@@ -126,6 +134,8 @@ impl TreeKin {
             axis: vec![z; nj],
             joint_origin: vec![z; nj],
             contact: vec![z; model.contacts.len()],
+            contact_center: vec![z; model.contacts.len()],
+            contact_radius: model.contacts.iter().map(|c| c.radius).collect(),
             phi_axes: [Vector3::x(), Vector3::y(), Vector3::z()],
             contact_body: model.contacts.iter().map(|c| c.body).collect(),
         }
@@ -188,7 +198,9 @@ impl TreeKin {
             self.com[b] = self.origin[b] + self.rotation[b] * body.com;
         }
         for (k, c) in model.contacts.iter().enumerate() {
-            self.contact[k] = self.origin[c.body] + self.rotation[c.body] * c.position;
+            let centre = self.origin[c.body] + self.rotation[c.body] * c.position;
+            self.contact_center[k] = centre;
+            self.contact[k] = Vector3::new(centre.x, centre.y - self.contact_radius[k], centre.z);
         }
     }
 
@@ -212,9 +224,10 @@ impl TreeKin {
         self.point_jacobian(b, &self.com[b])
     }
 
-    /// Jacobian of contact point `c` (its sphere's centre).
+    /// Jacobian of contact point `c`: its sphere's centre's (the lowest
+    /// point [`Self::contact`] is the centre moved by a constant).
     pub fn contact_jacobian(&self, c: usize) -> Columns<'_> {
-        self.point_jacobian(self.contact_body[c], &self.contact[c])
+        self.point_jacobian(self.contact_body[c], &self.contact_center[c])
     }
 
     /// Angular-velocity Jacobian of body `b`: `ω_b = Σ col_i·q̇_i`

@@ -30,13 +30,14 @@ pub mod data;
 pub mod run;
 pub mod search;
 pub mod step;
+pub mod surface;
 
 pub use data::RunData;
 
 use crate::SimError;
 use fbd_contact::{ContactMode, ContactParams, ContactTrial, Friction};
 use fbd_dynamics::{ContactSpec, History, PointKind};
-use fbd_kinematics::{Joint, JointLimits};
+use fbd_kinematics::Joint;
 use fbd_solver::{NewtonReport, SolverError};
 
 /// The law a trial solution breaks ([`Engine::contact_violation`],
@@ -98,8 +99,10 @@ pub struct LimitInfo {
     pub joint_index: usize,
     /// Which joint of its leg it is.
     pub joint: Joint,
-    /// Hexapod leg number.
+    /// Hexapod leg number (0 for other robots: `joint_index` names it).
     pub leg: usize,
+    /// The joint's range `[min, max]` (rad).
+    pub range: [f64; 2],
 }
 
 /// The fixed settings and sizes of a model's step.
@@ -140,8 +143,6 @@ pub struct Settings<'a, G: ?Sized> {
     pub friction: &'a Friction,
     /// The contact tolerances.
     pub contact: &'a ContactParams,
-    /// The joint ranges.
-    pub joint_limits: &'a JointLimits,
 }
 
 /// What the generic step needs from a model: its fixed data and the
@@ -205,10 +206,6 @@ pub trait Engine: Sized {
     /// Contact tolerances.
     fn contact_params(&self) -> &ContactParams {
         self.settings().contact
-    }
-    /// Joint ranges.
-    fn joint_limits(&self) -> &JointLimits {
-        self.settings().joint_limits
     }
     /// Contact points.
     fn contacts(&self) -> usize {

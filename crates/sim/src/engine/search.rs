@@ -259,8 +259,7 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
         let info = model.limit(l);
         let state = data.limit_trial[l];
         if !state.is_at() {
-            if let Some(at) = limit_arrival(model.joint_limits(), info.joint, data.z[info.q_index])
-            {
+            if let Some(at) = limit_arrival(info.range, data.z[info.q_index]) {
                 data.limit_trial[l] = at;
                 touchdown = true;
             }
@@ -517,7 +516,7 @@ pub(crate) fn worst_violation<M: Engine>(
         let angle = data.z[info.q_index];
         let (v, law) = match *state {
             LimitState::Free => {
-                let [lo, hi] = model.joint_limits().range(info.joint);
+                let [lo, hi] = info.range;
                 let tol = if model.exact() { LIMIT_ANGLE_TOL } else { 0.0 };
                 let beyond = (lo - angle).max(angle - hi) - tol;
                 (gain / length * beyond.max(0.0), Law::LimitCrossing)

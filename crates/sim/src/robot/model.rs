@@ -1,0 +1,281 @@
+//! The immutable model of a robot's run ([`RobotSim`]), validated from a
+//! [`fbd_robot::RobotModel`] and [`RobotParams`].
+
+use super::control::RobotControl;
+use super::params::RobotParams;
+use crate::SimError;
+use crate::rules::{check, positive};
+use fbd_contact::SpatialState;
+use fbd_dynamics::tree::TreeMechanism;
+use fbd_dynamics::tree::kin::{BASE_DOF, TreeKin};
+use fbd_dynamics::{ContactSpec, PointKind};
+use fbd_kinematics::nalgebra::DMatrix;
+use fbd_robot::RobotModel;
+use fbd_solver::NewtonParams;
+
+/// Everything fixed during a robot's run.
+#[derive(Clone, Debug)]
+pub struct RobotSim {
+    /// The parameters it was built from.
+    pub params: RobotParams,
+    /// The FBD mechanism: the robot's bodies, reactions, contact points
+    /// (every point of the model on the ground, none in flight) and stops.
+    pub mech: TreeMechanism,
+    /// The contact points' identities for the generic step (name, FBD
+    /// body; `leg` is the point's index + 1, `kind` tip).
+    pub contact_specs: Vec<ContactSpec>,
+    /// Each joint's effort limit (N·m), from the description.
+    pub effort: Vec<Option<f64>>,
+    /// Newton tolerances (the hexapod's).
+    pub newton: NewtonParams,
+    /// Steps to solve: `round(duration/dt) + 1`.
+    pub steps: usize,
+    /// Contact state of each point at `t = 0`.
+    pub initial_states: Vec<SpatialState>,
+    /// Finest subdivision of a step that cannot be solved whole. Default 64.
+    pub max_substeps: usize,
+    /// A cycling state search is closed by its least inconsistent trial
+    /// when its violation is at most this force (N). Default `1e-7 ×`
+    /// weight.
+    pub cycle_tolerance: f64,
+    /// Whether the contact points in contact solve stick/slip and lift-off
+    /// as a complementarity problem (default `true`, as the hexapod).
+    pub complementarity: bool,
+    /// The (unused) ground of a run in flight.
+    pub(crate) no_ground: fbd_contact::Surface,
+}
+
+impl RobotSim {
+    /// Validates `params` for `robot` and builds the model.
+    ///
+    /// # Errors
+    /// [`SimError::InvalidParameter`] naming the configuration key,
+    /// [`SimError::InitialPenetration`] for a point starting below ground.
+    pub fn new(robot: &RobotModel, params: &RobotParams) -> Result<Self, SimError> {
+        let p = params;
+        let nq = BASE_DOF + robot.joints.len();
+        let nj = robot.joints.len();
+        positive("time.dt", p.dt)?;
+        check(
+            p.duration.is_finite() && p.duration >= 0.0,
+            "time.duration",
+            "must be finite and not negative",
+            p.duration,
+            "≥ 0",
+        )?;
+        check(
+            p.gravity.is_finite(),
+            "world.gravity",
+            "must be finite",
+            p.gravity,
+            "a finite value",
+        )?;
+        check(
+            p.stride >= 1,
+            "output.stride",
+            "must be at least 1",
+            p.stride,
+            "≥ 1",
+        )?;
+        assert_eq!(p.q0.len(), nq, "q0: 6 base coordinates + one per joint");
+        assert_eq!(p.qdot0.len(), nq, "qdot0: the layout of q0");
+        p.friction
+            .validate()
+            .map_err(|e| SimError::InvalidParameter {
+                key: "terrain.mu_dynamic".into(),
+                what: e.to_string(),
+                got: format!(
+                    "μS = {}, μD = {}",
+                    p.friction.mu_static, p.friction.mu_dynamic
+                ),
+                expected: "0 ≤ μD ≤ μS".into(),
+            })?;
+        let gains = |kp: &[f64], kd: &[f64]| -> Result<(), SimError> {
+            assert!(kp.len() == nj && kd.len() == nj, "one gain per joint");
+            for (key, v) in kp
+                .iter()
+                .map(|&v| ("control.kp", v))
+                .chain(kd.iter().map(|&v| ("control.kd", v)))
+            {
+                check(
+                    v.is_finite() && v >= 0.0,
+                    key,
+                    "must be finite and not negative",
+                    v,
+                    "a finite value ≥ 0",
+                )?;
+            }
+            Ok(())
+        };
+        match &p.control {
+            RobotControl::None => {}
+            RobotControl::Pd {
+                kp,
+                kd,
+                target,
+                torque_limit,
+            } => {
+                gains(kp, kd)?;
+                assert_eq!(target.len(), nj, "one target per joint");
+                if let Some(l) = torque_limit {
+                    positive("control.torque_limit", *l)?;
+                }
+            }
+            RobotControl::Trajectory {
+                kp,
+                kd,
+                trajectory,
+                torque_limit,
+            } => {
+                gains(kp, kd)?;
+                check(
+                    !trajectory.times.is_empty()
+                        && trajectory.times.len() == trajectory.angles.len()
+                        && trajectory.times.windows(2).all(|w| w[0] < w[1])
+                        && trajectory.angles.iter().all(|a| a.len() == nj),
+                    "control.trajectory",
+                    "needs at least one knot, times strictly increasing, one angle per joint",
+                    trajectory.times.len(),
+                    "≥ 1 knot",
+                )?;
+                if let Some(l) = torque_limit {
+                    positive("control.torque_limit", *l)?;
+                }
+            }
+        }
+        for (j, joint) in robot.joints.iter().enumerate() {
+            if let Some(l) = joint.limits {
+                let a = p.q0[BASE_DOF + j];
+                check(
+                    a >= l.lower - 1e-12 && a <= l.upper + 1e-12,
+                    &format!("initial.joints_deg.{}", joint.name),
+                    "outside the joint's limits",
+                    format!("{:.6}°", a.to_degrees()),
+                    &format!(
+                        "[{:.6}°, {:.6}°]",
+                        l.lower.to_degrees(),
+                        l.upper.to_degrees()
+                    ),
+                )?;
+            }
+        }
+        pd_stability(robot, p)?;
+        let contacts: Vec<usize> = if p.terrain.is_some() {
+            (0..robot.contacts.len()).collect()
+        } else {
+            Vec::new()
+        };
+        let mech = TreeMechanism::with_contacts(robot, p.gravity, &contacts);
+        let contact_specs = mech
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(i, c)| ContactSpec {
+                name: c.name.clone(),
+                leg: i + 1,
+                kind: PointKind::Tip,
+                body: c.body,
+                point: i,
+            })
+            .collect();
+        let mut initial_states = Vec::with_capacity(mech.contacts.len());
+        if let Some(surface) = &p.terrain {
+            let mut kin = TreeKin::new(robot);
+            kin.eval(robot, &p.q0);
+            for c in &mech.contacts {
+                let pt = kin.contact[c.model_contact];
+                let state =
+                    SpatialState::initial([pt.x, pt.y, pt.z], surface, p.contact.initial_tol)
+                        .map_err(|depth| SimError::InitialPenetration {
+                            leg: "position".into(),
+                            point: c.name.clone(),
+                            depth,
+                        })?;
+                initial_states.push(state);
+            }
+        }
+        let total_mass = mech.total_mass();
+        Ok(Self {
+            params: p.clone(),
+            effort: robot.joints.iter().map(|j| j.effort).collect(),
+            contact_specs,
+            newton: NewtonParams {
+                chord_steps: 6,
+                residual_tol: 1e-9,
+                max_iterations: 50,
+                max_backtracks: 30,
+                ..NewtonParams::default()
+            },
+            steps: (p.duration / p.dt).round() as usize + 1,
+            initial_states,
+            max_substeps: 64,
+            cycle_tolerance: 1e-7 * total_mass * p.gravity.abs().max(1.0),
+            complementarity: true,
+            no_ground: fbd_contact::Surface::default(),
+            mech,
+        })
+    }
+
+    /// Number of generalised coordinates, `6 + joints`.
+    pub fn nq(&self) -> usize {
+        self.mech.nq()
+    }
+}
+
+/// The mass matrix `M(q)` (kinetic energy `½·q̇ᵀ·M·q̇`) of `robot` at `q`
+/// (`6 + joints` coordinates), from the bodies' centre-of-mass and angular
+/// Jacobians.
+pub fn mass_matrix(robot: &RobotModel, q: &[f64]) -> DMatrix<f64> {
+    let mut kin = TreeKin::new(robot);
+    kin.eval(robot, q);
+    let n = q.len();
+    let mut m = DMatrix::zeros(n, n);
+    for (b, body) in robot.bodies.iter().enumerate() {
+        if body.mass == 0.0 {
+            continue;
+        }
+        let r = kin.rotation[b];
+        let inertia = r * body.inertia * r.transpose();
+        let jc = kin.com_jacobian(b);
+        let jw = kin.angular_jacobian(b);
+        for (i, a) in jc.iter() {
+            for (j, c) in jc.iter() {
+                m[(i, j)] += body.mass * a.dot(&c);
+            }
+        }
+        for (i, a) in jw.iter() {
+            for (j, c) in jw.iter() {
+                m[(i, j)] += a.dot(&(inertia * c));
+            }
+        }
+    }
+    m
+}
+
+/// The stability rule of the explicit joint torques
+/// ([`crate::rules::pd_stability`]) for a robot: the largest `kp` and `kd`
+/// of any joint must be stable on the smallest effective joint inertia of
+/// the free robot at `q0` ([`crate::joint_inertia::fastest_mode`]): a foot
+/// in the air swings on it. Errors name `control.kd` (or `control.kp`)
+/// with the largest stable value and the joint that moves most.
+fn pd_stability(robot: &RobotModel, p: &RobotParams) -> Result<(), SimError> {
+    let (kp, kd) = match &p.control {
+        RobotControl::None => return Ok(()),
+        RobotControl::Pd { kp, kd, .. } | RobotControl::Trajectory { kp, kd, .. } => (kp, kd),
+    };
+    let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
+    let (kp, kd) = (max(kp), max(kd));
+    if robot.joints.is_empty() || (kp == 0.0 && kd == 0.0) {
+        return Ok(());
+    }
+    let m = mass_matrix(robot, &p.q0);
+    let joints: Vec<usize> = (BASE_DOF..BASE_DOF + robot.joints.len()).collect();
+    let mode = crate::joint_inertia::fastest_mode(&m, &DMatrix::zeros(0, m.ncols()), &joints);
+    crate::rules::pd_stability(
+        kp,
+        kd,
+        mode.inertia,
+        p.dt,
+        &format!("joint {}", robot.joints[mode.joint].name),
+    )
+}

@@ -107,6 +107,17 @@ pub(crate) fn positive(key: &str, v: f64) -> Result<(), SimError> {
     )
 }
 
+/// Coulomb friction's domain, `0 ≤ μD ≤ μS` (the 3D models' rule; the
+/// error names `terrain.mu_dynamic`).
+pub(crate) fn friction(f: &fbd_contact::Friction) -> Result<(), SimError> {
+    f.validate().map_err(|e| SimError::InvalidParameter {
+        key: "terrain.mu_dynamic".into(),
+        what: e.to_string(),
+        got: format!("μS = {}, μD = {}", f.mu_static, f.mu_dynamic),
+        expected: "0 ≤ μD ≤ μS".into(),
+    })
+}
+
 /// Whether the explicit PD torques are stable on a joint of effective
 /// inertia `I`: with `a = kp·Δt²/I` and `b = kd·Δt/I` (both ≥ 0), the
 /// step `I·(θ[k+1] − 2θ[k] + θ[k−1])/Δt² = −kp·θ[k] − kd·(θ[k] − θ[k−1])/Δt`

@@ -177,6 +177,100 @@ pub trait SurfaceEngine:
     fn total_mass(&self) -> f64;
 }
 
+/// The [`Engine`] stages every model on a surface shares, written once:
+/// expanded inside `impl Engine for …` of a [`SurfaceEngine`] whose
+/// assembly module is `$asm` (`fbd_dynamics::spatial` or
+/// `fbd_dynamics::tree::assemble`: `prepare_step`, `evaluate_next`,
+/// `set_configuration`, `set_previous`, `advance`) and whose model holds it
+/// in `self.mech`, its record `newton_iterations` and `state_trials`.
+macro_rules! surface_stages {
+    ($asm:path) => {
+        fn kinematics(
+            &self,
+            data: &mut $crate::engine::RunData<Self>,
+            history: fbd_dynamics::History<'_>,
+            h: f64,
+        ) {
+            use $asm as asm;
+            asm::prepare_step(&self.mech, &mut data.fbd, history, h);
+            $crate::engine::surface::reset_search(&mut data.fbd);
+        }
+        fn solve(
+            &self,
+            data: &mut $crate::engine::RunData<Self>,
+        ) -> Result<fbd_solver::NewtonReport, fbd_solver::SolverError> {
+            let (mut sys, solver, z) = $crate::engine::surface::system(self, data);
+            solver.solve(&mut sys, z)
+        }
+        fn evaluate_next(&self, data: &mut $crate::engine::RunData<Self>) {
+            use $asm as asm;
+            let nq = $crate::engine::Engine::nq(self);
+            asm::evaluate_next(&self.mech, &mut data.fbd, &data.z[..nq]);
+        }
+        fn trial(
+            &self,
+            data: &$crate::engine::RunData<Self>,
+            c: usize,
+        ) -> fbd_contact::SpatialTrial {
+            $crate::engine::surface::trial_of(self, data, c)
+        }
+        fn contact_violation(
+            &self,
+            data: &$crate::engine::RunData<Self>,
+            state: &fbd_contact::SpatialState,
+            t: &fbd_contact::SpatialTrial,
+        ) -> (f64, $crate::engine::Law) {
+            $crate::engine::surface::contact_violation(self, data, state, t)
+        }
+        fn limit_gain(&self, data: &$crate::engine::RunData<Self>) -> f64 {
+            data.fbd.limit_gain
+        }
+        fn length_scale(&self, _data: &$crate::engine::RunData<Self>) -> f64 {
+            self.mech.length_scale()
+        }
+        fn anchor_at_distance(
+            &self,
+            data: &$crate::engine::RunData<Self>,
+            reference: usize,
+            from: [f64; 3],
+            c: usize,
+        ) -> [f64; 3] {
+            $crate::engine::surface::anchor_at_distance(self, data, reference, from, c)
+        }
+        fn newton_fallback(&self, data: &mut $crate::engine::RunData<Self>) -> bool {
+            $crate::engine::surface::newton_fallback(self, data)
+        }
+        fn complementarity_switches(&self, data: &mut $crate::engine::RunData<Self>) -> bool {
+            $crate::engine::surface::switches(self, data)
+        }
+        fn refine_directions(&self, data: &mut $crate::engine::RunData<Self>) -> bool {
+            $crate::engine::surface::refine_directions(self, data)
+        }
+        fn set_previous(&self, data: &mut $crate::engine::RunData<Self>) {
+            use $asm as asm;
+            asm::set_previous(&self.mech, &mut data.fbd, &data.q_prev);
+        }
+        fn reset_kinematics(&self, data: &mut $crate::engine::RunData<Self>) {
+            use $asm as asm;
+            asm::set_configuration(&self.mech, &mut data.fbd, &data.grid_q);
+            asm::set_previous(&self.mech, &mut data.fbd, &data.grid_q_prev);
+        }
+        fn add_to_record(record: &mut Self::Record, iterations: usize, trials: usize) {
+            record.newton_iterations += iterations;
+            record.state_trials += trials;
+        }
+        fn advance(&self, data: &mut $crate::engine::RunData<Self>) {
+            use $asm as asm;
+            $crate::engine::surface::advance_states(data);
+            asm::advance(&mut data.fbd);
+        }
+        fn accepted_whole(&self, data: &mut $crate::engine::RunData<Self>) {
+            data.fbd.l_carry_valid = true;
+        }
+    };
+}
+pub(crate) use surface_stages;
+
 /// One step's equations on a surface as a [`NewtonSystem`].
 pub struct SurfaceSystem<'a, A: FbdModel<S = Space3, Ground = Surface>> {
     mech: &'a A,

@@ -79,17 +79,7 @@ impl RobotSim {
         )?;
         assert_eq!(p.q0.len(), nq, "q0: 6 base coordinates + one per joint");
         assert_eq!(p.qdot0.len(), nq, "qdot0: the layout of q0");
-        p.friction
-            .validate()
-            .map_err(|e| SimError::InvalidParameter {
-                key: "terrain.mu_dynamic".into(),
-                what: e.to_string(),
-                got: format!(
-                    "μS = {}, μD = {}",
-                    p.friction.mu_static, p.friction.mu_dynamic
-                ),
-                expected: "0 ≤ μD ≤ μS".into(),
-            })?;
+        crate::rules::friction(&p.friction)?;
         let gains = |kp: &[f64], kd: &[f64]| -> Result<(), SimError> {
             assert!(kp.len() == nj && kd.len() == nj, "one gain per joint");
             for (key, v) in kp

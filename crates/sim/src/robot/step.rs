@@ -11,16 +11,13 @@ use super::model::RobotSim;
 use super::record::RobotRecord;
 use crate::SimError;
 use crate::engine::surface::{self, SurfaceEngine};
-use crate::engine::{Engine, Law, LimitInfo, Settings};
+use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::LimitCode;
 use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
-use fbd_dynamics::History;
 use fbd_dynamics::spatial::half_momentum_and_rotation;
-use fbd_dynamics::tree::assemble::{advance, evaluate_next, prepare_step, set_previous};
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism};
 use fbd_kinematics::Joint;
 use fbd_kinematics::nalgebra::Vector3;
-use fbd_solver::{NewtonReport, SolverError};
 
 /// Solves step `data.k` (its record in `data.record`) and advances to
 /// `k + 1`, retrying in substeps when the whole step cannot be solved
@@ -93,23 +90,9 @@ impl Engine for RobotSim {
         self.mech.dims().limit_moment(l)
     }
 
-    fn kinematics(&self, data: &mut RobotData, history: History<'_>, h: f64) {
-        prepare_step(&self.mech, &mut data.fbd, history, h);
-        surface::reset_search(&mut data.fbd);
-    }
+    crate::engine::surface::surface_stages!(fbd_dynamics::tree::assemble);
     fn torques(&self, data: &mut RobotData) -> Result<(), SimError> {
         joint_torques(self, data)
-    }
-    fn solve(&self, data: &mut RobotData) -> Result<NewtonReport, SolverError> {
-        let (mut sys, solver, z) = surface::system(self, data);
-        solver.solve(&mut sys, z)
-    }
-    fn evaluate_next(&self, data: &mut RobotData) {
-        let nq = self.nq();
-        evaluate_next(&self.mech, &mut data.fbd, &data.z[..nq]);
-    }
-    fn trial(&self, data: &RobotData, c: usize) -> SpatialTrial {
-        surface::trial_of(self, data, c)
     }
     fn friction_at(&self, at: [f64; 2]) -> Friction {
         match &self.params.terrain {
@@ -117,61 +100,11 @@ impl Engine for RobotSim {
             None => self.params.friction,
         }
     }
-    fn contact_violation(
-        &self,
-        data: &RobotData,
-        state: &SpatialState,
-        t: &SpatialTrial,
-    ) -> (f64, Law) {
-        surface::contact_violation(self, data, state, t)
-    }
-    fn limit_gain(&self, data: &RobotData) -> f64 {
-        data.fbd.limit_gain
-    }
-    fn length_scale(&self, _data: &RobotData) -> f64 {
-        self.mech.length_scale()
-    }
-    fn anchor_at_distance(
-        &self,
-        data: &RobotData,
-        reference: usize,
-        from: [f64; 3],
-        c: usize,
-    ) -> [f64; 3] {
-        surface::anchor_at_distance(self, data, reference, from, c)
-    }
-    fn newton_fallback(&self, data: &mut RobotData) -> bool {
-        surface::newton_fallback(self, data)
-    }
-    fn complementarity_switches(&self, data: &mut RobotData) -> bool {
-        surface::switches(self, data)
-    }
-    fn refine_directions(&self, data: &mut RobotData) -> bool {
-        surface::refine_directions(self, data)
-    }
-    fn set_previous(&self, data: &mut RobotData) {
-        set_previous(&self.mech, &mut data.fbd, &data.q_prev);
-    }
-    fn reset_kinematics(&self, data: &mut RobotData) {
-        data.fbd.kin.eval(&self.mech.model, &data.grid_q);
-        set_previous(&self.mech, &mut data.fbd, &data.grid_q_prev);
-    }
     fn make_record(&self, data: &mut RobotData, iterations: usize, trials: usize, h: f64) {
         make_record(self, data, iterations, trials, h);
     }
     fn skip_record(&self, data: &mut RobotData, h: f64) {
         carry_momenta(self, data, h);
-    }
-    fn add_to_record(record: &mut RobotRecord, iterations: usize, trials: usize) {
-        record.newton_iterations += iterations;
-        record.state_trials += trials;
-    }
-    fn advance(&self, data: &mut RobotData) {
-        surface::advance_states(data);
-        advance(&mut data.fbd);
-    }
-    fn accepted_whole(&self, data: &mut RobotData) {
-        data.fbd.l_carry_valid = true;
     }
 }
 

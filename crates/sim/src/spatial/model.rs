@@ -135,17 +135,7 @@ impl SpatialParams {
             format!("{}°", p.q0[5].to_degrees()),
             "|φz| away from 90°",
         )?;
-        p.friction
-            .validate()
-            .map_err(|e| SimError::InvalidParameter {
-                key: "terrain.mu_dynamic".into(),
-                what: e.to_string(),
-                got: format!(
-                    "μS = {}, μD = {}",
-                    p.friction.mu_static, p.friction.mu_dynamic
-                ),
-                expected: "0 ≤ μD ≤ μS".into(),
-            })?;
+        crate::rules::friction(&p.friction)?;
         check(
             p.joint_limits.is_valid(),
             "leg.theta1_deg",

@@ -15,16 +15,11 @@ use super::data::SpatialData;
 use super::model::SpatialModel;
 use crate::SimError;
 use crate::engine::surface::{self, SurfaceEngine, SurfaceSystem};
-use crate::engine::{Engine, Law, LimitInfo, Settings};
+use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::LimitCode;
 use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
-use fbd_dynamics::History;
-use fbd_dynamics::spatial::{
-    SpatialFbdData, SpatialMechanism, advance, evaluate_next, half_momentum_and_rotation,
-    prepare_step, set_previous,
-};
+use fbd_dynamics::spatial::{SpatialFbdData, SpatialMechanism, half_momentum_and_rotation};
 use fbd_kinematics::nalgebra::Vector3;
-use fbd_solver::{NewtonReport, SolverError};
 
 pub use crate::engine::surface::{LIMIT_RELEASE_ANGLE, SLIP_RESOLUTION, UNLOADED_STICK_DRIFT};
 
@@ -105,82 +100,18 @@ impl Engine for SpatialModel {
         self.mech.layout().limit_moment(l)
     }
 
-    fn kinematics(&self, data: &mut SpatialData, history: History<'_>, h: f64) {
-        prepare_step(&self.mech, &mut data.fbd, history, h);
-        surface::reset_search(&mut data.fbd);
-    }
+    crate::engine::surface::surface_stages!(fbd_dynamics::spatial);
     fn torques(&self, data: &mut SpatialData) -> Result<(), SimError> {
         joint_torques(self, data)
     }
-    fn solve(&self, data: &mut SpatialData) -> Result<NewtonReport, SolverError> {
-        let (mut sys, solver, z) = surface::system(self, data);
-        solver.solve(&mut sys, z)
-    }
-    fn evaluate_next(&self, data: &mut SpatialData) {
-        let nq = SpatialModel::nq(self);
-        evaluate_next(&self.mech, &mut data.fbd, &data.z[..nq]);
-    }
-    fn trial(&self, data: &SpatialData, c: usize) -> SpatialTrial {
-        surface::trial_of(self, data, c)
-    }
     fn friction_at(&self, at: [f64; 2]) -> Friction {
         surface::friction_on(&self.params.terrain, &self.params.friction, at)
-    }
-    fn contact_violation(
-        &self,
-        data: &SpatialData,
-        state: &SpatialState,
-        t: &SpatialTrial,
-    ) -> (f64, Law) {
-        surface::contact_violation(self, data, state, t)
-    }
-    fn limit_gain(&self, data: &SpatialData) -> f64 {
-        data.fbd.limit_gain
-    }
-    fn length_scale(&self, _data: &SpatialData) -> f64 {
-        self.mech.length_scale()
-    }
-    fn anchor_at_distance(
-        &self,
-        data: &SpatialData,
-        reference: usize,
-        from: [f64; 3],
-        c: usize,
-    ) -> [f64; 3] {
-        surface::anchor_at_distance(self, data, reference, from, c)
-    }
-    fn newton_fallback(&self, data: &mut SpatialData) -> bool {
-        surface::newton_fallback(self, data)
-    }
-    fn complementarity_switches(&self, data: &mut SpatialData) -> bool {
-        surface::switches(self, data)
-    }
-    fn refine_directions(&self, data: &mut SpatialData) -> bool {
-        surface::refine_directions(self, data)
-    }
-    fn set_previous(&self, data: &mut SpatialData) {
-        set_previous(&self.mech, &mut data.fbd, &data.q_prev);
-    }
-    fn reset_kinematics(&self, data: &mut SpatialData) {
-        data.fbd.kin.eval(&self.mech, &data.grid_q);
-        set_previous(&self.mech, &mut data.fbd, &data.grid_q_prev);
     }
     fn make_record(&self, data: &mut SpatialData, iterations: usize, trials: usize, h: f64) {
         make_record(self, data, iterations, trials, h);
     }
     fn skip_record(&self, data: &mut SpatialData, h: f64) {
         carry_momenta(self, data, h);
-    }
-    fn add_to_record(record: &mut Self::Record, iterations: usize, trials: usize) {
-        record.newton_iterations += iterations;
-        record.state_trials += trials;
-    }
-    fn advance(&self, data: &mut SpatialData) {
-        surface::advance_states(data);
-        advance(&mut data.fbd);
-    }
-    fn accepted_whole(&self, data: &mut SpatialData) {
-        data.fbd.l_carry_valid = true;
     }
 }
 

@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # The browser test of viewer.html: runs the default experiment, the
-# hexapod tripod gait and the dynamic hexapod walk, opens each run's
+# hexapod tripod gait, the dynamic hexapod walk and the lab hexapod
+# imported from URDF in flight (its page from `fbd view`), opens each run's
 # viewer.html in headless Chromium (Debian's package, driven by
 # playwright-core from npm) and checks what it draws against
 # trajectory.csv (tests/browser/viewer.test.mjs). Installs chromium with
 # apt-get when it is missing (needs root), and the pinned playwright-core
-# with `npm ci`. Saves the screenshots viewer.png, viewer_hexapod.png and
-# viewer_hexapod_walk.png in a temporary folder it names (or in
+# with `npm ci`. Saves the screenshots viewer.png, viewer_hexapod.png,
+# viewer_hexapod_walk.png and viewer_robot.png in a temporary folder it names (or in
 # $FBD_SCREENSHOT_DIR): the test leaves the checkout as it was.
 # scripts/docs-figures.sh regenerates docs/*.png with FBD_SCREENSHOT_DIR=docs.
 set -euo pipefail
@@ -36,11 +37,13 @@ trap 'rm -rf "$runs"' EXIT
 "$fbd" run --out "$runs/paper-fall" >/dev/null
 "$fbd" run examples/hexapod_tripod.toml --out "$runs/hexapod-tripod" >/dev/null
 "$fbd" run examples/hexapod_walk.toml --out "$runs/hexapod-walk" >/dev/null
+"$fbd" run examples/robots/lab_hexapod_flight.toml --out "$runs/robot-flight" >/dev/null
+"$fbd" view "$runs/robot-flight" >/dev/null
 
 shots=${FBD_SCREENSHOT_DIR:-$(mktemp -d "${TMPDIR:-/tmp}/fbd-viewer-shots.XXXXXX")}
 shots=$(cd "$shots" && pwd)
 cd tests/browser
 CHROMIUM="$chromium" FBD_PLANAR_DIR="$runs/paper-fall" FBD_HEXAPOD_DIR="$runs/hexapod-tripod" \
-  FBD_DYNAMIC_DIR="$runs/hexapod-walk" \
+  FBD_DYNAMIC_DIR="$runs/hexapod-walk" FBD_ROBOT_DIR="$runs/robot-flight" \
   FBD_SCREENSHOT_DIR="$shots" node --test
 echo "screenshots: $shots"

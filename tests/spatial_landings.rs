@@ -24,7 +24,7 @@ fn landing(run: usize) -> SpatialModel {
         "/examples/sweep_hexapod_landing_1000.toml"
     )))
     .expect("the sweep file loads");
-    let fbd_cli::Config::Hexapod(c) = &plan.configs[run] else {
+    let fbd_cli::sweep::RunConfig::Model(fbd_cli::Config::Hexapod(c)) = &plan.configs[run] else {
         panic!("a hexapod run")
     };
     let mut params = c.spatial_params("landing").expect("a valid run");

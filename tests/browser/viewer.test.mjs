@@ -5,8 +5,10 @@
 //   FBD_PLANAR_DIR   output folder of `fbd run` (the default experiment)
 //   FBD_HEXAPOD_DIR  output folder of a hexapod run
 //   FBD_DYNAMIC_DIR  output folder of a dynamic (3D FBD) hexapod run
+//   FBD_ROBOT_DIR    output folder of an imported robot's run, with its
+//                    viewer.html (`fbd view`)
 //   FBD_SCREENSHOT_DIR  where viewer.png / viewer_hexapod.png /
-//                       viewer_hexapod_walk.png are saved
+//                       viewer_hexapod_walk.png / viewer_robot.png are saved
 //                       (optional)
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -459,6 +461,112 @@ test('dynamic hexapod run (3D FBD)', async (t) => {
       assert.deepEqual(marks, want);
     });
     await t.test('no console error', () => assert.deepEqual(errors, []));
+  } finally {
+    await context.close();
+  }
+});
+
+test('imported robot run (URDF, bodies as capsules)', async (t) => {
+  const dir = process.env.FBD_ROBOT_DIR;
+  assert.ok(dir, 'FBD_ROBOT_DIR is not set (run scripts/test-browser.sh)');
+  const csv = readCsv(join(dir, 'trajectory.csv'));
+  const { page, context, requests, errors } = await open(dir);
+  try {
+    const v = await page.evaluate(() => {
+      const w = window.fbdViewer;
+      return { n: w.frameCount, rows: w.rows, row: w.row, model: w.model, radius: w.radius, lines: w.lines.length };
+    });
+    await t.test('a robot scene of every row of trajectory.csv', () => {
+      assert.equal(v.model, 'robot');
+      assert.equal(v.rows, csv.rows.length);
+      assert.ok(csv.rows.length <= 2000);
+      assert.equal(v.n, csv.rows.length);
+      assert.deepEqual(v.row, csv.rows.map((_, i) => i));
+      assert.ok(v.lines > 0, 'no capsules');
+      assert.ok(v.radius > 0, `capsule radius ${v.radius}`);
+    });
+    const frames = [...new Set([0, Math.floor(v.n / 2), v.n - 1])];
+    for (const i of frames) {
+      await t.test(`frame ${i}: the base where trajectory.csv puts it, every capsule drawn on screen`, async () => {
+        const s = await page.evaluate((i) => {
+          const w = window.fbdViewer;
+          w.seek(i);
+          return { row: w.row[i], world: w.worldPoints(), screen: w.screenPoints(), lines: w.lines };
+        }, i);
+        const row = csv.rows[s.row];
+        const base = s.world.find((p) => p.name === 'base');
+        assert.ok(base, 'no base point');
+        ['rx', 'ry', 'rz'].forEach((c, a) => {
+          const got = base[['x', 'y', 'z'][a]];
+          const want = Number(row[csv.col(c)]);
+          assert.ok(Math.abs(got - want) < 2e-6, `frame ${i} base ${c}: drawn ${got}, trajectory.csv ${want}`);
+        });
+        const box = await page.evaluate(() => { const c = document.getElementById('canvas3d'); return { w: c.clientWidth, h: c.clientHeight }; });
+        for (const p of s.screen) {
+          assert.ok(p.x >= 0 && p.x <= box.w && p.y >= 0 && p.y <= box.h, `frame ${i} ${p.name} off screen at (${p.x}, ${p.y})`);
+        }
+        await snap(page, 'robot');
+        // The middle of every capsule on screen is drawn (not the white
+        // background), and the base's dark sphere is there.
+        const mids = s.lines.map((l) => ({ x: 0.5 * (s.screen[l.a].x + s.screen[l.b].x), y: 0.5 * (s.screen[l.a].y + s.screen[l.b].y) }));
+        const luma = await darkest(page, 'robot', mids);
+        luma.forEach((l, k) => {
+          const { a, b } = s.lines[k];
+          assert.ok(l < 230, `frame ${i}: capsule ${s.screen[a].name}–${s.screen[b].name} not drawn (lightest ${l.toFixed(0)})`);
+        });
+        const [dark] = await darkest(page, 'robot', [s.screen.find((p) => p.name === 'base')]);
+        assert.ok(dark < 110, `frame ${i}: nothing dark at the base (luma ${dark.toFixed(0)})`);
+        // Non-background pixels over the whole view.
+        const drawn = await page.evaluate(() => {
+          const { img } = window.__snaps.robot;
+          let n = 0;
+          for (let k = 0; k < img.data.length; k += 4) if (img.data[k] + img.data[k + 1] + img.data[k + 2] < 3 * 245) n++;
+          return n / (img.width * img.height);
+        });
+        assert.ok(drawn > 0.005, `only ${(100 * drawn).toFixed(3)} % of the view drawn`);
+      });
+    }
+    await t.test('seeking changes the picture', async () => {
+      await seek(page, 0);
+      await snap(page, 'first');
+      await seek(page, v.n - 1);
+      await snap(page, 'last');
+      const d = await difference(page, 'first', 'last');
+      assert.ok(d > 0.005, `only ${(100 * d).toFixed(3)} % of the pixels changed`);
+    });
+    // A run on the ground: each contact point's state and ground force as
+    // trajectory.csv has them (a flight has no such columns).
+    const names = await page.evaluate(() => window.fbdViewer.contactNames);
+    if (names.length && csv.header.includes(`${names[0]}_state`)) {
+      await t.test('every contact point: its state and ground force as trajectory.csv has them', async () => {
+        for (const i of frames) {
+          const s = await page.evaluate((i) => {
+            window.fbdViewer.seek(i);
+            return { row: window.fbdViewer.row[i], state: window.fbdViewer.state(), fc: window.fbdViewer.contactForces() };
+          }, i);
+          const row = csv.rows[s.row];
+          assert.equal(s.state, names.map((c) => row[csv.col(`${c}_state`)].slice(2)).join(''), `frame ${i}`);
+          names.forEach((c, k) => ['fx', 'fy', 'fz'].forEach((a, j) => {
+            const want = num(row, csv, `${c}_${a}`);
+            assert.ok(Math.abs(s.fc[3 * k + j] - want) < 2e-6, `frame ${i} ${c}_${a}: drawn ${s.fc[3 * k + j]}, trajectory.csv ${want}`);
+          }));
+        }
+      });
+    }
+    await t.test('the page is titled after the robot, with its panels', async () => {
+      const title = await page.title();
+      assert.ok(/robot/.test(title) && !title.includes(basename(dir)), `title "${title}"`);
+      const panels = await page.evaluate(() => [...document.querySelectorAll('.panel h2')].map((h) => h.textContent));
+      assert.ok(panels.includes('Joint angles (°)'), panels.join(', '));
+    });
+    if (shots) {
+      await seek(page, Math.floor(v.n / 2));
+      await page.screenshot({ path: join(shots, 'viewer_robot.png'), fullPage: true });
+    }
+    await t.test('no console error and no network request', () => {
+      assert.deepEqual(errors, []);
+      assert.deepEqual(requests, []);
+    });
   } finally {
     await context.close();
   }

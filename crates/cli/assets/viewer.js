@@ -10,8 +10,14 @@
   const S = JSON.parse(document.getElementById('fbd-scene').textContent);
   const N = S.t.length;
   const planar = S.model === 'planar';
-  // Contact states ST1/ST2/ST3 and force arrows: the planar model and a
-  // dynamic hexapod run (a kinematic gait has only swing and stance).
+  // An imported robot (URDF/MJCF): its bodies as capsules of radius
+  // S.radius between the points (joint origins, contact points, centres of
+  // mass), one colour per limb.
+  const robotKind = S.model === 'robot';
+  const hexapod = S.model === 'hexapod';
+  // Contact states ST1/ST2/ST3 and force arrows: the planar model, a
+  // dynamic hexapod run (a kinematic gait has only swing and stance) and
+  // a robot's run with contacts.
   const forces = planar || !!S.dynamic;
   const NP = S.points.length;
 
@@ -58,7 +64,7 @@
   // Longest arrow (m): an impact's force is clipped to it, so that the
   // arrow stays in the view, and its magnitude written beside the view.
   const MAX_ARROW = (planar ? 0.45 : 0.6) * robot;
-  const radius = (planar ? 0.022 : 0.012) * robot;
+  const radius = robotKind && S.radius > 0 ? S.radius : (planar ? 0.022 : 0.012) * robot;
 
   // ---- three.js scene ------------------------------------------------
   const canvas = document.getElementById('canvas3d');
@@ -94,11 +100,20 @@
     mesh.scale.set(r, Math.max(len, 1e-9), r);
   }
 
-  // Links.
+  // Links; a robot's are capsules: a cylinder and a sphere at each end.
   const links = S.lines.map((l) => {
     const c = l.group === 0 ? BODY : LEGS[(l.group - 1) % LEGS.length];
-    const m = new THREE.Mesh(cylGeo, mat(c));
-    m.userData = { line: l, r: l.group === 0 && planar ? 1.6 * radius : radius };
+    const material = mat(c);
+    const m = new THREE.Mesh(cylGeo, material);
+    m.userData = { line: l, r: l.group === 0 && planar ? 1.6 * radius : radius, caps: [] };
+    if (robotKind) {
+      for (let k = 0; k < 2; k++) {
+        const cap = new THREE.Mesh(sphereGeo, material);
+        cap.scale.setScalar(radius);
+        scene.add(cap);
+        m.userData.caps.push(cap);
+      }
+    }
     scene.add(m);
     return m;
   });
@@ -106,22 +121,35 @@
   const contactOf = new Map(S.contacts.map((c, i) => [c.point, i]));
   const dots = S.points.map((name, i) => {
     const isContact = contactOf.has(i);
-    const isCom = /com/.test(name) && planar;
+    const isCom = planar ? /com/.test(name) : robotKind && /_com$/.test(name);
     const m = new THREE.Mesh(sphereGeo, mat(isContact ? STATE['1'] : isCom ? 0x607d8b : BODY));
-    const r = isContact ? 1.5 * radius : isCom ? 0.9 * radius : 1.3 * radius;
+    const r = isContact ? 1.5 * radius : isCom ? 0.9 * radius : robotKind ? 1.2 * radius : 1.3 * radius;
     m.scale.setScalar(r);
     scene.add(m);
     return m;
   });
   // Hexapod: a translucent body plate (fan from the centre to the corners).
   let plate = null;
-  if (!planar) {
+  if (hexapod) {
     const corners = S.points.map((n, i) => [n, i]).filter(([n]) => /^corner/.test(n)).map(([, i]) => i);
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(corners.length * 9), 3));
     plate = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ color: 0x90a4ae, transparent: true, opacity: 0.55, side: THREE.DoubleSide }));
     plate.userData.corners = corners;
     scene.add(plate);
+  }
+  // Robot: the root's ring (its capsules not at `base`, point 0) filled
+  // with a translucent plate fanned from `base`.
+  let rootPlate = null;
+  if (robotKind) {
+    const ring = S.lines.filter((l) => l.group === 0 && l.a !== 0 && l.b !== 0);
+    if (ring.length >= 3) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(ring.length * 9), 3));
+      rootPlate = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ color: 0x90a4ae, transparent: true, opacity: 0.55, side: THREE.DoubleSide }));
+      rootPlate.userData.ring = ring;
+      scene.add(rootPlate);
+    }
   }
   // Centre of mass and its vertical line to the ground.
   const com = new THREE.Mesh(sphereGeo, mat(0x000000));
@@ -303,7 +331,11 @@
   function update() {
     if (N === 0) return;
     const f = frame;
-    for (const m of links) setCylinder(m, P(f, m.userData.line.a), P(f, m.userData.line.b), m.userData.r);
+    for (const m of links) {
+      const a = P(f, m.userData.line.a), b = P(f, m.userData.line.b);
+      setCylinder(m, a, b, m.userData.r);
+      if (m.userData.caps.length) { m.userData.caps[0].position.copy(a); m.userData.caps[1].position.copy(b); }
+    }
     dots.forEach((m, i) => m.position.copy(P(f, i)));
     const st = S.state[f];
     clipped = [];
@@ -323,6 +355,16 @@
       });
       a.needsUpdate = true;
       plate.geometry.computeBoundingSphere();
+    }
+    if (rootPlate) {
+      const a = rootPlate.geometry.attributes.position;
+      const c0 = P(f, 0);
+      rootPlate.userData.ring.forEach((l, k) => {
+        const p1 = P(f, l.a), p2 = P(f, l.b);
+        a.setXYZ(3 * k, c0.x, c0.y, c0.z); a.setXYZ(3 * k + 1, p1.x, p1.y, p1.z); a.setXYZ(3 * k + 2, p2.x, p2.y, p2.z);
+      });
+      a.needsUpdate = true;
+      rootPlate.geometry.computeBoundingSphere();
     }
     const c = new THREE.Vector3(S.com[f][0], S.com[f][1], S.com[f][2]);
     com.position.copy(c);
@@ -364,7 +406,7 @@
   const pointIndex = new Map(S.points.map((n, i) => [n, i]));
   const legLabels = [];
   let headingArrow = null;
-  if (!planar) {
+  if (hexapod) {
     for (let n = 1; n <= 6; n++) {
       const hip = pointIndex.get('hip' + n);
       if (hip === undefined) continue;
@@ -447,7 +489,7 @@
       parts.push('<span class="bar" style="width:' + scaleBar.px.toFixed(1) + 'px"></span> ' +
         Number(metres.toPrecision(2)) + ' m', '<span class="axes">↑ Y (up) → X</span>');
     } else {
-      parts.push('<span class="axes">axes: <b style="color:#e53935">X</b> <b style="color:#43a047">Y up</b> <b style="color:#1e88e5">Z</b>; <b style="color:#ff6f00">→</b> heading</span>');
+      parts.push('<span class="axes">axes: <b style="color:#e53935">X</b> <b style="color:#43a047">Y up</b> <b style="color:#1e88e5">Z</b>' + (hexapod ? '; <b style="color:#ff6f00">→</b> heading' : '') + '</span>');
     }
     if (slopeNote) parts.push(slopeNote);
     if (clipped.length) {
@@ -618,21 +660,26 @@
 
   // ---- header and legend -------------------------------------------------
   document.getElementById('title').textContent = 'fbd viewer — ' + S.title;
-  document.getElementById('info').textContent = (planar ? 'planar model, side view' : S.dynamic ? 'hexapod, 3D dynamics' : 'hexapod, 3D') + ' · ' + N + ' frames of ' + S.rows + ' rows' +
+  const kindNote = planar ? 'planar model, side view'
+    : robotKind ? (S.dynamic ? 'robot, 3D dynamics on the ground' : 'robot, 3D') + ' · capsules ' + Number((1000 * radius).toPrecision(2)) + ' mm'
+      : S.dynamic ? 'hexapod, 3D dynamics' : 'hexapod, 3D';
+  document.getElementById('info').textContent = kindNote + ' · ' + N + ' frames of ' + S.rows + ' rows' +
     (N < S.rows ? ' (decimated, every event kept)' : '') + ' · ' + (S.event_rows || S.events.length) + ' events (events.csv' +
     (S.event_rows > S.events.length ? '; ' + S.events.length + ' contact changes marked' : '') + ')' +
     (forceScale > 0 ? ' · arrows: ' + Number((0.1 / forceScale).toPrecision(2)) + ' N per 0.1 m' : '');
   const legend = document.getElementById('legend');
-  const states = forces ? ['1', '2', '3'] : ['1', '2'];
+  const states = forces ? ['1', '2', '3'] : robotKind ? ['1'] : ['1', '2'];
   for (const s of states) {
     const sw = document.createElement('span');
     sw.className = 'sw';
     sw.style.background = css(STATE[s]);
-    legend.append(sw, document.createTextNode(forces ? STATE_NAME[s] : s === '1' ? 'swing' : 'stance'));
+    legend.append(sw, document.createTextNode(forces || robotKind ? STATE_NAME[s] : s === '1' ? 'swing' : 'stance'));
   }
   const keys = planar
     ? [[CONTACT_FORCE, 'contact force'], [JOINT_FORCE, 'joint force'], [0x000000, 'centre of mass']]
-    : forces
+    : robotKind
+      ? (forces ? [[CONTACT_FORCE, 'ground force on the contact point']] : []).concat([[BODY, 'root body'], [0x000000, 'centre of mass']])
+      : forces
       ? [[CONTACT_FORCE, 'ground force on the foot'], [JOINT_FORCE, 'hip and knee forces'], [0x000000, 'centre of mass'], [0x2e7d32, 'support polygon']]
       : [[0x000000, 'centre of mass'], [0x2e7d32, 'support polygon']];
   for (const [c, label] of keys) {
@@ -642,6 +689,7 @@
     legend.append(sw, document.createTextNode(label));
   }
   if (!forces) { showJoint.parentElement.style.display = 'none'; showContact.parentElement.style.display = 'none'; }
+  if (robotKind && S.joints.length === 0) showJoint.parentElement.style.display = 'none';
 
   // ---- the test interface -------------------------------------------------
   function worldPoints() {
@@ -666,6 +714,17 @@
     seek, play, pause, worldPoints, screenPoints,
     state() { return N ? S.state[frame] : ''; },
     dynamic: !!S.dynamic,
+    model: S.model,
+    radius,
+    lines: S.lines,
+    contactNames: S.contacts.map((c) => c.name),
+    /** Capsules of a robot: [start, end] world points of each, drawn. */
+    capsules() {
+      return links.map((m) => [m.userData.line.a, m.userData.line.b].map((i) => {
+        const p = P(frame, i);
+        return [p.x, p.y, p.z];
+      }));
+    },
     contactForces() { return N ? S.fc[frame].slice() : []; },
     arrowsShown() { return contactArrows.filter((a) => a.visible).length; },
     /** Screen positions of the visible arrows' tips (contact and joint). */

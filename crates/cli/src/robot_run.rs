@@ -2,8 +2,9 @@
 //! [`fbd_scenario::robot::LoadedRobot::run`] (the generic FBD model on its
 //! terrain, or in flight with `[terrain] kind = "none"`); this module
 //! writes `trajectory.csv` (streamed, every `[output] stride`-th step),
-//! `events.csv`, `summary.json` and `config.toml`, each all-or-nothing,
-//! also after a simulation error or an interruption.
+//! `events.csv`, `summary.json`, `config.toml` and `viewer.html` (unless
+//! `[output] viewer = false`; [`crate::viewer::robot`]), each
+//! all-or-nothing, also after a simulation error or an interruption.
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -15,12 +16,14 @@ use crate::config::robot::{ColumnKind, LoadedRobot, RobotRun};
 use crate::output::{self, Ending, IterationsPerStep};
 use crate::steptime::StepTimes;
 
-/// The files of a robot's run, in the order they are written.
-pub const FILES: [&str; 4] = [
+/// The files of a robot's run, in the order they are written (the last
+/// only with `[output] viewer`).
+pub const FILES: [&str; 5] = [
     "trajectory.csv",
     "events.csv",
     "summary.json",
     "config.toml",
+    "viewer.html",
 ];
 
 /// `events.csv`'s header for a robot.
@@ -66,6 +69,19 @@ pub struct RobotSummary {
     pub rows_written: usize,
     /// The contact points, in the order of their columns (none in flight).
     pub contact_points: Vec<String>,
+    /// The root's horizontal distance from its start after the last step
+    /// (m).
+    pub distance: f64,
+    /// The root's height `ry` after the last step (m).
+    pub final_height: f64,
+    /// The largest `|τ|` of any joint over the written rows (N·m).
+    pub peak_torque_max: f64,
+    /// The largest normal force of any contact point over the written
+    /// rows (N).
+    pub peak_normal_force: f64,
+    /// Per contact point, the time of its first touchdown (`ST1` → `ST2`
+    /// or `ST3`; null if it never touched or started in contact).
+    pub first_touchdown: std::collections::BTreeMap<String, Option<f64>>,
     /// Newton iterations over the run.
     pub newton_iterations: usize,
     /// Mean and largest Newton iterations of one step.
@@ -80,6 +96,8 @@ pub struct RobotSummary {
     pub events: Vec<RobotEvent>,
     /// Steps solved again in substeps.
     pub retried_steps: usize,
+    /// Substeps solved over all retries.
+    pub substeps: usize,
     /// State searches closed by their least inconsistent combination.
     pub resolved_cycles: usize,
     /// The largest violation of a contact or limit law over the accepted
@@ -179,7 +197,33 @@ pub fn simulate(
     let mut row = Vec::with_capacity(columns.names.len());
     let mut buf = ryu::Buffer::new();
     let last = columns.names.len() - 1;
+    let contacts = sim.mech.contacts.len();
+    let mut frames = robot
+        .config
+        .output
+        .viewer
+        .then(|| crate::viewer::robot::RobotFrames::new(&robot.model, contacts > 0));
+    let mut states = vec![0u8; contacts];
+    let mut forces = vec![[0.0; 3]; contacts];
+    let (mut peak_torque, mut peak_normal) = (0.0f64, 0.0f64);
     let run = robot.run_sim(&sim, stop, &mut |r| {
+        for c in &r.contacts {
+            peak_normal = peak_normal.max(c.normal);
+        }
+        for t in &r.torque {
+            peak_torque = peak_torque.max(t.abs());
+        }
+        if let Some(f) = frames.as_mut() {
+            for (i, c) in r.contacts.iter().enumerate() {
+                states[i] = c.state as u8 + 1;
+                forces[i] = c.force;
+            }
+            f.push(
+                r.t,
+                &r.q,
+                (contacts > 0).then_some((&states[..], &forces[..])),
+            );
+        }
         if io.is_err() {
             return;
         }
@@ -258,6 +302,25 @@ pub fn simulate(
         stride: robot.config.output.stride,
         rows_written: rows,
         contact_points: sim.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+        distance: (run.final_q[0] - robot.params().q0[0])
+            .hypot(run.final_q[2] - robot.params().q0[2]),
+        final_height: run.final_q[1],
+        peak_torque_max: peak_torque,
+        peak_normal_force: peak_normal,
+        first_touchdown: sim
+            .mech
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(c, tc)| {
+                let t = s
+                    .events
+                    .iter()
+                    .find(|e| e.contact == c && e.from == fbd_contact::StateCode::St1)
+                    .map(|e| times.value(e.step, e.t));
+                (tc.name.clone(), t)
+            })
+            .collect(),
         newton_iterations: s.newton_iterations,
         newton_iterations_per_step: IterationsPerStep::of(s),
         wall_seconds: s.wall_seconds,
@@ -265,6 +328,7 @@ pub fn simulate(
         symbolic_factorizations: s.symbolic_factorizations,
         events: events.into_iter().map(|(_, _, e)| e).collect(),
         retried_steps: s.retries.len(),
+        substeps: s.substeps,
         resolved_cycles: s.resolved_cycles,
         max_law_violation: s.max_law_violation,
     };
@@ -275,14 +339,31 @@ pub fn simulate(
         &robot.config.to_toml(),
         &mut keep,
     );
+    if let Some(mut f) = frames {
+        if contacts > 0 {
+            f = f.with_surface(robot.config.terrain.surface());
+        }
+        f.set_event_rows(events_csv.lines().count() - 1);
+        keep(f.write(out_dir));
+    }
     if io_error.is_none() {
-        io_error = output::remove_stale(out_dir, &FILES).err();
+        io_error = output::remove_stale(out_dir, files(robot)).err();
     }
     Ok(RobotRunOutput {
         run,
         summary,
         io_error,
     })
+}
+
+/// The files a run of `robot` writes ([`FILES`], `viewer.html` only with
+/// `[output] viewer`).
+pub fn files(robot: &LoadedRobot) -> &'static [&'static str] {
+    if robot.config.output.viewer {
+        &FILES
+    } else {
+        &FILES[..4]
+    }
 }
 
 /// `fbd run` of a `model = "robot"` configuration `text` read from `path`:
@@ -320,5 +401,5 @@ pub fn run_command(
     } else {
         Ending::Completed
     };
-    output::conclude(out, text, out_dir, &FILES, io_error, ending)
+    output::conclude(out, text, out_dir, files(&robot), io_error, ending)
 }

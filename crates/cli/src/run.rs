@@ -434,7 +434,7 @@ pub fn run_command(
     if let Some(p) = config_path {
         let text = config::read_text(p)?;
         if config::robot::is_robot(&text) {
-            // An imported robot in flight: every file in `robot_run`.
+            // An imported robot: every file in `robot_run`.
             return crate::robot_run::run_command(&text, p, out_dir, out);
         }
     }

@@ -646,6 +646,9 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
     if s["model"] == "hexapod" && s["run"] == "dynamic" {
         return Some(dynamic_row(&s, run, values));
     }
+    if s["model"] == "robot" {
+        return Some(robot_row(&s, run, values));
+    }
     if s["model"] == "hexapod" {
         let liftoffs = s["events"]
             .as_array()
@@ -744,9 +747,58 @@ fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
     }
 }
 
+/// The row of a finished run of an imported robot, from its
+/// `summary.json`: the dynamic hexapod's columns ([`DYNAMIC_COLUMNS`]),
+/// every contact point counted as a foot.
+fn robot_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
+    let num = |v: &serde_json::Value| v.as_f64();
+    let events = s["events"].as_array();
+    let contacts: Vec<&str> = s["contact_points"]
+        .as_array()
+        .map(|a| a.iter().filter_map(serde_json::Value::as_str).collect())
+        .unwrap_or_default();
+    let slips = events.map(|e| {
+        e.iter()
+            .filter(|e| {
+                e["point"].as_str().is_some_and(|p| contacts.contains(&p))
+                    && e["to"] == "ST3"
+                    && e["from"] != "ST3"
+            })
+            .count() as f64
+    });
+    let first_touchdown = s["first_touchdown"].as_object().and_then(|m| {
+        m.values()
+            .filter_map(serde_json::Value::as_f64)
+            .reduce(f64::min)
+    });
+    Row {
+        run,
+        status: s["status"].as_str().unwrap_or("error").to_owned(),
+        values,
+        numbers: vec![
+            num(&s["distance"]),
+            num(&s["final_height"]),
+            num(&s["peak_torque_max"]),
+            num(&s["peak_normal_force"]),
+            first_touchdown,
+            slips,
+            events.map(|e| e.len() as f64),
+            num(&s["newton_iterations"]),
+            num(&s["steps_per_second"]),
+            num(&s["steps"]),
+            num(&s["wall_seconds"]),
+            num(&s["max_law_violation"]),
+            num(&s["retried_steps"]),
+            num(&s["substeps"]),
+        ],
+        kind: IndexKind::Dynamic,
+        error: s["error"].as_str().unwrap_or("").replace('\n', " "),
+    }
+}
+
 /// A finished run with status ok whose config.toml is the one planned
 /// (so `--resume` after editing the sweep file reruns what changed).
-fn is_done_ok(dir: &Path, run: usize, config: &Config) -> Option<Row> {
+fn is_done_ok(dir: &Path, run: usize, config: &RunConfig) -> Option<Row> {
     if !dir.join(DONE).is_file()
         || std::fs::read(dir.join("config.toml")).ok()? != config.to_toml().as_bytes()
     {
@@ -772,6 +824,50 @@ fn parse_shard(s: &str) -> Result<(usize, usize), CliError> {
     Ok((i, n))
 }
 
+/// One run's complete configuration: the planar model or the hexapod
+/// ([`Config`]), or an imported robot.
+#[derive(Clone, Debug)]
+pub enum RunConfig {
+    /// `model = "planar"` or `"hexapod"`.
+    Model(Config),
+    /// `model = "robot"`.
+    Robot(Box<config::robot::LoadedRobot>),
+}
+
+impl RunConfig {
+    /// The complete configuration as TOML (`config.toml` of the run).
+    pub fn to_toml(&self) -> String {
+        match self {
+            RunConfig::Model(c) => c.to_toml(),
+            RunConfig::Robot(r) => r.config.to_toml(),
+        }
+    }
+
+    /// The columns of `index.csv` it gives (a robot's are the dynamic
+    /// hexapod's).
+    pub fn kind(&self) -> IndexKind {
+        match self {
+            RunConfig::Model(c) => IndexKind::of(c),
+            RunConfig::Robot(_) => IndexKind::Dynamic,
+        }
+    }
+
+    /// Whether the run writes `viewer.html` and the plots.
+    fn set_outputs(&mut self, viewer: bool, plots: bool) {
+        match self {
+            RunConfig::Model(c) => {
+                let output = match c {
+                    Config::Planar(p) => &mut p.output,
+                    Config::Hexapod(h) => &mut h.output,
+                };
+                output.viewer = viewer;
+                output.plots = plots;
+            }
+            RunConfig::Robot(r) => r.config.output.viewer = viewer,
+        }
+    }
+}
+
 /// A loaded, validated sweep: the configuration of every run.
 pub struct Plan {
     /// The sweep file's definition.
@@ -781,7 +877,7 @@ pub struct Plan {
     /// Per run: the varied values.
     pub values: Vec<Vec<toml::Value>>,
     /// Per run: the complete configuration.
-    pub configs: Vec<Config>,
+    pub configs: Vec<RunConfig>,
     /// Per run: its trajectory file as planned (rows, columns, format),
     /// for the sweep's size warning.
     pub trajectories: Vec<crate::output::TrajectorySize>,
@@ -843,6 +939,9 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         }
         None => (String::new(), "the built-in default".to_owned()),
     };
+    if config::robot::is_robot(&base_text) {
+        return plan_robot(file, keys, values, set, &base_text, &base_name, &name);
+    }
     // The [set] keys alone on the base: an unknown key or a value of the
     // wrong type is named once (a value out of range, which may depend on
     // the varied keys, is reported per run below).
@@ -911,7 +1010,76 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
                 size(m.steps, crate::hexapod::columns().len(), &h.output)
             }
         });
-        configs.push(c);
+        configs.push(RunConfig::Model(c));
+    }
+    Ok(Plan {
+        file,
+        keys,
+        values,
+        configs,
+        trajectories,
+    })
+}
+
+/// [`plan`] of a sweep whose base is an imported robot: every run's
+/// overrides set in the base's table, its robot loaded and its simulator
+/// built (errors name the run and the key).
+fn plan_robot(
+    file: SweepFile,
+    keys: Vec<String>,
+    values: Vec<Vec<toml::Value>>,
+    set: Vec<Override>,
+    base_text: &str,
+    base_name: &str,
+    name: &str,
+) -> Result<Plan, CliError> {
+    let base_path = Path::new(base_name);
+    for i in 0..set.len() {
+        if let Err(e) = config::robot::load_with_overrides(base_text, base_path, &set[..=i]) {
+            let key = &set[i].key;
+            let message = match e {
+                config::ConfigError::Override { message, .. } => message,
+                other => other.to_string(),
+            };
+            return Err(CliError::Usage(format!(
+                "{name}: set.\"{key}\": {}",
+                message.replace('\n', " ")
+            )));
+        }
+    }
+    let mut configs = Vec::with_capacity(values.len());
+    let mut trajectories = Vec::with_capacity(values.len());
+    for (i, vals) in values.iter().enumerate() {
+        let overrides: Vec<Override> = set
+            .iter()
+            .cloned()
+            .chain(
+                keys.iter()
+                    .zip(vals)
+                    .map(|(k, v)| Override::new(k.clone(), v.clone())),
+            )
+            .collect();
+        let fail = |e: String| {
+            let what = keys
+                .iter()
+                .zip(vals)
+                .map(|(k, v)| format!("{k} = {}", format_value(v)))
+                .collect::<Vec<_>>()
+                .join(", ");
+            CliError::Usage(format!("{name}: run {i} ({what}): {e}"))
+        };
+        let robot = config::robot::load_with_overrides(base_text, base_path, &overrides)
+            .map_err(|e| fail(e.to_string()))?;
+        let sim = robot.sim().map_err(|e| fail(e.to_string()))?;
+        let stride = robot.config.output.stride.max(1);
+        trajectories.push(crate::output::TrajectorySize {
+            rows: sim.steps.div_ceil(stride),
+            columns: robot.columns(&sim).names.len(),
+            stride,
+            format: fbd_scenario::OutputFormat::Csv,
+            hexapod: true,
+        });
+        configs.push(RunConfig::Robot(Box::new(robot)));
     }
     Ok(Plan {
         file,
@@ -991,13 +1159,13 @@ impl Progress {
 
 /// Runs one sweep entry into `dir`: config.toml first, then `fbd run` of
 /// it (so the files are those of `fbd run dir/config.toml`), then `.done`.
-fn run_one(dir: &Path, config: &Config, run: usize, values: Vec<String>) -> Row {
+fn run_one(dir: &Path, config: &RunConfig, run: usize, values: Vec<String>) -> Row {
     let fail = |msg: String| Row {
         run,
         status: "error".into(),
         values: values.clone(),
         error: msg.replace('\n', " "),
-        kind: IndexKind::of(config),
+        kind: config.kind(),
         ..Row::default()
     };
     if dir.exists()
@@ -1104,12 +1272,7 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
     };
     let mut plan = plan(path)?;
     for c in &mut plan.configs {
-        let output = match c {
-            Config::Planar(p) => &mut p.output,
-            Config::Hexapod(h) => &mut h.output,
-        };
-        output.viewer = a.viewer;
-        output.plots = a.plots;
+        c.set_outputs(a.viewer, a.plots);
     }
     let total = plan.configs.len();
     // Before anything is written: a sweep larger than LARGE_SWEEP says so
@@ -1206,7 +1369,7 @@ pub fn sweep_command(a: SweepArgs, out: &mut dyn Write) -> Result<(), CliError> 
     let kind = plan
         .configs
         .first()
-        .map_or(IndexKind::Planar, IndexKind::of);
+        .map_or(IndexKind::Planar, RunConfig::kind);
     remove_stale_runs(dir, total)?;
     write_index(dir, &plan.keys, kind, &rows)?;
     write_plot(dir, &plan.keys, &rows, default_plot(kind, &a.plot), out)?;

@@ -65,21 +65,6 @@ fn inverse_of_a_robot_at_rest_needs_its_weight_at_the_root() {
 
 #[test]
 fn robot_configurations_fail_on_one_line_where_they_do_not_work() {
-    let cfg = example("robots/lab_hexapod.toml");
-    let out = tempfile::tempdir().unwrap();
-    let sweep = write(
-        out.path(),
-        "sweep.toml",
-        &format!("base = {cfg:?}\nmode = \"grid\"\n[vary]\n\"time.duration\" = [0.1, 0.2]\n"),
-    );
-    let e = one_line_error(
-        &fbd(&["sweep", s(&sweep), "--out", s(&out.path().join("sweep"))]),
-        2,
-    );
-    assert!(
-        e.contains("model = \"robot\"") && e.contains("sweeps, fbd.run and fbd.Simulator take"),
-        "{e}"
-    );
     let e = one_line_error(&fbd(&["inverse", &example("paper.toml")]), 2);
     assert!(e.contains("fbd inverse takes a model = \"robot\""), "{e}");
 

@@ -29,10 +29,11 @@ fn write(dir: &Path, name: &str, body: &str) -> std::path::PathBuf {
     p
 }
 
-fn stride_and_duration(c: &Config) -> (usize, f64) {
+fn stride_and_duration(c: &fbd_cli::sweep::RunConfig) -> (usize, f64) {
     match c {
-        Config::Planar(p) => (p.output.stride, p.time.duration),
-        Config::Hexapod(h) => (h.output.stride, h.time.duration),
+        fbd_cli::sweep::RunConfig::Model(Config::Planar(p)) => (p.output.stride, p.time.duration),
+        fbd_cli::sweep::RunConfig::Model(Config::Hexapod(h)) => (h.output.stride, h.time.duration),
+        fbd_cli::sweep::RunConfig::Robot(r) => (r.config.output.stride, r.config.time.duration),
     }
 }
 

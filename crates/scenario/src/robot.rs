@@ -208,6 +208,14 @@ pub struct RobotOutput {
     /// Every `stride`-th step is written (≥ 1). Default 1.
     #[serde(default = "default_stride")]
     pub stride: usize,
+    /// Write `viewer.html` (default true; `fbd sweep` sets it false in its
+    /// runs unless `--viewer`).
+    #[serde(default = "default_viewer")]
+    pub viewer: bool,
+}
+
+fn default_viewer() -> bool {
+    true
 }
 
 fn default_stride() -> usize {
@@ -218,6 +226,7 @@ impl Default for RobotOutput {
     fn default() -> Self {
         Self {
             stride: default_stride(),
+            viewer: default_viewer(),
         }
     }
 }
@@ -705,6 +714,33 @@ fn complete(config: &RobotConfig, description: &Path) -> RobotConfig {
     }
     c.robot.up.get_or_insert_with(|| "z".to_owned());
     c
+}
+
+/// [`load_str`] after `overrides` (dotted keys, e.g. a sweep's) are set in
+/// the configuration's table; an override that cannot be set is a
+/// [`ConfigError::Override`] naming its key.
+pub fn load_with_overrides(
+    text: &str,
+    path: &Path,
+    overrides: &[crate::Override],
+) -> Result<LoadedRobot, ConfigError> {
+    if overrides.is_empty() {
+        return load_str(text, path);
+    }
+    let file = path.display().to_string();
+    let mut table: toml::Table =
+        toml::from_str(text).map_err(|e| crate::syntax_error(&file, text, &e))?;
+    for o in overrides {
+        crate::apply_override(&mut table, &o.key, o.value.clone()).map_err(|message| {
+            ConfigError::Override {
+                file: file.clone(),
+                key: o.key.clone(),
+                message,
+            }
+        })?;
+    }
+    let text = toml::to_string(&table).map_err(|e| semantic(&file, e.to_string()))?;
+    load_str(&text, path)
 }
 
 /// Reads `path` and loads its robot ([`load_str`]).
@@ -1208,6 +1244,8 @@ pub struct RobotRun {
     pub summary: fbd_sim::RunSummary,
     /// Steps planned: `round(duration/Δt) + 1`.
     pub steps_planned: usize,
+    /// `q` after the last solved step (m, rad).
+    pub final_q: Vec<f64>,
 }
 
 impl LoadedRobot {
@@ -1352,11 +1390,12 @@ impl LoadedRobot {
         stop: &std::sync::atomic::AtomicBool,
         on_record: &mut dyn FnMut(&fbd_sim::robot::RobotRecord),
     ) -> RobotRun {
-        let data = fbd_sim::robot::RobotData::new(sim);
-        let summary = fbd_sim::engine::run::run_until(sim, data, stop, on_record);
+        let mut data = fbd_sim::robot::RobotData::new(sim);
+        let summary = fbd_sim::engine::run::run_in(sim, &mut data, stop, on_record);
         RobotRun {
             summary,
             steps_planned: sim.steps,
+            final_q: data.q,
         }
     }
 }

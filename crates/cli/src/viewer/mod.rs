@@ -15,6 +15,10 @@
 //!   24 coordinates, which feet are in stance, the centre of mass; for a
 //!   dynamic run the feet's states and forces and the joint forces), from
 //!   a gait run, a dynamic (3D FBD) run, or their `trajectory.csv`;
+//! * [`robot`] fills one from the frames of an imported robot
+//!   ([`robot::RobotFrames`]: base pose and joint angles, each contact
+//!   point's state and ground force), its bodies drawn as capsules from
+//!   joint to joint with `fbd_robot`'s forward kinematics;
 //! * [`view`] is `fbd view DIR`.
 //!
 //! Long runs are decimated to at most [`MAX_FRAMES`] frames: every k-th
@@ -23,6 +27,7 @@
 
 pub mod hexapod;
 pub mod planar;
+pub mod robot;
 pub mod view;
 
 use std::path::{Path, PathBuf};
@@ -48,7 +53,7 @@ const VIEWER_CSS: &str = include_str!("../../assets/viewer.css");
 const THREE_LICENSE: &str = include_str!("../../assets/THREE_LICENSE");
 
 /// How a scene is viewed: `"planar"` (orthographic side view of the XY
-/// plane) or `"hexapod"` (3D, orbiting camera).
+/// plane), `"hexapod"` or `"robot"` (3D, orbiting camera).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SceneKind {
@@ -57,6 +62,9 @@ pub enum SceneKind {
     Planar,
     /// The 24-DOF hexapod.
     Hexapod,
+    /// An imported robot (URDF/MJCF): its bodies drawn as capsules
+    /// ([`robot`]).
+    Robot,
 }
 
 /// A drawn segment between two points; `group` picks the colour (0 body,
@@ -365,10 +373,16 @@ fn script_safe(s: &str) -> String {
 
 /// The complete page for `scene`.
 pub fn render(scene: &Scene) -> Result<String, CliError> {
+    render_json(scene, &scene.title)
+}
+
+/// The complete page for any serializable scene: a [`Scene`], or one with
+/// fields of its own beside a flattened [`Scene`] (a robot's
+/// [`robot::RobotScene`]), titled `title`.
+pub fn render_json<S: Serialize>(scene: &S, title: &str) -> Result<String, CliError> {
     let json = serde_json::to_string(scene)
         .map_err(|e| CliError::Io(format!("viewer.html: cannot encode the scene: {e}")))?;
-    let title = scene
-        .title
+    let title = title
         .replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;");

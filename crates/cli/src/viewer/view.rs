@@ -391,6 +391,11 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
         )));
     }
     let config_file = dir.join("config.toml");
+    if let Ok(text) = std::fs::read_to_string(&config_file)
+        && config::robot::is_robot(&text)
+    {
+        return robot_view(dir, &config_file, &text);
+    }
     let config = config::load(&config_file)?;
     let source = config_file.display().to_string();
     let traj = dir.join("trajectory.csv");
@@ -451,6 +456,90 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
     scene.event_rows = std::fs::read_to_string(dir.join("events.csv"))
         .map_or(scene.events.len(), |t| t.lines().count().saturating_sub(1));
     super::write(dir, &scene)
+}
+
+/// `viewer.html` of an imported robot's run (`model = "robot"`): the base
+/// pose and the joint angles of `trajectory.csv` by name (`t, rx, ry, rz,
+/// phi_x, phi_y, phi_z`, one column per joint) and, when the file has them,
+/// each contact point's `<c>_state` and `<c>_fx, <c>_fy, <c>_fz`.
+fn robot_view(dir: &Path, config_file: &Path, text: &str) -> Result<PathBuf, CliError> {
+    let robot = config::robot::load_str(text, config_file)?;
+    let traj = dir.join("trajectory.csv");
+    if !traj.exists() {
+        return Err(CliError::Io(format!(
+            "{}: missing (give the output folder of `fbd run`)",
+            traj.display()
+        )));
+    }
+    let table = Table::read(&traj)?;
+    let model = &robot.model;
+    let t_col = table.column("t")?;
+    let mut q_cols = Vec::with_capacity(6 + model.joints.len());
+    for c in ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"] {
+        q_cols.push(table.column(c)?);
+    }
+    for j in &model.joints {
+        q_cols.push(table.column(&j.name)?);
+    }
+    // Contact columns: all or none (a flight has none).
+    let has_contacts = model
+        .contacts
+        .iter()
+        .any(|c| table.columns.contains_key(&format!("{}_state", c.name)));
+    let contact_cols: Vec<[usize; 4]> = if has_contacts {
+        model
+            .contacts
+            .iter()
+            .map(|c| {
+                let n = &c.name;
+                Ok([
+                    table.column(&format!("{n}_state"))?,
+                    table.column(&format!("{n}_fx"))?,
+                    table.column(&format!("{n}_fy"))?,
+                    table.column(&format!("{n}_fz"))?,
+                ])
+            })
+            .collect::<Result<_, CliError>>()?
+    } else {
+        Vec::new()
+    };
+    let mut frames = super::robot::RobotFrames::new(model, has_contacts);
+    if has_contacts && robot.config.terrain.kind != config::TerrainKind::None {
+        frames = frames.with_surface(robot.config.terrain.surface());
+    }
+    let mut q = vec![0.0; q_cols.len()];
+    let mut codes = vec![1u8; contact_cols.len()];
+    let mut forces = vec![[0.0; 3]; contact_cols.len()];
+    for (r, row) in table.rows.iter().enumerate() {
+        for (v, &c) in q.iter_mut().zip(&q_cols) {
+            *v = table.number(row, r, c)?;
+        }
+        for (k, cols) in contact_cols.iter().enumerate() {
+            let s = cell(row, cols[0]);
+            codes[k] = match state(s) {
+                Some(StateCode::St1) => 1,
+                Some(StateCode::St2) => 2,
+                Some(StateCode::St3) => 3,
+                None => {
+                    return Err(CliError::Io(format!(
+                        "{}: line {}: `{s}` is not a contact state (ST1, ST2 or ST3)",
+                        table.file.display(),
+                        r + 2
+                    )));
+                }
+            };
+            for (a, &c) in cols[1..].iter().enumerate() {
+                forces[k][a] = table.number(row, r, c)?;
+            }
+        }
+        let t = table.number(row, r, t_col)?;
+        frames.push(t, &q, has_contacts.then_some((&codes[..], &forces[..])));
+    }
+    // The header counts the rows of events.csv.
+    if let Ok(t) = std::fs::read_to_string(dir.join("events.csv")) {
+        frames.set_event_rows(t.lines().count().saturating_sub(1));
+    }
+    frames.write(dir)
 }
 
 /// `fbd view DIR`: writes `DIR/viewer.html` and prints its path.

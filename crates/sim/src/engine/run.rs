@@ -17,9 +17,21 @@ pub fn run_until<M: Engine>(
     model: &M,
     data: RunData<M>,
     stop: &AtomicBool,
-    mut on_row: impl FnMut(&M::Record),
+    on_row: impl FnMut(&M::Record),
 ) -> RunSummary {
     let mut data = data;
+    run_in(model, &mut data, stop, on_row)
+}
+
+/// [`run_until`] on a workspace the caller keeps: after the run, `data`
+/// holds the last state (`q[k]`, the contact states); its event lists
+/// have moved into the summary.
+pub fn run_in<M: Engine>(
+    model: &M,
+    data: &mut RunData<M>,
+    stop: &AtomicBool,
+    mut on_row: impl FnMut(&M::Record),
+) -> RunSummary {
     let settings = model.settings();
     let stride = settings.stride.max(1);
     let mut error: Option<SimError> = None;
@@ -33,7 +45,7 @@ pub fn run_until<M: Engine>(
         }
         let wanted = k % stride == 0;
         data.want_record = wanted;
-        match super::step::step(model, &mut data) {
+        match super::step::step(model, data) {
             Ok(()) if wanted => {
                 let t = std::time::Instant::now();
                 on_row(&data.record);
@@ -51,9 +63,10 @@ pub fn run_until<M: Engine>(
     summary(data, wall, error, interrupted)
 }
 
-/// The summary of a run that ended with `data`.
+/// The summary of a run that ended with `data` (its event lists move
+/// into it).
 fn summary<M: Engine>(
-    data: RunData<M>,
+    data: &mut RunData<M>,
     wall: f64,
     error: Option<SimError>,
     interrupted: bool,
@@ -67,10 +80,10 @@ fn summary<M: Engine>(
         wall_seconds: wall,
         symbolic_factorizations: data.symbolic_factorizations(),
         evicted_patterns: data.solver.evicted_patterns(),
-        events: data.events,
+        events: std::mem::take(&mut data.events),
         error,
-        limit_events: data.limit_events,
-        retries: data.retries,
+        limit_events: std::mem::take(&mut data.limit_events),
+        retries: std::mem::take(&mut data.retries),
         resolved_cycles: data.resolved_cycles,
         enumerated_cycles: data.enumerated_cycles,
         rejected_solutions: data.rejected_solutions,

@@ -326,3 +326,61 @@ fn lab_hexapod_landing_tumbles_within_the_laws() {
         assert!(v < 1e-6 * weight, "{what}: {v} N");
     }
 }
+
+/// The lab hexapod walking in a tripod gait (`examples/robots/
+/// lab_hexapod_walk.toml`, 3 s): every row within the laws, recomputed
+/// from `trajectory.csv`; it walks forward (along −Z) at about its command
+/// once the ramp is over, level, every foot lifting off once a period.
+#[test]
+fn lab_hexapod_walks_in_a_tripod_gait_within_the_laws() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(root.join("examples/robots/lab_hexapod_walk.toml"))
+        .unwrap()
+        .replace(
+            "urdf = \"lab_hexapod.urdf\"",
+            &format!(
+                "urdf = \"{}\"",
+                root.join("examples/robots/lab_hexapod.urdf").display()
+            ),
+        );
+    let (sim, rows, data, [body, turn, com, law]) = check(&text);
+    let weight = sim.mech.total_mass() * 9.81;
+    eprintln!("walk: body {body:.3e} N, rotation {turn:.3e} N, com {com:.3e} N, laws {law:.3e} N");
+    for (what, v) in [
+        ("translation", body),
+        ("rotation", turn),
+        ("centre of mass", com),
+        ("contact laws", law),
+    ] {
+        assert!(v < 1e-6 * weight, "{what}: {v} N");
+    }
+    // From t = 1.5 s (after the start-up and the ramp) to 3 s at 0.1 m/s.
+    let at = |t: f64| rows.iter().find(|r| (r.t - t).abs() < 1e-9).unwrap();
+    let (a, b) = (at(1.5), at(3.0));
+    let speed = -(b.q[2] - a.q[2]) / 1.5;
+    let sideways = (b.q[0] - a.q[0]).abs();
+    eprintln!(
+        "walk: {speed:.4} m/s forward, {sideways:.4} m sideways, {} events",
+        data.events.len()
+    );
+    assert!((0.07..0.13).contains(&speed), "{speed} m/s");
+    assert!(sideways < 0.02, "{sideways} m");
+    assert!(
+        rows.iter()
+            .all(|r| r.q[3].abs() < 0.1 && r.q[5].abs() < 0.1),
+        "level"
+    );
+    // Every foot lifts off at every step of its tripod: (3.0 − 0.5)/0.8
+    // periods, one lift-off each.
+    for c in 0..sim.contacts() {
+        let liftoffs = data
+            .events
+            .iter()
+            .filter(|e| e.contact == c && e.to == fbd_contact::StateCode::St1)
+            .count();
+        assert!(
+            (3..=4).contains(&liftoffs),
+            "foot {c}: {liftoffs} lift-offs"
+        );
+    }
+}

@@ -241,6 +241,21 @@ fn bad_keys_and_a_robot_below_ground_are_one_line_errors() {
             ),
             "control.kd: makes the explicit joint torques unstable",
         ),
+        (
+            format!("{}\n[control]\nkind = \"gait\"\n", flight_text()),
+            "a gait walks on a terrain",
+        ),
+        (
+            format!(
+                "{}\n[control]\nkind = \"gait\"\n[gait]\npattern = \"tripod\"\nsped = 0.1\n",
+                flight_text()
+            ),
+            "unknown field `sped`",
+        ),
+        (
+            format!("{}\n[gait]\npattern = \"tripod\"\n", flight_text()),
+            "gait: a [gait] table needs [control] kind = \"gait\"",
+        ),
         (flight_text().replace("dt = 0.001", "dt = 0.0"), "time.dt"),
         (
             flight_text().replace("duration = 0.5", "duration = -1.0"),

@@ -190,10 +190,36 @@ pub fn load_robot(
     load_str(&text, &path).map(Some).map_err(|e| err(e, true))
 }
 
+/// The name a robot configuration goes by in errors and results (as
+/// [`load`] names it: the path, `<string>` or `<dict>`) and whether its
+/// errors' lines refer to text the user wrote.
+pub fn robot_source(config: Option<&Bound<'_, PyAny>>) -> (String, bool) {
+    let Some(obj) = config.filter(|c| !c.is_none()) else {
+        return ("the built-in default".into(), true);
+    };
+    if obj.cast::<PyDict>().is_ok() {
+        return (DICT_SOURCE.into(), false);
+    }
+    if let Ok(s) = obj.extract::<String>()
+        && is_toml_text(&s)
+    {
+        return (STRING_SOURCE.into(), true);
+    }
+    match obj.extract::<PathBuf>() {
+        Ok(p) => (p.display().to_string(), true),
+        Err(_) => ("<config>".into(), true),
+    }
+}
+
 /// `config_toml(config=None) -> str`: the complete configuration with every
 /// key, as `fbd run` writes it to `config.toml`.
 #[pyfunction]
 #[pyo3(signature = (config=None))]
 pub fn config_toml(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<String> {
-    crate::errors::guard(|| Ok(load(py, config)?.config.to_toml()))
+    crate::errors::guard(|| {
+        if let Some(robot) = load_robot(py, config)? {
+            return Ok(robot.config.to_toml());
+        }
+        Ok(load(py, config)?.config.to_toml())
+    })
 }

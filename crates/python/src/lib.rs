@@ -3,7 +3,8 @@
 //! The native module `fbd._fbd` of the Python package `fbd`: loading a
 //! configuration from a path, a TOML string or a dict ([`config`]), whole
 //! runs with every trajectory column ([`run`]; a dynamic hexapod in
-//! [`spatial`], its kinematic gait in [`hexapod`]), the step-wise
+//! [`spatial`], its kinematic gait in [`hexapod`], an imported robot in
+//! [`robot`]), the step-wise
 //! [`simulator::Simulator`], sweeps ([`sweep`]) and kinematics
 //! ([`kinematics`]). The Python layer (`python/fbd/__init__.py`) wraps the
 //! raw results in classes and defines the exceptions this module raises.
@@ -16,6 +17,7 @@ mod config;
 mod errors;
 mod hexapod;
 mod kinematics;
+mod robot;
 mod run;
 mod simulator;
 mod spatial;

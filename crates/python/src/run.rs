@@ -1,5 +1,6 @@
 //! `run(config=None, out=None)`: a whole run, every trajectory column in
-//! memory, the CLI's files written only when `out` is given.
+//! memory, the CLI's files written only when `out` is given; an imported
+//! robot's run in [`crate::robot`].
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -160,6 +161,10 @@ pub fn run<'py>(
     out: Option<PathBuf>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
+        if let Some(robot) = crate::config::load_robot(py, config)? {
+            let (source, from_text) = crate::config::robot_source(config);
+            return crate::robot::run(py, &robot, &source, from_text, out.as_deref());
+        }
         let loaded = crate::config::load(py, config)?;
         if let fbd_scenario::Config::Hexapod(h) = &loaded.config
             && h.is_dynamic()

@@ -1,10 +1,13 @@
-//! `Simulator(config)`: the planar model or the 24-DOF hexapod stepped
+//! `Simulator(config)`: the planar model, the 24-DOF hexapod or an
+//! imported robot (`model = "robot"`) stepped
 //! from Python, one Δt at a time, with the configured controller, the
 //! caller's joint torques, or PD targets tracked inside Rust
 //! ([`fbd_sim::simulator`]); its state saved, restored, copied and
 //! pickled; many simulators stepped at once on Rust threads
 //! ([`step_many`]).
 
+use fbd_cli::config::robot::LoadedRobot;
+use fbd_sim::robot::RobotSim;
 use fbd_sim::simulator::{Action, PdTargets, Readout, SimState, Simulator as Core};
 use fbd_sim::spatial::SpatialModel;
 use fbd_sim::{Model, SimError};
@@ -23,24 +26,28 @@ const EXTERNAL_TORQUE_HINT: &str = "; the torques given to step() are applied ex
      (I: the effective joint inertia, about 1e-2 kg·m² for the default legs), so lower \
      the gains or time.dt, or track targets inside the step with set_pd_targets()";
 
-/// The stepped model, planar or spatial.
+/// The stepped model: planar, the hexapod, or an imported robot (with
+/// its loaded configuration: names, events).
 #[derive(Clone)]
 enum Plant {
     Planar(Box<Model>),
     Hexapod(Box<SpatialModel>),
+    Robot(Box<RobotSim>, Box<LoadedRobot>),
 }
 
-/// A simulator of either model.
+/// A simulator of any model.
 enum Sim {
     Planar(Box<Core<Model>>),
     Hexapod(Box<Core<SpatialModel>>),
+    Robot(Box<Core<RobotSim>>),
 }
 
-/// A saved state of either model.
+/// A saved state of any model.
 #[derive(Clone)]
 enum Saved {
     Planar(Box<SimState<Model>>),
     Hexapod(Box<SimState<SpatialModel>>),
+    Robot(Box<SimState<RobotSim>>),
 }
 
 impl Sim {
@@ -48,30 +55,35 @@ impl Sim {
         match plant {
             Plant::Planar(m) => Sim::Planar(Box::new(Core::new((**m).clone()))),
             Plant::Hexapod(m) => Sim::Hexapod(Box::new(Core::new((**m).clone()))),
+            Plant::Robot(m, _) => Sim::Robot(Box::new(Core::new((**m).clone()))),
         }
     }
     fn step(&mut self, action: &Action<'_>) -> Result<(), SimError> {
         match self {
             Sim::Planar(s) => s.step(action),
             Sim::Hexapod(s) => s.step(action),
+            Sim::Robot(s) => s.step(action),
         }
     }
     fn readout(&self, out: &mut Readout) {
         match self {
             Sim::Planar(s) => s.readout_into(out),
             Sim::Hexapod(s) => s.readout_into(out),
+            Sim::Robot(s) => s.readout_into(out),
         }
     }
     fn k(&self) -> usize {
         match self {
             Sim::Planar(s) => s.k(),
             Sim::Hexapod(s) => s.k(),
+            Sim::Robot(s) => s.k(),
         }
     }
     fn q(&self) -> &[f64] {
         match self {
             Sim::Planar(s) => s.q(),
             Sim::Hexapod(s) => s.q(),
+            Sim::Robot(s) => s.q(),
         }
     }
     fn qdot(&self) -> Vec<f64> {
@@ -79,6 +91,7 @@ impl Sim {
         match self {
             Sim::Planar(s) => s.qdot(&mut v),
             Sim::Hexapod(s) => s.qdot(&mut v),
+            Sim::Robot(s) => s.qdot(&mut v),
         }
         v
     }
@@ -86,18 +99,21 @@ impl Sim {
         match self {
             Sim::Planar(s) => s.joints(),
             Sim::Hexapod(s) => s.joints(),
+            Sim::Robot(s) => s.joints(),
         }
     }
     fn state(&self) -> Saved {
         match self {
             Sim::Planar(s) => Saved::Planar(Box::new(s.state())),
             Sim::Hexapod(s) => Saved::Hexapod(Box::new(s.state())),
+            Sim::Robot(s) => Saved::Robot(Box::new(s.state())),
         }
     }
     fn set_state(&mut self, saved: &Saved) -> bool {
         match (self, saved) {
             (Sim::Planar(s), Saved::Planar(v)) => s.set_state(v),
             (Sim::Hexapod(s), Saved::Hexapod(v)) => s.set_state(v),
+            (Sim::Robot(s), Saved::Robot(v)) => s.set_state(v),
             _ => return false,
         }
         true
@@ -254,8 +270,8 @@ pub fn _state_from_log(config: String, k: usize, log: &[u8]) -> PyResult<Simulat
     })
 }
 
-/// The planar model or the 24-DOF hexapod stepped one Δt at a time, for
-/// controllers written in Python. `config` is a configuration as for
+/// The planar model, the 24-DOF hexapod or an imported robot stepped one
+/// Δt at a time, for controllers written in Python. `config` is a configuration as for
 /// `fbd.run` (None, a path, TOML text or a dict). See the reference
 /// (docs/reference.md, "fbd.Simulator") for every attribute.
 #[pyclass(module = "fbd._fbd")]
@@ -294,6 +310,13 @@ fn coordinate_names(plant: &Plant) -> Vec<String> {
             }
             v
         }
+        Plant::Robot(_, r) => {
+            let mut v: Vec<String> = fbd_cli::config::robot::MOTION_BASE_COLUMNS
+                .map(String::from)
+                .to_vec();
+            v.extend(r.model.joints.iter().map(|j| j.name.clone()));
+            v
+        }
     }
 }
 
@@ -303,11 +326,13 @@ impl Simulator {
         let contacts = match &plant {
             Plant::Planar(m) => m.mech.contacts.iter().map(|c| c.name.clone()).collect(),
             Plant::Hexapod(m) => m.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+            Plant::Robot(m, _) => m.mech.contacts.iter().map(|c| c.name.clone()).collect(),
         };
         let coordinates = coordinate_names(&plant);
         let joint_names = match &sim {
             Sim::Planar(s) => s.model().joint_indices_names(&coordinates),
             Sim::Hexapod(s) => s.model().joint_indices_names(&coordinates),
+            Sim::Robot(s) => s.model().joint_indices_names(&coordinates),
         };
         let mut s = Self {
             plant,
@@ -330,23 +355,20 @@ impl Simulator {
         self.sim.readout(&mut self.readout);
     }
 
-    fn is_planar(&self) -> bool {
-        matches!(self.plant, Plant::Planar(_))
-    }
-
     fn dt_(&self) -> f64 {
         match &self.plant {
             Plant::Planar(m) => m.dt(),
             Plant::Hexapod(m) => m.dt(),
+            Plant::Robot(m, _) => m.params.dt,
         }
     }
 
     fn vector(&self, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
         let n = self.sim.joints();
-        let names = if self.is_planar() {
-            "hip3, knee3, hip4, knee4".to_owned()
-        } else {
-            "θ1, θ2, θ3 of leg 1, then leg 2, …".to_owned()
+        let names = match &self.plant {
+            Plant::Planar(_) => "hip3, knee3, hip4, knee4".to_owned(),
+            Plant::Hexapod(_) => "θ1, θ2, θ3 of leg 1, then leg 2, …".to_owned(),
+            Plant::Robot(..) => "the joints of joint_names in order".to_owned(),
         };
         let kind = if what == "torques" {
             "joint torques"
@@ -510,6 +532,22 @@ impl Simulator {
     #[pyo3(signature = (config=None))]
     fn new(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         guard(|| {
+            if let Some(robot) = crate::config::load_robot(py, config)? {
+                let (source, from_text) = crate::config::robot_source(config);
+                let model = robot.sim().map_err(|e| {
+                    config_error(
+                        py,
+                        &fbd_cli::ConfigError::Semantic {
+                            file: source.clone(),
+                            message: e.to_string(),
+                        },
+                        from_text,
+                    )
+                })?;
+                let text = robot.config.to_toml();
+                let plant = Plant::Robot(Box::new(model), Box::new(robot));
+                return Ok(Self::build(plant, source, text));
+            }
             let loaded = crate::config::load(py, config)?;
             let text = loaded.config.to_toml();
             let plant = match &loaded.config {
@@ -770,13 +808,129 @@ impl Simulator {
         (f, args).into_pyobject(py).map(|t| t.into_any())
     }
 
-    /// `"planar"` or `"hexapod"`.
+    /// `"planar"`, `"hexapod"` or `"robot"`.
     #[getter]
     fn model(&self) -> &'static str {
-        if self.is_planar() {
-            "planar"
-        } else {
-            "hexapod"
+        match &self.plant {
+            Plant::Planar(_) => "planar",
+            Plant::Hexapod(_) => "hexapod",
+            Plant::Robot(..) => "robot",
+        }
+    }
+
+    /// The imported robot's name (from its description), None for the
+    /// paper's models.
+    #[getter]
+    fn robot_name(&self) -> Option<String> {
+        match &self.plant {
+            Plant::Robot(_, r) => Some(r.model.name.clone()),
+            _ => None,
+        }
+    }
+
+    /// Names of the bodies of `observe()`'s `body_*` rows for an imported
+    /// robot (every body of the model, the root first); empty for the
+    /// paper's models.
+    #[getter]
+    fn body_names(&self) -> Vec<String> {
+        match &self.plant {
+            Plant::Robot(_, r) => r.model.bodies.iter().map(|b| b.name.clone()).collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// Names of an imported robot's joint reactions, the rows of
+    /// `joint_forces` and `observe()`'s `reaction_*` (each named by its
+    /// first joint, as the `<joint>_fx` columns of `trajectory.csv`);
+    /// empty for the paper's models.
+    #[getter]
+    fn reaction_names(&self) -> Vec<String> {
+        match &self.plant {
+            Plant::Robot(m, r) => m
+                .mech
+                .reactions
+                .iter()
+                .map(|x| r.model.joints[x.joints[0]].name.clone())
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
+    /// An imported robot's configured controller (`[control]`):
+    /// `{"kind": "none" | "pd" | "trajectory" | "gait", "kp", "kd"}` (arrays per
+    /// joint, N·m/rad and N·m·s/rad; empty for `"none"`), `"torque_limit"`
+    /// (N·m or None) and for `"pd"` its `"targets"` (rad); None for the
+    /// paper's models.
+    #[getter]
+    fn control<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyDict>>> {
+        use fbd_sim::robot::RobotControl;
+        let Plant::Robot(m, _) = &self.plant else {
+            return Ok(None);
+        };
+        let d = PyDict::new(py);
+        let (kind, kp, kd, limit): (&str, &[f64], &[f64], Option<f64>) = match &m.params.control {
+            RobotControl::None => ("none", &[], &[], None),
+            RobotControl::Pd {
+                kp,
+                kd,
+                target,
+                torque_limit,
+            } => {
+                d.set_item("targets", PyArray1::from_slice(py, target))?;
+                ("pd", kp, kd, *torque_limit)
+            }
+            RobotControl::Trajectory {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            } => ("trajectory", kp, kd, *torque_limit),
+            RobotControl::Gait {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            } => ("gait", kp, kd, *torque_limit),
+        };
+        d.set_item("kind", kind)?;
+        d.set_item("kp", PyArray1::from_slice(py, kp))?;
+        d.set_item("kd", PyArray1::from_slice(py, kd))?;
+        d.set_item("torque_limit", limit)?;
+        Ok(Some(d))
+    }
+
+    /// An imported robot's smallest effective joint inertia (kg·m²) of the
+    /// free robot at `q0` and the joint that moves most in that mode: the
+    /// `I` of fbd's PD stability rule `kp·Δt²/I + 2·kd·Δt/I < 4`
+    /// (docs/reference.md, the PD stability rule); None for the paper's
+    /// models or a robot without joints.
+    #[getter]
+    fn joint_inertia(&self) -> Option<(f64, String)> {
+        let Plant::Robot(m, r) = &self.plant else {
+            return None;
+        };
+        let nj = r.model.joints.len();
+        if nj == 0 {
+            return None;
+        }
+        let mass = fbd_sim::robot::mass_matrix(&r.model, &m.params.q0);
+        let joints: Vec<usize> = (6..6 + nj).collect();
+        let none = fbd_kinematics::nalgebra::DMatrix::zeros(0, mass.ncols());
+        let mode = fbd_sim::joint_inertia::fastest_mode(&mass, &none, &joints);
+        Some((mode.inertia, r.model.joints[mode.joint].name.clone()))
+    }
+
+    /// Effort limit of each joint from an imported robot's description
+    /// (N·m, NaN for none), in `joint_names` order; None for the paper's
+    /// models.
+    #[getter]
+    fn effort_limits<'py>(&self, py: Python<'py>) -> Option<Bound<'py, PyArray1<f64>>> {
+        match &self.plant {
+            Plant::Robot(m, _) => Some(PyArray1::from_vec(
+                py,
+                m.effort.iter().map(|e| e.unwrap_or(f64::NAN)).collect(),
+            )),
+            _ => None,
         }
     }
 
@@ -804,6 +958,7 @@ impl Simulator {
         match &self.plant {
             Plant::Planar(m) => m.steps,
             Plant::Hexapod(m) => m.steps,
+            Plant::Robot(m, _) => m.steps,
         }
     }
 
@@ -817,7 +972,8 @@ impl Simulator {
 
     /// `q[k]` (m, rad), a new array: the planar model's `(Rx, Ry, φz, θ2₃,
     /// θ3₃, θ2₄, θ3₄)`, the hexapod's 24 coordinates in the order of
-    /// `fbd.hexapod_fk` (`coordinate_names`).
+    /// `fbd.hexapod_fk`, an imported robot's root `(R, φ)` then its joint
+    /// angles in model order (`coordinate_names`).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_slice(py, self.sim.q())
@@ -836,6 +992,7 @@ impl Simulator {
         match &self.plant {
             Plant::Planar(m) => PyArray1::from_slice(py, &m.params.q0),
             Plant::Hexapod(m) => PyArray1::from_slice(py, &m.params.q0),
+            Plant::Robot(m, _) => PyArray1::from_slice(py, &m.params.q0),
         }
     }
 
@@ -847,7 +1004,8 @@ impl Simulator {
 
     /// Names of the actuated joints, the order of torques and targets: the
     /// planar `theta2_3, theta3_3, theta2_4, theta3_4` (hip3, knee3, hip4,
-    /// knee4); the hexapod's `theta1_1, theta2_1, theta3_1, theta1_2, …`.
+    /// knee4); the hexapod's `theta1_1, theta2_1, theta3_1, theta1_2, …`;
+    /// an imported robot's joint names in model order.
     #[getter]
     fn joint_names(&self) -> Vec<String> {
         self.joint_names.clone()
@@ -913,9 +1071,14 @@ impl Simulator {
     /// Joint forces at the last solved step (N, parent on child, inertial
     /// frame): the planar hip3, knee3, hip4, knee4 `(Fx, Fy)`, shape
     /// `(4, 2)`; the hexapod's hip and knee of each leg, shape
-    /// `(legs, 2, 3)`.
+    /// `(legs, 2, 3)`; an imported robot's reactions (`reaction_names`),
+    /// shape `(reactions, 3)`.
     #[getter]
     fn joint_forces<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        if let Sim::Robot(_) = &self.sim {
+            let f: Vec<[f64; 3]> = self.readout.reactions.iter().map(|r| r.force).collect();
+            return self.arr3(py, &f).into_any();
+        }
         if let Sim::Planar(s) = &self.sim {
             let r = &s.data().record;
             let a = Array2::from_shape_fn((r.joint_force.len(), 2), |(j, i)| r.joint_force[j][i]);
@@ -1032,6 +1195,15 @@ impl Simulator {
             "contact_slip_velocity",
             self.arr3(py, &c.iter().map(|c| c.slip_velocity).collect::<Vec<_>>()),
         )?;
+        let x = &r.reactions;
+        d.set_item(
+            "reaction_force",
+            self.arr3(py, &x.iter().map(|x| x.force).collect::<Vec<_>>()),
+        )?;
+        d.set_item(
+            "reaction_moment",
+            self.arr3(py, &x.iter().map(|x| x.moment).collect::<Vec<_>>()),
+        )?;
         d.set_item("kinetic", r.kinetic)?;
         d.set_item("potential", r.potential)?;
         Ok(d)
@@ -1051,6 +1223,19 @@ impl Simulator {
             Sim::Hexapod(s) => {
                 let d = s.data();
                 crate::run::events(py, &d.events, &d.limit_events, &d.retries, dt)
+            }
+            Sim::Robot(s) => {
+                let Plant::Robot(_, robot) = &self.plant else {
+                    return Ok(PyList::empty(py));
+                };
+                let d = s.data();
+                let run = fbd_sim::RunSummary {
+                    events: d.events.clone(),
+                    limit_events: d.limit_events.clone(),
+                    retries: d.retries.clone(),
+                    ..Default::default()
+                };
+                crate::robot::events(py, robot, s.model(), &run)
             }
         }
     }

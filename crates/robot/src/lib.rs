@@ -22,6 +22,7 @@
 pub mod dh;
 pub mod error;
 pub mod forward;
+pub mod gait;
 pub mod ik;
 pub mod mjcf;
 pub mod mjcf_export;

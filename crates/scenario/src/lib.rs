@@ -1392,17 +1392,20 @@ fn model_of(table: &toml::Table) -> ModelKind {
     }
 }
 
-/// The error for `model = "robot"` where only the hexapod and the planar
-/// model work so far.
+/// The error for `model = "robot"` where a configuration of the paper's
+/// models is needed (every caller of [`parse_str`] / [`parse_table`],
+/// which build a [`Config`]); imported robots load through
+/// [`robot::load_str`] in the commands and functions that take them.
 fn robot_not_yet(table: &toml::Table, file: &str) -> Result<(), ConfigError> {
     match table.get("model") {
         Some(toml::Value::String(s)) if s == robot::MODEL => Err(ConfigError::Semantic {
             file: file.to_owned(),
             message: "model = \"robot\": an imported URDF/MJCF robot works with the \
-                      commands `fbd run` (in flight), `fbd kinematics`, `fbd inverse` and \
-                      `fbd export mjcf`, and with Python's fbd.kinematics and fbd.inverse, \
-                      so far; sweeps, fbd.run and fbd.Simulator take model = \"planar\" \
-                      or \"hexapod\""
+                      commands `fbd run` (on the ground or in flight), `fbd sweep`, \
+                      `fbd kinematics`, `fbd inverse` and `fbd export mjcf`, and with \
+                      Python's fbd.run, fbd.sweep, fbd.Simulator, fbd.kinematics, \
+                      fbd.inverse and the Gymnasium environment fbd/Robot-v0; this takes \
+                      model = \"planar\" or \"hexapod\""
                 .to_owned(),
         }),
         _ => Ok(()),

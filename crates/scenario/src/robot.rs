@@ -164,6 +164,75 @@ pub enum RobotControlKind {
     Pd,
     /// PD along piecewise-linear joint trajectories.
     Trajectory,
+    /// PD along the joint angles and rates of the `[gait]` plan.
+    Gait,
+}
+
+/// A gait's stepping pattern (`[gait] pattern`).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+#[serde(rename_all = "lowercase")]
+pub enum GaitPattern {
+    /// Four legs, diagonal pairs: phases `[0, ½, ½, 0]` (feet FL, FR, HL,
+    /// HR), period 0.5 s, duty factor 0.6.
+    #[default]
+    Trot,
+    /// Four legs, one at a time (FL, HR, FR, HL): phases `[0, ½, ¾, ¼]`,
+    /// period 0.8 s, duty factor 0.75.
+    Walk,
+    /// Six legs in two tripods: phases `[0, ½, 0, ½, 0, ½]` (LF, LM, LR,
+    /// RF, RM, RR), period 0.8 s, duty factor 0.6.
+    Tripod,
+    /// `phases` given, period 0.5 s and duty factor 0.6 unless given.
+    Custom,
+}
+
+/// `[gait]` of an imported robot (`[control] kind = "gait"`): the plan of
+/// [`fbd_robot::gait`]. Every key but `pattern` is optional; the complete
+/// configuration (`config.toml`) holds the values used.
+#[derive(Clone, Debug, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RobotGaitConfig {
+    /// The pattern; its phases, period and duty factor are the defaults.
+    #[serde(default)]
+    pub pattern: GaitPattern,
+    /// The feet (contact points by name), in the order of `phases`;
+    /// default every contact point in the model's order.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feet: Option<Vec<String>>,
+    /// Per foot, the lift-off's phase in `[0, 1)`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phases: Option<Vec<f64>>,
+    /// Gait period (s).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+    /// Duty factor: the stance's share of the period, in (0, 1).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duty_factor: Option<f64>,
+    /// Swing apex above the ground (m). Default 0.04.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_height: Option<f64>,
+    /// Forward speed (m/s, along the body's `−z`); or `velocity`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed: Option<f64>,
+    /// Horizontal velocity `[vx, vz]` (m/s) in the heading frame; default
+    /// `[0, −speed]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub velocity: Option<[f64; 2]>,
+    /// Yaw rate (deg/s, counter-clockwise seen from above). Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub yaw_rate_deg: Option<f64>,
+    /// Body height while walking (m); default the initial one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body_height: Option<f64>,
+    /// Footholds moved outwards along the body's `x` (m). Default 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stance_width: Option<f64>,
+    /// Standing time before the first step (s). Default 0.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub startup: Option<f64>,
+    /// The velocity's smooth ramp after `startup` (s). Default 0.5.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ramp: Option<f64>,
 }
 
 /// `[control]` of an imported robot: `τ = kp·(θ* − θ[k]) + kd·(θ̇* −
@@ -258,6 +327,9 @@ pub struct RobotConfig {
     /// `[control]`.
     #[serde(default)]
     pub control: RobotControlConfig,
+    /// `[gait]` (with `[control] kind = "gait"`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gait: Option<RobotGaitConfig>,
     /// `[output]`.
     #[serde(default)]
     pub output: RobotOutput,
@@ -514,7 +586,28 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
             .fold(f64::INFINITY, f64::min);
         base.translation.vector.y -= lowest;
     }
-    let control = resolve_control(&config.control, &model, &q, &file, &description)?;
+    let plan = if config.control.kind == RobotControlKind::Gait {
+        if config.terrain.kind == crate::TerrainKind::None {
+            return Err(semantic(
+                &file,
+                "control.kind = \"gait\": a gait walks on a terrain (not kind = \"none\")"
+                    .to_owned(),
+            ));
+        }
+        let time = config.time.clone();
+        let gait = config.gait.get_or_insert_with(Default::default);
+        let plan = resolve_gait(gait, &model, &base, init.phi_deg, &q, &file)?;
+        check_reach(&plan, &time, &file)?;
+        Some(plan)
+    } else if config.gait.is_some() {
+        return Err(semantic(
+            &file,
+            "gait: a [gait] table needs [control] kind = \"gait\"".to_owned(),
+        ));
+    } else {
+        None
+    };
+    let control = resolve_control(&config.control, &model, &q, &file, &description, plan)?;
     let config = complete(&config, &description);
     Ok(LoadedRobot {
         description,
@@ -576,15 +669,153 @@ fn resolve_description(
     ))
 }
 
+/// Every target of `plan` over the run's first steps is within reach: up to
+/// the start-up, the ramp and two periods (after the ramp the plan repeats
+/// itself in the body's frame every period) or the run's end, every step.
+/// The first foot out of reach is an error naming it and the time.
+fn check_reach(
+    plan: &fbd_robot::gait::GaitPlan,
+    time: &RobotTime,
+    file: &str,
+) -> Result<(), ConfigError> {
+    let p = plan.params();
+    let horizon = time.duration.min(p.startup + p.ramp + 2.0 * p.period);
+    let steps = (horizon / time.dt).round() as usize + 1;
+    let mut plan = plan.clone();
+    let n = plan.standing().len();
+    let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    for k in 0..steps {
+        plan.targets(k as f64 * time.dt, &mut q, &mut qd)
+            .map_err(|e| semantic(file, format!("gait: {e}")))?;
+    }
+    Ok(())
+}
+
+/// `[gait]` into a plan from the initial pose (`base`, `phi_deg`, joint
+/// angles `q`); fills every key of `gait` with the value used. Errors name
+/// `gait.<key>`.
+fn resolve_gait(
+    gait: &mut RobotGaitConfig,
+    model: &RobotModel,
+    base: &Isometry3<f64>,
+    phi_deg: [f64; 3],
+    q: &[f64],
+    file: &str,
+) -> Result<fbd_robot::gait::GaitPlan, ConfigError> {
+    use fbd_robot::gait::{GaitParams, GaitPlan};
+    let mut p = match gait.pattern {
+        GaitPattern::Trot | GaitPattern::Custom => GaitParams::trot(),
+        GaitPattern::Walk => GaitParams::walk(),
+        GaitPattern::Tripod => GaitParams::tripod(),
+    };
+    let names: Vec<String> = match &gait.feet {
+        Some(f) => f.clone(),
+        None => model.contacts.iter().map(|c| c.name.clone()).collect(),
+    };
+    let refs: Vec<&str> = names.iter().map(String::as_str).collect();
+    let feet = GaitPlan::feet_by_name(model, &refs)
+        .map_err(|e| semantic(file, format!("gait.feet: {e}")))?;
+    if let Some(ph) = &gait.phases {
+        p.phases = ph.clone();
+    } else if gait.pattern == GaitPattern::Custom {
+        return Err(semantic(
+            file,
+            "gait.phases: pattern = \"custom\" needs phases, one per foot".to_owned(),
+        ));
+    } else if p.phases.len() != feet.len() {
+        return Err(semantic(
+            file,
+            format!(
+                "gait.pattern: {:?} has {} legs, the robot {} feet ({}); give gait.feet or gait.phases",
+                gait.pattern,
+                p.phases.len(),
+                feet.len(),
+                names.join(", ")
+            )
+            .to_lowercase(),
+        ));
+    }
+    let finite = |key: &str, v: f64| {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(semantic(
+                file,
+                format!("gait.{key}: must be finite (got {v})"),
+            ))
+        }
+    };
+    if let Some(v) = gait.period {
+        p.period = finite("period", v)?;
+    }
+    if let Some(v) = gait.duty_factor {
+        p.duty = finite("duty_factor", v)?;
+    }
+    if let Some(v) = gait.step_height {
+        p.step_height = finite("step_height", v)?;
+    }
+    match (gait.velocity, gait.speed) {
+        (Some(_), Some(_)) => {
+            return Err(semantic(
+                file,
+                "gait.velocity: give speed or velocity, not both".to_owned(),
+            ));
+        }
+        (Some(v), None) => p.velocity = [finite("velocity", v[0])?, finite("velocity", v[1])?],
+        (None, Some(s)) => p.velocity = [0.0, -finite("speed", s)?],
+        (None, None) => p.velocity = [0.0, 0.0],
+    }
+    if let Some(v) = gait.yaw_rate_deg {
+        p.yaw_rate = finite("yaw_rate_deg", v)?.to_radians();
+    }
+    if let Some(v) = gait.body_height {
+        p.body_height = Some(finite("body_height", v)?);
+    }
+    if let Some(v) = gait.stance_width {
+        p.stance_width = finite("stance_width", v)?;
+    }
+    if let Some(v) = gait.startup {
+        p.startup = finite("startup", v)?;
+    }
+    if let Some(v) = gait.ramp {
+        p.ramp = finite("ramp", v)?;
+    }
+    let position = base.translation.vector;
+    let plan = GaitPlan::new(
+        model,
+        &feet,
+        [position.x, position.y, position.z],
+        phi_deg.map(f64::to_radians),
+        q,
+        p.clone(),
+    )
+    .map_err(|e| semantic(file, format!("gait: {e}")))?;
+    gait.feet = Some(names);
+    gait.phases = Some(p.phases);
+    gait.period.get_or_insert(p.period);
+    gait.duty_factor.get_or_insert(p.duty);
+    gait.step_height.get_or_insert(p.step_height);
+    if gait.speed.is_none() {
+        gait.velocity.get_or_insert(p.velocity);
+    }
+    gait.yaw_rate_deg.get_or_insert(0.0);
+    gait.stance_width.get_or_insert(p.stance_width);
+    gait.startup.get_or_insert(p.startup);
+    gait.ramp.get_or_insert(p.ramp);
+    Ok(plan)
+}
+
 /// `[control]` per joint in radians: gains (`kp`, `kd`, `gains`), targets
 /// (`pd`: `target_deg`, others at `q`; `trajectory`: `times`,
-/// `targets_deg`). Errors name the key.
+/// `targets_deg`; `gait`: `plan`, built from `[gait]`). Errors name the
+/// key.
 fn resolve_control(
     c: &RobotControlConfig,
     model: &RobotModel,
     q: &[f64],
     file: &str,
     description: &Path,
+    plan: Option<fbd_robot::gait::GaitPlan>,
 ) -> Result<fbd_sim::robot::RobotControl, ConfigError> {
     use fbd_sim::robot::{JointTrajectory, RobotControl};
     let nj = model.joints.len();
@@ -633,6 +864,7 @@ fn resolve_control(
                         RobotControlKind::None => "none",
                         RobotControlKind::Pd => "pd",
                         RobotControlKind::Trajectory => "trajectory",
+                        RobotControlKind::Gait => "gait",
                     }
                 ),
             ))
@@ -641,6 +873,17 @@ fn resolve_control(
         }
     };
     Ok(match c.kind {
+        RobotControlKind::Gait => {
+            unused("target_deg", !c.target_deg.is_empty())?;
+            unused("times", !c.times.is_empty())?;
+            unused("targets_deg", !c.targets_deg.is_empty())?;
+            RobotControl::Gait {
+                kp,
+                kd,
+                plan: Box::new(plan.expect("the caller builds the plan of kind = \"gait\"")),
+                torque_limit: c.torque_limit,
+            }
+        }
         RobotControlKind::None => {
             unused("target_deg", !c.target_deg.is_empty())?;
             unused("times", !c.times.is_empty())?;

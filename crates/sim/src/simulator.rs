@@ -1,6 +1,7 @@
 //! The stepping API: any model stepped one Δt at a time by a controller
 //! outside the simulator, for every model ([`Plant`]: the planar
-//! [`crate::Model`] and the spatial [`crate::spatial::SpatialModel`]).
+//! [`crate::Model`], the spatial [`crate::spatial::SpatialModel`] and any
+//! imported robot, [`crate::robot::RobotSim`]).
 //!
 //! * [`Simulator::new`] from a validated model (`fbd-scenario` builds them
 //!   from TOML);
@@ -15,7 +16,8 @@
 //!   factorisations): stepping after a restore is bit-identical to
 //!   stepping on;
 //! * [`Simulator::readout`]: body poses and twists, joint angles, rates and
-//!   torques, joint reaction forces and moments, every contact point's
+//!   torques, joint reaction forces and moments (per leg, or per reaction
+//!   of an imported robot), every contact point's
 //!   position, state, force, normal and slip velocity, energies
 //!   ([`Readout`]).
 //!
@@ -42,13 +44,15 @@ use fbd_dynamics::PointKind;
 
 /// What a model must give the stepping API beyond the generic step: its
 /// fresh workspace, its actuated joints, how external torques are set and
-/// its readouts. Implemented by [`Model`] and [`SpatialModel`].
+/// its readouts. Implemented by [`Model`], [`SpatialModel`] and
+/// [`crate::robot::RobotSim`].
 pub trait Plant: Engine<Fbd: Clone, Record: Clone, Torques: Clone, ControlData: Clone> {
     /// The workspace at the model's initial state.
     fn fresh(&self) -> RunData<Self>;
     /// The actuated joints' indices in `q`, in the order of the torques:
     /// the planar model's hip3, knee3, hip4, knee4; the hexapod's
-    /// `(θ1, θ2, θ3)` of each leg of the model in order.
+    /// `(θ1, θ2, θ3)` of each leg of the model in order; an imported
+    /// robot's every joint in model order (`6 + j`).
     fn joint_indices(&self) -> Vec<usize>;
     /// Sets the external torques of the next step from a flat slice in the
     /// order of [`Self::joint_indices`].
@@ -171,12 +175,25 @@ pub struct LegReadout {
     pub knee_moment: [f64; 3],
 }
 
+/// One joint reaction of an imported robot at the step solved last
+/// (inertial frame): the force of the parent on the child body at the
+/// reaction's first joint's origin and the moment on the child about that
+/// point (constraint moments, actuator torques and stops), the columns
+/// `<joint>_fx … <joint>_mz` of its `trajectory.csv`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ReactionReadout {
+    /// Force (N).
+    pub force: [f64; 3],
+    /// Moment (N·m).
+    pub moment: [f64; 3],
+}
+
 /// One contact point.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactReadout {
-    /// Leg number.
+    /// Leg number (an imported robot: the point's index + 1).
     pub leg: usize,
-    /// Tip, knee or hip.
+    /// Tip, knee or hip (an imported robot's points: tip).
     pub kind: PointKind,
     /// Position at `q[k]`, inertial frame (m).
     pub position: [f64; 3],
@@ -226,12 +243,18 @@ pub struct Readout {
     /// `(q[k] − q[k−1])/Δt` (the initial velocities at k = 0).
     pub qdot: Vec<f64>,
     /// Every rigid body: the central body first, then per leg the upper
-    /// and the lower link.
+    /// and the lower link; an imported robot's every body in model order
+    /// (the root first).
     pub bodies: Vec<BodyReadout>,
     /// Actuated joints, order of [`Plant::joint_indices`].
     pub joints: Vec<JointReadout>,
-    /// Joint reactions per leg.
+    /// Joint reactions per leg (the planar model and the hexapod; empty
+    /// for an imported robot).
     pub legs: Vec<LegReadout>,
+    /// Joint reactions of an imported robot, one per reaction of its
+    /// mechanism ([`fbd_dynamics::tree::TreeMechanism::reactions`]; empty
+    /// for the planar model and the hexapod).
+    pub reactions: Vec<ReactionReadout>,
     /// Contact points, the model's order.
     pub contacts: Vec<ContactReadout>,
     /// Kinetic energy (J).

@@ -76,13 +76,20 @@ class Result(_Mapping):
     the torques ``tau{1,2,3}_{n}``; the knee and hip contact points
     ``kneepoint{n}_state/fx/fy/fz/n`` (``hippoint…``); ``kinetic``,
     ``potential``, ``newton_iterations`` (int64). The kinematic gait's
-    columns are all float64.
+    columns are all float64. An imported robot (``model = "robot"``) has
+    the columns of its ``trajectory.csv``: ``t``, ``rx`` … ``phi_z``, its
+    joint angles by name, per reaction ``<joint>_fx`` … ``<joint>_mz``,
+    ``tau_<joint>``, per contact point ``<c>_state`` (strings as above),
+    ``<c>_x/y/z``, ``<c>_fx/fy/fz``, ``<c>_n``; ``com_x/y/z``,
+    ``kinetic``, ``potential``, ``newton_iterations`` (int64).
 
     Attributes:
         columns: the column names, in the file's order.
         events: contact, joint-limit and retried-step events, dicts with
             ``t``, ``step``, ``leg``, ``point``, ``from``, ``to`` (as
-            ``events.csv``; also for the hexapod's 3D dynamics); for the
+            ``events.csv``; also for the hexapod's 3D dynamics; an imported
+            robot's without ``leg``: ``point`` is a contact point,
+            ``<joint>_limit`` or ``substeps``); for the
             hexapod's kinematic gait lift-offs, touchdowns and stability
             warnings, dicts with ``t``, ``leg``, ``event``, ``margin``.
         summary: the content of ``summary.json`` as a dict.
@@ -144,7 +151,8 @@ def run(config: ConfigLike = None, out: Union[None, str, "_os.PathLike[str]"] = 
             fall), a path to a TOML file, TOML text, or a dict with the
             same keys as the files, e.g. ``{"time": {"duration": 0.5}}``.
             A hexapod (``model = "hexapod"``) runs as ``fbd run`` runs it:
-            the 3D FBD dynamics, or the kinematic gait.
+            the 3D FBD dynamics, or the kinematic gait; so does an imported
+            robot (``model = "robot"``, on its terrain or in flight).
         out: when given, the directory where the files of ``fbd run`` are
             written (``trajectory.csv``, ``events.csv``, ``summary.json``,
             ``config.toml`` and the plots); nothing is written otherwise.

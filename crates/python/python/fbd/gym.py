@@ -11,6 +11,11 @@ gymnasium is installed:
 * ``fbd/PlanarStand-v0`` — :class:`PlanarStandEnv`: the paper's planar
   two-leg model dropped onto the ground learns to land and stand at a
   height; vector entry point :class:`PlanarStandVectorEnv`.
+* ``fbd/Robot-v0`` — :class:`RobotEnv`: any imported robot
+  (``model = "robot"``, URDF/MJCF) on its configured terrain learns to move
+  forward with per-joint PD position targets:
+  ``gymnasium.make("fbd/Robot-v0", config="examples/robots/solo12_stand.toml")``;
+  vector entry point :class:`RobotVectorEnv`.
 
 Every environment is deterministic given its seed: ``reset(seed=s)`` draws
 the initial pose and the soil's friction from ``s``; equal seeds give equal
@@ -43,6 +48,53 @@ episodes, bit for bit. Environments pickle (their simulator with it).
   yaw (±5°), each joint (±2° around the stance) and the friction
   ``μS ∈ [0.6, 1.0]``, ``μD = 0.8·μS``.
 
+**Robot-v0** (``RobotEnv(config, ...)``; names of every entry in
+``env.observation_names``):
+
+* physics: the configuration's own (its ``[time] dt``, terrain, friction,
+  initial state); a control period is ``frame_skip`` physics steps,
+  ``round(1/(control_hz·dt))`` by default (``control_hz = 50``);
+* action, shape ``(joints,)`` in ``[−1, 1]``, joints in model order
+  (``Simulator.joint_names``): PD targets ``θ* = q0 + action_scale·a``
+  around the initial joint angles (``action_scale = 0.25`` rad), tracked
+  inside Rust for the period with the gains of the configuration's
+  ``[control]`` when it has some (``kind = "pd"``, ``"trajectory"`` or
+  ``"gait"``; its ``torque_limit`` too);
+  otherwise ``kp = 0.1·I/Δt²``, ``kd = I/Δt`` with ``I`` the robot's
+  smallest effective joint inertia (``Simulator.joint_inertia``):
+  ``kp·Δt²/I + 2·kd·Δt/I = 2.1``, about half of fbd's explicit-PD
+  stability limit 4, the fastest joint mode damped without oscillation
+  (its roots 0 and 0.9).
+  Torques are clamped to ``torque_limit``, else to the smallest effort
+  limit of the description's joints (if any). ``kp``, ``kd``,
+  ``torque_limit`` may also be given;
+* observation, shape ``(1 + 4 + 3 + 3 + 2·joints + 2·points,)``, float64:
+  ``[0]`` the base's height (its root frame origin's ``y``, m); ``[1:5]``
+  its orientation as a unit quaternion ``(w, x, y, z)`` (``w ≥ 0``; body
+  → inertial); ``[5:8]`` its linear velocity (the root origin's, m/s) and
+  ``[8:11]`` angular velocity (rad/s), both in body axes; the joint angles
+  (rad) and rates (rad/s); per contact point (``Simulator.contact_points``)
+  its state (0 free, 1 sticking, 2 sliding), then per point its normal
+  force (N);
+* reward per control period: forward speed − ``effort·Σ τ²`` (the torques
+  of the period's last step, N·m; ``effort = 1e-3``). Forward is the
+  robot's own: fbd's body frame has ``+y`` up and ``−z`` forward, and an
+  imported robot's ``+x`` forward (ROS REP 103, ``[robot] up = "z"``, the
+  default) is turned to ``−z``; the speed is the root origin's
+  displacement over the period along the robot's forward axis at the
+  episode's start, projected on the horizontal plane (``−Z`` for a robot
+  not turned by ``[initial]``), divided by the period (m/s);
+* terminated when the base's height falls below ``fall_fraction``
+  (default 0.5) of its initial height, when its up axis tilts more than
+  ``max_tilt_deg`` (60°) from vertical, or when a step cannot be solved
+  (``info["error"]``); truncated at ``episode_seconds`` (default 2 s);
+* ``reset(seed=)``: the configuration's initial state; with
+  ``init_noise > 0`` (rad, default 0) the first control period tracks
+  targets ``q0 + U(−init_noise, init_noise)`` drawn from the seed before
+  the episode's first observation (equal seeds, equal episodes; a period
+  that cannot be solved falls back to the initial state); the episode's
+  ``episode_seconds`` count from that first observation.
+
 **PlanarStand-v0**: action ``(4,)`` in ``[−1, 1]``: targets of hip3, knee3,
 hip4, knee4 around ``(0°, 250°)`` per leg (``±0.5`` rad); observation
 ``(18,)``: ``q`` (7), ``q̇`` (7), the tips' states (2, as above) and normal
@@ -71,6 +123,8 @@ __all__ = [
     "HexapodWalkVectorEnv",
     "PlanarStandEnv",
     "PlanarStandVectorEnv",
+    "RobotEnv",
+    "RobotVectorEnv",
     "register_envs",
 ]
 
@@ -81,6 +135,8 @@ class _FbdEnv(gymnasium.Env):
     (``_config``, ``_targets``, ``_observe``, ``_reward``, ``_terminated``)."""
 
     metadata: Dict[str, Any] = {"render_modes": []}
+    #: Simulated time at the episode's first observation (s).
+    _t0 = 0.0
     KP = 300.0
     KD = 8.0
     TORQUE_LIMIT: Optional[float] = 80.0
@@ -137,7 +193,7 @@ class _FbdEnv(gymnasium.Env):
             return obs, 0.0, True, False, {"error": self._error}
         reward, info = self._reward(o, before)
         terminated = self._terminated(o)
-        truncated = (not terminated) and self.sim.t >= self.episode_seconds - 0.5 * self.dt
+        truncated = (not terminated) and self.sim.t - self._t0 >= self.episode_seconds - 0.5 * self.dt
         return obs, reward, terminated, truncated, info
 
     def step(self, action: Any):
@@ -302,6 +358,180 @@ class PlanarStandEnv(_FbdEnv):
         return bool(q[1] < 0.25 or abs(q[2]) > math.radians(45.0))
 
 
+def _quaternion(r: np.ndarray) -> np.ndarray:
+    """The unit quaternion ``(w, x, y, z)`` (``w ≥ 0``) of rotation ``r``."""
+    t = float(np.trace(r))
+    if t > 0.0:
+        s = 2.0 * math.sqrt(1.0 + t)
+        q = [0.25 * s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
+    elif r[0, 0] > r[1, 1] and r[0, 0] > r[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + r[0, 0] - r[1, 1] - r[2, 2])
+        q = [(r[2, 1] - r[1, 2]) / s, 0.25 * s, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s]
+    elif r[1, 1] > r[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + r[1, 1] - r[0, 0] - r[2, 2])
+        q = [(r[0, 2] - r[2, 0]) / s, (r[0, 1] + r[1, 0]) / s, 0.25 * s, (r[1, 2] + r[2, 1]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + r[2, 2] - r[0, 0] - r[1, 1])
+        q = [(r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, 0.25 * s]
+    q = np.array(q)
+    q /= np.linalg.norm(q)
+    return -q if q[0] < 0.0 else q
+
+
+class RobotEnv(_FbdEnv):
+    """``fbd/Robot-v0``: any imported robot (see the module docs).
+
+    Args:
+        config: a ``model = "robot"`` configuration (a path, TOML text or a
+            dict, as for :class:`fbd.Simulator`).
+        episode_seconds: episode length (s).
+        control_hz: policy rate (Hz); ``frame_skip`` physics steps per
+            action, ``max(1, round(1/(control_hz·dt)))``.
+        action_scale: target offset of ``a = ±1`` (rad; a number or one per
+            joint).
+        kp, kd, torque_limit: PD gains (numbers or one per joint) and the
+            torque clamp; default from the configuration (module docs).
+        effort: the effort penalty's weight (per N·m²).
+        fall_fraction, max_tilt_deg: the termination thresholds.
+        init_noise: the reset's random first targets (rad), 0 for none.
+    """
+
+    DEFAULT_ACTION_SCALE = 0.25
+    DEFAULT_EFFORT = 1e-3
+
+    def __init__(
+        self,
+        config: Any = None,
+        episode_seconds: float = 2.0,
+        control_hz: float = 50.0,
+        action_scale: Any = DEFAULT_ACTION_SCALE,
+        kp: Any = None,
+        kd: Any = None,
+        torque_limit: Optional[float] = None,
+        effort: float = DEFAULT_EFFORT,
+        fall_fraction: float = 0.5,
+        max_tilt_deg: float = 60.0,
+        init_noise: float = 0.0,
+    ) -> None:
+        if config is None:
+            raise ValueError("fbd/Robot-v0: give config=, a model = \"robot\" configuration")
+        sim = _fbd.Simulator(config)
+        if sim.model != "robot":
+            raise ValueError(
+                f"fbd/Robot-v0: {config!r} is a model = \"{sim.model}\" configuration; "
+                "it takes model = \"robot\""
+            )
+        dt = sim.dt
+        frame_skip = max(1, int(round(1.0 / (float(control_hz) * dt))))
+        super().__init__(episode_seconds, frame_skip, dt)
+        self.config = config
+        self.sim = sim
+        self.q0 = np.array(sim.q0)
+        n = len(sim.joint_names)
+        self.joints = n
+        self.stance = self.q0[6:]
+        self.action_scale = np.broadcast_to(np.asarray(action_scale, dtype=np.float64), (n,)).copy()
+        control = sim.control
+        if control["kind"] != "none":
+            self.kp = np.array(control["kp"])
+            self.kd = np.array(control["kd"])
+            limit = control["torque_limit"]
+        else:
+            inertia = sim.joint_inertia
+            i = inertia[0] if inertia is not None else 1.0
+            self.kp = np.full(n, 0.1 * i / dt**2)
+            self.kd = np.full(n, i / dt)
+            limit = None
+        if kp is not None:
+            self.kp = np.broadcast_to(np.asarray(kp, dtype=np.float64), (n,)).copy()
+        if kd is not None:
+            self.kd = np.broadcast_to(np.asarray(kd, dtype=np.float64), (n,)).copy()
+        if torque_limit is not None:
+            limit = float(torque_limit)
+        if limit is None:
+            efforts = np.asarray(sim.effort_limits)
+            efforts = efforts[np.isfinite(efforts)]
+            limit = float(np.min(efforts)) if efforts.size else None
+        self.TORQUE_LIMIT = limit
+        self.effort = float(effort)
+        self.fall_fraction = float(fall_fraction)
+        self.cos_tilt = math.cos(math.radians(float(max_tilt_deg)))
+        self.init_noise = float(init_noise)
+        self.height0 = float(self.q0[1])
+        rot0 = np.asarray(sim.observe()["body_rotation"][0])
+        forward = rot0 @ np.array([0.0, 0.0, -1.0])
+        forward[1] = 0.0
+        norm = float(np.linalg.norm(forward))
+        self.forward = forward / norm if norm > 1e-9 else np.array([0.0, 0.0, -1.0])
+        self.points = list(sim.contact_points)
+        self.observation_names = (
+            ["height", "qw", "qx", "qy", "qz", "vx", "vy", "vz", "wx", "wy", "wz"]
+            + [f"q_{j}" for j in sim.joint_names]
+            + [f"qd_{j}" for j in sim.joint_names]
+            + [f"state_{p}" for p in self.points]
+            + [f"n_{p}" for p in self.points]
+        )
+        size = len(self.observation_names)
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(n,), dtype=np.float64)
+        self.observation_space = spaces.Box(-np.inf, np.inf, shape=(size,), dtype=np.float64)
+        self._started = False
+
+    def _start(self) -> Tuple[np.ndarray, Dict[str, Any]]:
+        self.sim.reset()
+        self._error = None
+        self._started = True
+        if self.init_noise > 0.0:
+            noise = self.np_random.uniform(-self.init_noise, self.init_noise, self.joints)
+            self.sim.set_pd_targets(self.stance + noise, self.kp, self.kd, torque_limit=self.TORQUE_LIMIT)
+            try:
+                self.sim.step(steps=self.frame_skip)
+            except SimulationError:
+                self.sim.reset()  # the configuration's own initial state
+        self._t0 = self.sim.t
+        return self._observe(self.sim.observe()), {}
+
+    def step(self, action: Any):
+        if not self._started:
+            raise RuntimeError("call reset() before step()")
+        return super().step(action)
+
+    def _apply(self, action: Any) -> np.ndarray:
+        a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
+        self.sim.set_pd_targets(self._targets(a), self.kp, self.kd, torque_limit=self.TORQUE_LIMIT)
+        return self.sim.q
+
+    def _targets(self, a: np.ndarray) -> np.ndarray:
+        return self.stance + self.action_scale * a
+
+    def _observe(self, o: Dict[str, Any]) -> np.ndarray:
+        rot = np.asarray(o["body_rotation"][0])
+        v = rot.T @ o["qdot"][0:3]
+        w = rot.T @ o["body_angular_velocity"][0]
+        states = o["contact_state"].astype(np.float64) - 1.0
+        return np.concatenate(
+            [
+                [o["q"][1]],
+                _quaternion(rot),
+                v,
+                w,
+                o["joint_angle"],
+                o["joint_rate"],
+                states,
+                o["contact_normal_force"],
+            ]
+        ).astype(np.float64)
+
+    def _reward(self, o: Dict[str, Any], before: np.ndarray) -> Tuple[float, Dict[str, Any]]:
+        period = self.frame_skip * self.dt
+        forward = float(np.dot(o["q"][0:3] - before[0:3], self.forward)) / period
+        effort = self.effort * float(np.sum(o["joint_torque"] ** 2))
+        return forward - effort, {"forward_speed": forward, "effort": effort}
+
+    def _terminated(self, o: Dict[str, Any]) -> bool:
+        up = float(o["body_rotation"][0][1, 1])
+        return bool(o["q"][1] < self.fall_fraction * self.height0 or up < self.cos_tilt)
+
+
 class _FbdVectorEnv(VectorEnv):
     """N environments of one class stepped together: the physics of every
     sub-environment on Rust threads (``fbd._fbd.step_many``, the GIL
@@ -382,12 +612,20 @@ class PlanarStandVectorEnv(_FbdVectorEnv):
     ENV = PlanarStandEnv
 
 
+class RobotVectorEnv(_FbdVectorEnv):
+    """The vector entry point of ``fbd/Robot-v0`` (``config=`` as for
+    :class:`RobotEnv`)."""
+
+    ENV = RobotEnv
+
+
 def register_envs() -> None:
-    """Registers ``fbd/HexapodWalk-v0`` and ``fbd/PlanarStand-v0`` (done by
-    ``import fbd`` when gymnasium is installed)."""
+    """Registers ``fbd/HexapodWalk-v0``, ``fbd/PlanarStand-v0`` and
+    ``fbd/Robot-v0`` (done by ``import fbd`` when gymnasium is installed)."""
     for name, env, vec in [
         ("fbd/HexapodWalk-v0", "HexapodWalkEnv", "HexapodWalkVectorEnv"),
         ("fbd/PlanarStand-v0", "PlanarStandEnv", "PlanarStandVectorEnv"),
+        ("fbd/Robot-v0", "RobotEnv", "RobotVectorEnv"),
     ]:
         if name not in gymnasium.registry:
             gymnasium.register(

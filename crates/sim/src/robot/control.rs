@@ -12,6 +12,7 @@ use super::data::RobotData;
 use super::model::RobotSim;
 use crate::SimError;
 use fbd_dynamics::tree::kin::BASE_DOF;
+use fbd_robot::gait::GaitPlan;
 
 /// Joint angles over time, linear between knots.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -70,6 +71,46 @@ pub enum RobotControl {
         /// `|τ| ≤ torque_limit` (N·m) on every joint.
         torque_limit: Option<f64>,
     },
+    /// PD along a gait plan's joint angles with its rates as feed-forward.
+    Gait {
+        /// Position gain per joint (N·m/rad).
+        kp: Vec<f64>,
+        /// Rate gain per joint (N·m·s/rad).
+        kd: Vec<f64>,
+        /// The plan at `t = 0` (each run steps its own copy).
+        plan: Box<GaitPlan>,
+        /// `|τ| ≤ torque_limit` (N·m) on every joint.
+        torque_limit: Option<f64>,
+    },
+}
+
+/// The controller's workspace of a gait run: the plan (warm-started IK)
+/// and its targets of the current step.
+#[derive(Clone, Debug)]
+pub struct GaitWork {
+    /// The run's copy of the plan.
+    pub plan: GaitPlan,
+    /// Joint targets `θ*` (rad).
+    pub target: Vec<f64>,
+    /// Joint rate targets `θ̇*` (rad/s).
+    pub rate: Vec<f64>,
+}
+
+impl RobotControl {
+    /// The workspace a run of this controller needs (a gait's plan).
+    pub fn work(&self) -> Option<Box<GaitWork>> {
+        match self {
+            RobotControl::Gait { plan, .. } => {
+                let n = plan.standing().len();
+                Some(Box::new(GaitWork {
+                    plan: (**plan).clone(),
+                    target: vec![0.0; n],
+                    rate: vec![0.0; n],
+                }))
+            }
+            _ => None,
+        }
+    }
 }
 
 /// Joint `j`'s rate `θ̇[k]` (backward difference; `q̇0` at k = 0).
@@ -110,12 +151,31 @@ pub fn joint_torques(model: &RobotSim, data: &mut RobotData) -> Result<(), SimEr
             kd,
             torque_limit,
             ..
+        }
+        | RobotControl::Gait {
+            kp,
+            kd,
+            torque_limit,
+            ..
         } => (kp, kd, *torque_limit),
     };
+    if let Some(work) = data.control.as_mut() {
+        let GaitWork { plan, target, rate } = &mut **work;
+        plan.targets(t, target, rate)
+            .map_err(|e| SimError::Control {
+                step: data.k,
+                t,
+                message: e.to_string(),
+            })?;
+    }
     for j in 0..model.mech.model.joints.len() {
         let (target, target_rate) = match &model.params.control {
             RobotControl::Pd { target, .. } => (target[j], 0.0),
             RobotControl::Trajectory { trajectory, .. } => trajectory.at(t, j),
+            RobotControl::Gait { .. } => {
+                let w = data.control.as_ref().expect("a gait run's workspace");
+                (w.target[j], w.rate[j])
+            }
             RobotControl::None => unreachable!("handled above"),
         };
         let theta = data.q[BASE_DOF + j];

@@ -60,7 +60,7 @@ impl RunData<RobotSim> {
             fbd,
             solver: NewtonSolver::new(model.newton),
             record,
-            control: (),
+            control: model.params.control.work(),
         })
     }
 }

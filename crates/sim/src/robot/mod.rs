@@ -9,9 +9,9 @@
 //! * [`RobotParams`] → [`RobotSim`] (immutable, validated);
 //! * [`RobotData`] (= [`crate::RunData`]`<RobotSim>`, the workspace);
 //! * [`RobotRecord`]: what a step produced (row `k` of `trajectory.csv`);
-//! * [`RobotControl`]: passive joints, PD to fixed angles, a joint
-//!   trajectory or a gait plan ([`fbd_robot::gait`]), per joint, clamped to
-//!   each joint's effort limit.
+//! * [`RobotControl`]: passive joints, PD to fixed angles, along a joint
+//!   trajectory or along a gait plan ([`fbd_robot::gait`]), per joint,
+//!   clamped to each joint's effort limit.
 //!
 //! The layout of `q` is `(R, φ)` of the floating base, then the joint
 //! angles in model order; `q̇0` has the same layout, the base's angular
@@ -23,10 +23,11 @@ mod control;
 mod data;
 mod model;
 mod params;
+mod plant;
 mod record;
 mod step;
 
-pub use control::{JointTrajectory, RobotControl, joint_rates};
+pub use control::{GaitWork, JointTrajectory, RobotControl, joint_rates};
 pub use data::RobotData;
 pub use model::{RobotSim, mass_matrix};
 pub use params::RobotParams;

@@ -111,6 +111,18 @@ impl RobotSim {
                     positive("control.torque_limit", *l)?;
                 }
             }
+            RobotControl::Gait {
+                kp,
+                kd,
+                plan,
+                torque_limit,
+            } => {
+                gains(kp, kd)?;
+                assert_eq!(plan.standing().len(), nj, "a plan of this robot");
+                if let Some(l) = torque_limit {
+                    positive("control.torque_limit", *l)?;
+                }
+            }
             RobotControl::Trajectory {
                 kp,
                 kd,
@@ -251,7 +263,9 @@ pub fn mass_matrix(robot: &RobotModel, q: &[f64]) -> DMatrix<f64> {
 fn pd_stability(robot: &RobotModel, p: &RobotParams) -> Result<(), SimError> {
     let (kp, kd) = match &p.control {
         RobotControl::None => return Ok(()),
-        RobotControl::Pd { kp, kd, .. } | RobotControl::Trajectory { kp, kd, .. } => (kp, kd),
+        RobotControl::Pd { kp, kd, .. }
+        | RobotControl::Trajectory { kp, kd, .. }
+        | RobotControl::Gait { kp, kd, .. } => (kp, kd),
     };
     let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
     let (kp, kd) = (max(kp), max(kd));

@@ -52,7 +52,7 @@ impl Engine for RobotSim {
     type Fbd = TreeFbdData;
     type Record = RobotRecord;
     type Torques = Vec<f64>;
-    type ControlData = ();
+    type ControlData = Option<Box<super::control::GaitWork>>;
 
     fn settings(&self) -> Settings<'_, Surface> {
         Settings {

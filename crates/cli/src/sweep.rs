@@ -700,7 +700,6 @@ fn row_from_summary(dir: &Path, run: usize, values: Vec<String>) -> Option<Row> 
 /// The row of a finished dynamic hexapod run, from its `summary.json`
 /// ([`DYNAMIC_COLUMNS`]).
 fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
-    let num = |v: &serde_json::Value| v.as_f64();
     let events = s["events"].as_array();
     let foot_slips = events.map(|e| {
         e.iter()
@@ -722,6 +721,21 @@ fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
             .filter_map(|n| s["peak_contact_force"][format!("{tip}{n}")]["n"].as_f64())
             .reduce(f64::max)
     });
+    dynamic_columns(s, run, values, peak_foot_n, first_touchdown, foot_slips)
+}
+
+/// A row of [`DYNAMIC_COLUMNS`] from a dynamic run's `summary.json` and
+/// the values the models count their own way: the largest foot normal
+/// force, the first touchdown, the slips of the feet.
+fn dynamic_columns(
+    s: &serde_json::Value,
+    run: usize,
+    values: Vec<String>,
+    peak_foot_n: Option<f64>,
+    first_touchdown: Option<f64>,
+    foot_slips: Option<f64>,
+) -> Row {
+    let num = |v: &serde_json::Value| v.as_f64();
     Row {
         run,
         status: s["status"].as_str().unwrap_or("error").to_owned(),
@@ -733,7 +747,7 @@ fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
             peak_foot_n,
             first_touchdown,
             foot_slips,
-            events.map(|e| e.len() as f64),
+            s["events"].as_array().map(|e| e.len() as f64),
             num(&s["newton_iterations"]),
             num(&s["steps_per_second"]),
             num(&s["steps"]),
@@ -751,7 +765,6 @@ fn dynamic_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
 /// `summary.json`: the dynamic hexapod's columns ([`DYNAMIC_COLUMNS`]),
 /// every contact point counted as a foot.
 fn robot_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
-    let num = |v: &serde_json::Value| v.as_f64();
     let events = s["events"].as_array();
     let contacts: Vec<&str> = s["contact_points"]
         .as_array()
@@ -771,29 +784,14 @@ fn robot_row(s: &serde_json::Value, run: usize, values: Vec<String>) -> Row {
             .filter_map(serde_json::Value::as_f64)
             .reduce(f64::min)
     });
-    Row {
+    dynamic_columns(
+        s,
         run,
-        status: s["status"].as_str().unwrap_or("error").to_owned(),
         values,
-        numbers: vec![
-            num(&s["distance"]),
-            num(&s["final_height"]),
-            num(&s["peak_torque_max"]),
-            num(&s["peak_normal_force"]),
-            first_touchdown,
-            slips,
-            events.map(|e| e.len() as f64),
-            num(&s["newton_iterations"]),
-            num(&s["steps_per_second"]),
-            num(&s["steps"]),
-            num(&s["wall_seconds"]),
-            num(&s["max_law_violation"]),
-            num(&s["retried_steps"]),
-            num(&s["substeps"]),
-        ],
-        kind: IndexKind::Dynamic,
-        error: s["error"].as_str().unwrap_or("").replace('\n', " "),
-    }
+        s["peak_normal_force"].as_f64(),
+        first_touchdown,
+        slips,
+    )
 }
 
 /// A finished run with status ok whose config.toml is the one planned
@@ -949,32 +947,15 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
         if let Err(config::ConfigError::Override { key, message, .. }) =
             config::parse_str(&base_text, &base_name, &set[..=i])
         {
-            return Err(CliError::Usage(format!(
-                "{name}: set.\"{key}\": {}",
-                message.replace('\n', " ")
-            )));
+            return Err(set_error(&name, &key, &message));
         }
     }
     let mut configs = Vec::with_capacity(values.len());
     let mut trajectories = Vec::with_capacity(values.len());
     for (i, vals) in values.iter().enumerate() {
-        let overrides: Vec<Override> = set
-            .iter()
-            .cloned()
-            .chain(
-                keys.iter()
-                    .zip(vals)
-                    .map(|(k, v)| Override::new(k.clone(), v.clone())),
-            )
-            .collect();
-        let what = || {
-            keys.iter()
-                .zip(vals)
-                .map(|(k, v)| format!("{k} = {}", format_value(v)))
-                .collect::<Vec<_>>()
-                .join(", ")
-        };
-        let fail = |e: String| CliError::Usage(format!("{name}: run {i} ({}): {e}", what()));
+        let overrides = run_overrides(&set, &keys, vals);
+        let fail =
+            |e: String| CliError::Usage(format!("{}: {e}", run_label(&name, i, &keys, vals)));
         let c = config::parse_str(&base_text, &base_name, &overrides)
             .map_err(|e| fail(e.to_string()))?;
         let size = |steps: usize, columns: usize, output: &fbd_scenario::OutputConfig| {
@@ -1021,6 +1002,38 @@ pub fn plan(path: &Path) -> Result<Plan, CliError> {
     })
 }
 
+/// The overrides of one run: the `[set]` keys, then the varied ones with
+/// their values.
+fn run_overrides(set: &[Override], keys: &[String], vals: &[toml::Value]) -> Vec<Override> {
+    set.iter()
+        .cloned()
+        .chain(
+            keys.iter()
+                .zip(vals)
+                .map(|(k, v)| Override::new(k.clone(), v.clone())),
+        )
+        .collect()
+}
+
+/// `SWEEP: run i (key = value, …)`, how errors name a run.
+fn run_label(name: &str, i: usize, keys: &[String], vals: &[toml::Value]) -> String {
+    let what = keys
+        .iter()
+        .zip(vals)
+        .map(|(k, v)| format!("{k} = {}", format_value(v)))
+        .collect::<Vec<_>>()
+        .join(", ");
+    format!("{name}: run {i} ({what})")
+}
+
+/// A `[set]` key the base cannot take.
+fn set_error(name: &str, key: &str, message: &str) -> CliError {
+    CliError::Usage(format!(
+        "{name}: set.\"{key}\": {}",
+        message.replace('\n', " ")
+    ))
+}
+
 /// [`plan`] of a sweep whose base is an imported robot: every run's
 /// overrides set in the base's table, its robot loaded and its simulator
 /// built (errors name the run and the key).
@@ -1036,38 +1049,18 @@ fn plan_robot(
     let base_path = Path::new(base_name);
     for i in 0..set.len() {
         if let Err(e) = config::robot::load_with_overrides(base_text, base_path, &set[..=i]) {
-            let key = &set[i].key;
             let message = match e {
                 config::ConfigError::Override { message, .. } => message,
                 other => other.to_string(),
             };
-            return Err(CliError::Usage(format!(
-                "{name}: set.\"{key}\": {}",
-                message.replace('\n', " ")
-            )));
+            return Err(set_error(name, &set[i].key, &message));
         }
     }
     let mut configs = Vec::with_capacity(values.len());
     let mut trajectories = Vec::with_capacity(values.len());
     for (i, vals) in values.iter().enumerate() {
-        let overrides: Vec<Override> = set
-            .iter()
-            .cloned()
-            .chain(
-                keys.iter()
-                    .zip(vals)
-                    .map(|(k, v)| Override::new(k.clone(), v.clone())),
-            )
-            .collect();
-        let fail = |e: String| {
-            let what = keys
-                .iter()
-                .zip(vals)
-                .map(|(k, v)| format!("{k} = {}", format_value(v)))
-                .collect::<Vec<_>>()
-                .join(", ");
-            CliError::Usage(format!("{name}: run {i} ({what}): {e}"))
-        };
+        let overrides = run_overrides(&set, &keys, vals);
+        let fail = |e: String| CliError::Usage(format!("{}: {e}", run_label(name, i, &keys, vals)));
         let robot = config::robot::load_with_overrides(base_text, base_path, &overrides)
             .map_err(|e| fail(e.to_string()))?;
         let sim = robot.sim().map_err(|e| fail(e.to_string()))?;

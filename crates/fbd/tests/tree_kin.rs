@@ -157,10 +157,14 @@ fn check_forward(model: &RobotModel, q: &[f64]) -> Result<(), TestCaseError> {
         prop_assert!((kin.joint_origin[j] - data.frames[child].translation.vector).norm() < 1e-12);
     }
     for c in 0..model.contacts.len() {
+        // The sphere's centre, and the point that touches level ground,
+        // its radius below.
         prop_assert!(
-            (kin.contact[c] - data.contacts[c]).norm() < 1e-12,
+            (kin.contact_center[c] - data.contacts[c]).norm() < 1e-12,
             "contact {c}"
         );
+        let lowest = data.contacts[c] - model.contacts[c].radius * Vector3::y();
+        prop_assert!((kin.contact[c] - lowest).norm() < 1e-12, "contact {c}");
     }
     Ok(())
 }

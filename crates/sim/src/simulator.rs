@@ -439,6 +439,31 @@ impl<M: Plant> Simulator<M> {
     }
 }
 
+/// A contact point's readout: `spec` its identity, `at` its position at
+/// `q[k]` and the terrain's normal there, `before` its position at
+/// `q[k−1]` (`None` before the first step: no slip), `state` and `force`
+/// (with its normal component) of the step solved last.
+pub(crate) fn contact_readout(
+    spec: &fbd_dynamics::ContactSpec,
+    at: [[f64; 3]; 2],
+    before: Option<[f64; 3]>,
+    dt: f64,
+    state: StateCode,
+    force: ([f64; 3], f64),
+) -> ContactReadout {
+    let [p, normal] = at;
+    ContactReadout {
+        leg: spec.leg,
+        kind: spec.kind,
+        position: p,
+        state,
+        force: force.0,
+        normal_force: force.1,
+        normal,
+        slip_velocity: before.map_or([0.0; 3], |q| tangential(sub(p, q).map(|x| x / dt), normal)),
+    }
+}
+
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
@@ -505,28 +530,24 @@ impl Plant for SpatialModel {
             let p = kin.point(&self.mech, spec.point / 3, spec.kind);
             let p = [p.x, p.y, p.z];
             let normal = self.params.terrain.normal(p[0], p[2]);
-            let slip = if moved {
+            let before = moved.then(|| {
                 let q = prev.point(&self.mech, spec.point / 3, spec.kind);
-                let v = sub(p, [q.x, q.y, q.z]).map(|x| x / dt);
-                tangential(v, normal)
-            } else {
-                [0.0; 3]
-            };
+                [q.x, q.y, q.z]
+            });
             let row = &rec.contacts[c];
-            out.contacts[c] = ContactReadout {
-                leg: spec.leg,
-                kind: spec.kind,
-                position: p,
-                state: if moved {
-                    row.state
-                } else {
-                    data.states[c].code()
-                },
-                force: row.force,
-                normal_force: row.normal,
-                normal,
-                slip_velocity: slip,
+            let state = if moved {
+                row.state
+            } else {
+                data.states[c].code()
             };
+            out.contacts[c] = contact_readout(
+                spec,
+                [p, normal],
+                before,
+                dt,
+                state,
+                (row.force, row.normal),
+            );
         }
         out.kinetic = rec.kinetic;
         out.potential = rec.potential;

@@ -73,34 +73,24 @@ impl Plant for RobotSim {
             let p = kin.contact[tc.model_contact];
             let p = [p.x, p.y, p.z];
             let normal = ground.map_or([0.0, 1.0, 0.0], |s| s.normal(p[0], p[2]));
-            let slip = if moved {
+            let before = moved.then(|| {
                 let q = prev.contact[tc.model_contact];
-                let v = [(p[0] - q.x) / dt, (p[1] - q.y) / dt, (p[2] - q.z) / dt];
-                let d = v[0] * normal[0] + v[1] * normal[1] + v[2] * normal[2];
-                [
-                    v[0] - d * normal[0],
-                    v[1] - d * normal[1],
-                    v[2] - d * normal[2],
-                ]
-            } else {
-                [0.0; 3]
-            };
+                [q.x, q.y, q.z]
+            });
             let row = &rec.contacts[c];
-            let spec = &self.contact_specs[c];
-            out.contacts[c] = ContactReadout {
-                leg: spec.leg,
-                kind: spec.kind,
-                position: p,
-                state: if moved {
-                    row.state
-                } else {
-                    data.states[c].code()
-                },
-                force: row.force,
-                normal_force: row.normal,
-                normal,
-                slip_velocity: slip,
+            let state = if moved {
+                row.state
+            } else {
+                data.states[c].code()
             };
+            out.contacts[c] = crate::simulator::contact_readout(
+                &self.contact_specs[c],
+                [p, normal],
+                before,
+                dt,
+                state,
+                (row.force, row.normal),
+            );
         }
         out.kinetic = rec.kinetic;
         out.potential = rec.potential;

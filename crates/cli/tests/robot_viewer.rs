@@ -7,18 +7,9 @@ mod common;
 use std::collections::HashMap;
 use std::path::Path;
 
-use common::{example, fbd, s, stderr, stdout};
+use common::{example, fbd, s, scene, stderr, stdout};
 use fbd_robot::forward::{RobotData, base_frame, forward};
 use fbd_robot::nalgebra::Vector3;
-
-/// The scene embedded in `dir/viewer.html`.
-fn scene(dir: &Path) -> serde_json::Value {
-    let page = std::fs::read_to_string(dir.join("viewer.html")).unwrap();
-    let start = r#"<script id="fbd-scene" type="application/json">"#;
-    let a = page.find(start).expect("the scene element") + start.len();
-    let b = a + page[a..].find("</script>").unwrap();
-    serde_json::from_str(&page[a..b].replace("<\\/", "</")).unwrap()
-}
 
 /// `trajectory.csv`: column index by name, rows of numbers (NaN for text).
 fn table(dir: &Path) -> (HashMap<String, usize>, Vec<Vec<f64>>) {

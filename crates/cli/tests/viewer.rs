@@ -7,18 +7,9 @@
 
 mod common;
 
-use common::{example, fbd, s, stderr, write};
+use common::{example, fbd, s, scene, stderr, write};
 use std::collections::HashMap;
 use std::path::Path;
-
-/// The scene JSON embedded in `dir/viewer.html`.
-fn scene(dir: &Path) -> serde_json::Value {
-    let page = std::fs::read_to_string(dir.join("viewer.html")).unwrap();
-    let start = r#"<script id="fbd-scene" type="application/json">"#;
-    let a = page.find(start).expect("the scene element") + start.len();
-    let b = a + page[a..].find("</script>").unwrap();
-    serde_json::from_str(&page[a..b].replace("<\\/", "</")).unwrap()
-}
 
 /// `trajectory.csv` as a header index and rows of fields.
 fn csv(dir: &Path) -> (HashMap<String, usize>, Vec<Vec<String>>) {

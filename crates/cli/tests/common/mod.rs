@@ -79,3 +79,12 @@ pub fn fail_prefix() -> String {
 /// module for the workspace's and the CLI's tests).
 #[path = "../../../../tests/common/readme.rs"]
 pub mod readme;
+
+/// The scene JSON embedded in `dir/viewer.html`.
+pub fn scene(dir: &Path) -> serde_json::Value {
+    let page = std::fs::read_to_string(dir.join("viewer.html")).unwrap();
+    let start = r#"<script id="fbd-scene" type="application/json">"#;
+    let a = page.find(start).expect("the scene element") + start.len();
+    let b = a + page[a..].find("</script>").unwrap();
+    serde_json::from_str(&page[a..b].replace("<\\/", "</")).unwrap()
+}

@@ -203,6 +203,19 @@ fn audit(sim: &RobotSim, rows: &[Row]) -> [f64; 4] {
     [body_err, turn_err, com_err, law_err]
 }
 
+/// Prints the audit of `run` and asserts each part within 1e-6 of the
+/// weight (N).
+fn assert_exact(run: &str, audit: [f64; 4], weight: f64) {
+    let [body, turn, com, law] = audit;
+    eprintln!("{run}: body {body:.3e} N, rotation {turn:.3e} N, com {com:.3e} N, laws {law:.3e} N");
+    for (what, v) in ["translation", "rotation", "centre of mass", "contact laws"]
+        .into_iter()
+        .zip(audit)
+    {
+        assert!(v < 1e-6 * weight, "{run}: {what}: {v} N");
+    }
+}
+
 /// The configuration text of the lab hexapod under PD (kp 20, kd 0.2) on
 /// flat ground of friction `mu` from `q0` (root and joint angles), the
 /// root's velocity and angular velocity (deg/s).
@@ -273,15 +286,7 @@ fn lab_hexapod_stands_under_pd_with_every_row_balanced() {
         last.contacts.iter().all(|c| c.state == StateCode::St2),
         "every foot sticks"
     );
-    eprintln!("stand: body {body:.3e} N, rotation {turn:.3e} N, com {com:.3e} N, laws {law:.3e} N");
-    for (what, v) in [
-        ("translation", body),
-        ("rotation", turn),
-        ("centre of mass", com),
-        ("contact laws", law),
-    ] {
-        assert!(v < 1e-6 * weight, "{what}: {v} N");
-    }
+    assert_exact("stand", [body, turn, com, law], weight);
 }
 
 #[test]
@@ -314,17 +319,7 @@ fn lab_hexapod_landing_tumbles_within_the_laws() {
     assert_eq!(touched, 6, "every foot lands");
     assert!(slides > 0, "some foot slides");
     assert!(data.events.len() < 100, "events stay bounded");
-    eprintln!(
-        "landing: body {body:.3e} N, rotation {turn:.3e} N, com {com:.3e} N, laws {law:.3e} N"
-    );
-    for (what, v) in [
-        ("translation", body),
-        ("rotation", turn),
-        ("centre of mass", com),
-        ("contact laws", law),
-    ] {
-        assert!(v < 1e-6 * weight, "{what}: {v} N");
-    }
+    assert_exact("landing", [body, turn, com, law], weight);
 }
 
 /// The lab hexapod walking in a tripod gait (`examples/robots/
@@ -345,15 +340,7 @@ fn lab_hexapod_walks_in_a_tripod_gait_within_the_laws() {
         );
     let (sim, rows, data, [body, turn, com, law]) = check(&text);
     let weight = sim.mech.total_mass() * 9.81;
-    eprintln!("walk: body {body:.3e} N, rotation {turn:.3e} N, com {com:.3e} N, laws {law:.3e} N");
-    for (what, v) in [
-        ("translation", body),
-        ("rotation", turn),
-        ("centre of mass", com),
-        ("contact laws", law),
-    ] {
-        assert!(v < 1e-6 * weight, "{what}: {v} N");
-    }
+    assert_exact("walk", [body, turn, com, law], weight);
     // From t = 1.5 s (after the start-up and the ramp) to 3 s at 0.1 m/s.
     let at = |t: f64| rows.iter().find(|r| (r.t - t).abs() < 1e-9).unwrap();
     let (a, b) = (at(1.5), at(3.0));

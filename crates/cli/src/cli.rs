@@ -120,7 +120,12 @@ pub fn dispatch(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
         None => crate::run::run_command(None, &cli.out, out),
         Some(Command::Run(a)) => crate::run::run_command(a.config.as_deref(), &a.out, out),
         Some(Command::Kinematics(a)) => crate::kinematics::kinematics_command(&a.config, out),
-        Some(Command::Inverse(a)) => crate::kinematics::inverse_command(&a, out),
+        Some(Command::Inverse(a)) => crate::kinematics::inverse_command(
+            &a.config,
+            a.motion.as_deref(),
+            a.out.as_deref(),
+            out,
+        ),
         Some(Command::Sweep(a)) => crate::sweep::sweep_command(a, out),
         Some(Command::View(a)) => crate::viewer::view::view_command(&a.dir, out),
         Some(Command::Export(f)) => crate::export::export_command(f, out),

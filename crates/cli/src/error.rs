@@ -1,85 +1,39 @@
-//! The top-level error of a command and its exit status.
+//! The top-level error of a command ([`CliError`], the runs' own
+//! [`fbd_output::OutputError`]) and its exit status.
 
-use crate::config::{ConfigError, os_message};
+pub use fbd_output::OutputError as CliError;
 
-/// Why a command failed. Displays as one line (without the `error: `
-/// prefix the binary adds).
-#[derive(Debug, thiserror::Error)]
-pub enum CliError {
-    /// A configuration file is unreadable or invalid (exit 2, or 4 for an
-    /// operating-system read failure).
-    #[error(transparent)]
-    Config(#[from] ConfigError),
-    /// The request cannot be served (exit 2), e.g. `fbd run` of a hexapod.
-    #[error("{0}")]
-    Usage(String),
-    /// The simulation stopped with an error; what was computed is written
-    /// (exit 3).
-    #[error("{0}")]
-    Simulation(String),
-    /// SIGINT or SIGTERM stopped the command; what was computed is written
-    /// (exit 130).
-    #[error("{0}")]
-    Interrupted(String),
-    /// Reading or writing a file failed (exit 4).
-    #[error("{0}")]
-    Io(String),
-    /// Writing to stdout failed because the reader went away (exit 4,
-    /// nothing printed).
-    #[error("broken pipe")]
-    BrokenPipe,
-}
+/// Exit status for an internal error (a caught panic).
+pub const INTERNAL: u8 = 70;
 
-impl CliError {
-    /// Exit status for an internal error (a caught panic).
-    pub const INTERNAL: u8 = 70;
-
-    /// The process exit status of this error: 2 usage or configuration,
-    /// 3 simulation, 4 input/output, 130 interrupted.
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            CliError::Config(e) if e.is_io() => 4,
-            CliError::Config(_) | CliError::Usage(_) => 2,
-            CliError::Simulation(_) => 3,
-            CliError::Io(_) | CliError::BrokenPipe => 4,
-            CliError::Interrupted(_) => crate::interrupt::EXIT,
-        }
-    }
-
-    /// `true` when stdout was closed by its reader (no message is printed).
-    pub fn is_broken_pipe(&self) -> bool {
-        matches!(self, CliError::BrokenPipe)
-    }
-
-    /// Wraps an I/O error on `what` (a path or "stdout"):
-    /// `out/summary.json: permission denied`.
-    pub fn io(what: impl std::fmt::Display, e: &std::io::Error) -> Self {
-        CliError::Io(format!("{what}: {}", os_message(e)))
-    }
-
-    /// Maps a failed write to stdout.
-    pub fn stdout(e: std::io::Error) -> Self {
-        if e.kind() == std::io::ErrorKind::BrokenPipe {
-            CliError::BrokenPipe
-        } else {
-            CliError::io("stdout", &e)
-        }
+/// The process exit status of an error: 2 usage or configuration,
+/// 3 simulation, 4 input/output, 130 interrupted.
+pub fn exit_code(e: &CliError) -> u8 {
+    match e {
+        CliError::Config(c) if c.is_io() => 4,
+        CliError::Config(_) | CliError::Usage(_) => 2,
+        CliError::Simulation(_) => 3,
+        CliError::Io(_) | CliError::BrokenPipe => 4,
+        CliError::Interrupted(_) => fbd_output::interrupt::EXIT,
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use fbd_output::config::ConfigError;
 
     #[test]
-    fn os_messages_read_like_the_others() {
-        let e = std::io::Error::from_raw_os_error(2);
-        assert_eq!(os_message(&e), "no such file or directory");
-        let e = std::io::Error::other("Broken thing");
-        assert_eq!(os_message(&e), "broken thing");
-        assert_eq!(
-            CliError::io("out/x", &std::io::Error::from_raw_os_error(13)).to_string(),
-            "out/x: permission denied"
-        );
+    fn exit_codes() {
+        assert_eq!(exit_code(&CliError::Usage(String::new())), 2);
+        assert_eq!(exit_code(&CliError::Simulation(String::new())), 3);
+        assert_eq!(exit_code(&CliError::Io(String::new())), 4);
+        assert_eq!(exit_code(&CliError::BrokenPipe), 4);
+        assert_eq!(exit_code(&CliError::Interrupted(String::new())), 130);
+        let io = ConfigError::Io {
+            file: "x.toml".into(),
+            what: "permission denied".into(),
+        };
+        assert_eq!(exit_code(&CliError::Config(io)), 4);
     }
 }

@@ -1,34 +1,29 @@
 //! # fbd-cli
 //!
-//! The command-line front end of the simulator (docs/reference.md): the TOML
+//! The command-line front end of the simulator (docs/reference.md): the
+//! command line ([`cli`], clap), printing, and the exit status of every
+//! error ([`error::exit_code`]). The runs and every file they write live in
+//! the `fbd-output` crate, re-exported here under their old paths: the TOML
 //! configuration ([`config`]), the `fbd run` command writing
 //! `trajectory.csv`, `events.csv`, `summary.json`, `config.toml` and the
 //! plots ([`run`], [`output`], [`plot`]; a kinematic hexapod run in
 //! [`hexapod`], a dynamic one in [`spatial`]), and `fbd kinematics`
 //! ([`kinematics`]). The binary `fbd` only calls [`main_with_args`].
 //!
-//! Exit status ([`CliError::exit_code`]): 0 success, 2 usage or
+//! Exit status ([`error::exit_code`]): 0 success, 2 usage or
 //! configuration error, 3 simulation failed (files still written), 4 input
 //! or output error. Every error is one line on stderr, `error: …`.
 
 pub mod cli;
-pub mod columnar;
 /// The configuration: the `fbd-scenario` crate.
 pub use fbd_scenario as config;
 pub mod error;
 pub mod export;
-pub mod hexapod;
-pub mod interrupt;
-pub mod kinematics;
-pub mod output;
-pub mod plot;
-pub mod robot_run;
-pub mod run;
-pub mod spatial;
-pub mod steptime;
 pub mod sweep;
-pub mod sweep_plot;
-pub mod viewer;
+pub use fbd_output::{
+    columnar, hexapod, interrupt, kinematics, output, plot, robot_run, run, spatial, steptime,
+    sweep_plot, viewer,
+};
 
 pub use config::{Config, ConfigError, Override};
 pub use error::CliError;
@@ -110,9 +105,9 @@ where
             if !e.is_broken_pipe() {
                 let _ = writeln!(std::io::stderr(), "error: {e}");
             }
-            ExitCode::from(e.exit_code())
+            ExitCode::from(error::exit_code(&e))
         }
         // The panic hook already printed the message.
-        Err(_) => ExitCode::from(CliError::INTERNAL),
+        Err(_) => ExitCode::from(error::INTERNAL),
     }
 }

@@ -1,11 +1,11 @@
 //! Every column of `trajectory.csv`, kept in memory: the same names
-//! ([`fbd_cli::output::trajectory_columns`]) and the same values, from the
-//! same row builders ([`fbd_cli::output::row_values`],
-//! [`fbd_cli::spatial::csv::row_values`]), so that a run from Python equals
+//! ([`fbd_output::output::trajectory_columns`]) and the same values, from the
+//! same row builders ([`fbd_output::output::row_values`],
+//! [`fbd_output::spatial::csv::row_values`]), so that a run from Python equals
 //! the CLI's file bit for bit (the test suite compares them).
 
-use fbd_cli::output::{ContactSlots, RowSink};
-use fbd_cli::steptime::StepTimes;
+use fbd_output::output::{ContactSlots, RowSink};
+use fbd_output::steptime::StepTimes;
 use fbd_sim::StepRecord;
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -66,7 +66,7 @@ impl Columns {
     }
 
     /// The row being written, one value per call in column order (the 3D
-    /// run's [`fbd_cli::spatial::csv::row_values`]).
+    /// run's [`fbd_output::spatial::csv::row_values`]).
     pub fn sink(&mut self) -> Sink<'_> {
         Sink {
             w: Writer {
@@ -86,7 +86,7 @@ impl Columns {
             },
             times: &self.times,
         };
-        fbd_cli::output::row_values(&self.slots, r, &mut sink);
+        fbd_output::output::row_values(&self.slots, r, &mut sink);
         debug_assert_eq!(sink.w.i, self.names.len(), "a value for every column");
     }
 

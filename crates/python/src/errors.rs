@@ -3,7 +3,7 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use fbd_cli::CliError;
+use fbd_output::OutputError;
 use fbd_scenario::ConfigError;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError};
 use pyo3::prelude::*;
@@ -99,10 +99,10 @@ pub fn simulation_error(
 /// A CLI-library error as a Python exception: configuration errors as
 /// `fbd.ConfigError` (a hexapod `Simulator` names the key `model`), file errors as
 /// `OSError`.
-pub fn cli_error(py: Python<'_>, e: &CliError, from_text: bool) -> PyErr {
+pub fn cli_error(py: Python<'_>, e: &OutputError, from_text: bool) -> PyErr {
     match e {
-        CliError::Config(c) => config_error(py, c, from_text),
-        CliError::Usage(m) => {
+        OutputError::Config(c) => config_error(py, c, from_text),
+        OutputError::Usage(m) => {
             let kwargs = PyDict::new(py);
             let key = m.contains("model = ").then_some("model");
             if let Err(err) = kwargs.set_item("key", key) {
@@ -110,10 +110,10 @@ pub fn cli_error(py: Python<'_>, e: &CliError, from_text: bool) -> PyErr {
             }
             raise(py, "ConfigError", m, &kwargs)
         }
-        CliError::Simulation(m) => simulation_error(py, m, None, None, None),
-        CliError::Io(m) => PyOSError::new_err(m.clone()),
-        CliError::BrokenPipe => PyOSError::new_err("broken pipe"),
-        CliError::Interrupted(m) => PyKeyboardInterrupt::new_err(m.clone()),
+        OutputError::Simulation(m) => simulation_error(py, m, None, None, None),
+        OutputError::Io(m) => PyOSError::new_err(m.clone()),
+        OutputError::BrokenPipe => PyOSError::new_err("broken pipe"),
+        OutputError::Interrupted(m) => PyKeyboardInterrupt::new_err(m.clone()),
     }
 }
 

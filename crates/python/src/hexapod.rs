@@ -1,12 +1,12 @@
 //! `run(config)` of a kinematic hexapod configuration: the kinematic gait
 //! (or a kinematic standing run, `dynamics = "kinematic"`), every column of its `trajectory.csv` in
-//! memory ([`fbd_cli::hexapod::columns`]), the same values as the file.
+//! memory ([`fbd_output::hexapod::columns`]), the same values as the file.
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use fbd_cli::hexapod::{HexapodRun, ROW_VALUES, columns, row_values, simulate};
-use fbd_cli::steptime::StepTimes;
+use fbd_output::hexapod::{HexapodRun, ROW_VALUES, columns, row_values, simulate};
+use fbd_output::steptime::StepTimes;
 use fbd_scenario::{Config, HexapodConfig};
 use numpy::PyArray1;
 use pyo3::prelude::*;
@@ -62,7 +62,7 @@ pub fn run<'py>(
     let events = PyList::empty(py);
     for e in &run.events {
         let ev = PyDict::new(py);
-        ev.set_item("t", fbd_cli::hexapod::tidy(e.t))?;
+        ev.set_item("t", fbd_output::hexapod::tidy(e.t))?;
         ev.set_item("leg", e.leg)?;
         ev.set_item("event", e.kind.as_str())?;
         ev.set_item("margin", e.margin)?;

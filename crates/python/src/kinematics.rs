@@ -69,7 +69,7 @@ pub fn kinematics_json(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyR
                 .map_err(|e| PyValueError::new_err(e.to_string()));
         }
         let loaded = crate::config::load(py, config)?;
-        Ok(fbd_cli::kinematics::initial_kinematics(&loaded.config).to_json())
+        Ok(fbd_output::kinematics::initial_kinematics(&loaded.config).to_json())
     })
 }
 

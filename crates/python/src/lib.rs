@@ -44,7 +44,7 @@ fn _fbd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulator::_simulator_from_state, m)?)?;
     m.add(
         "TRAJECTORY_SPEC_COLUMNS",
-        fbd_cli::output::SPEC_COLUMNS.to_vec(),
+        fbd_output::output::SPEC_COLUMNS.to_vec(),
     )?;
     Ok(())
 }

@@ -1,5 +1,5 @@
 //! `run(config)` of an imported robot (`model = "robot"`): the CLI's own
-//! run ([`fbd_cli::robot_run::simulate`]) into `out` or a temporary
+//! run ([`fbd_output::robot_run::simulate`]) into `out` or a temporary
 //! directory, every column of its `trajectory.csv` read back into memory
 //! (shortest round-trip numbers: the file's values, bit for bit; the
 //! names and kinds of [`LoadedRobot::columns`]), its events and summary.
@@ -7,9 +7,9 @@
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use fbd_cli::config::robot::{ColumnKind, LoadedRobot, RobotColumns};
-use fbd_cli::robot_run::{robot_events, simulate};
-use fbd_cli::steptime::StepTimes;
+use fbd_output::config::robot::{ColumnKind, LoadedRobot, RobotColumns};
+use fbd_output::robot_run::{robot_events, simulate};
+use fbd_output::steptime::StepTimes;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -155,7 +155,7 @@ pub fn run<'py>(
     let sim = robot.sim().map_err(|e| {
         config_error(
             py,
-            &fbd_cli::ConfigError::Semantic {
+            &fbd_output::ConfigError::Semantic {
                 file: source.to_owned(),
                 message: e.to_string(),
             },
@@ -175,7 +175,7 @@ pub fn run<'py>(
             temp = TempDir::new().map_err(|e| {
                 cli_error(
                     py,
-                    &fbd_cli::CliError::io(std::env::temp_dir().display(), &e),
+                    &fbd_output::OutputError::io(std::env::temp_dir().display(), &e),
                     from_text,
                 )
             })?;
@@ -228,7 +228,7 @@ pub fn run<'py>(
     }
     let path = dir.join("trajectory.csv");
     let text = std::fs::read_to_string(&path)
-        .map_err(|e| cli_error(py, &fbd_cli::CliError::io(path.display(), &e), from_text))?;
+        .map_err(|e| cli_error(py, &fbd_output::OutputError::io(path.display(), &e), from_text))?;
     table.read_csv(&text).ok_or_else(|| {
         pyo3::exceptions::PyRuntimeError::new_err(format!(
             "{}: not a robot's trajectory.csv",

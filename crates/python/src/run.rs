@@ -5,8 +5,8 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use fbd_cli::output::ContactSlots;
-use fbd_cli::run::{Simulated, simulate};
+use fbd_output::output::ContactSlots;
+use fbd_output::run::{Simulated, simulate};
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -49,7 +49,7 @@ impl SignalWatch {
     /// KeyboardInterrupt for Ctrl-C, with where the run stopped).
     pub fn raise(
         self,
-        io_error: Option<fbd_cli::CliError>,
+        io_error: Option<fbd_output::OutputError>,
         from_text: bool,
         source: &str,
         steps: usize,
@@ -124,7 +124,7 @@ pub fn dynamics_result<'py>(
 }
 
 /// Every event of a run — contact, joint-limit and retried-step events, as
-/// `events.csv` lists them ([`fbd_cli::output::merge_events`]) — as a list
+/// `events.csv` lists them ([`fbd_output::output::merge_events`]) — as a list
 /// of dicts (`t`, `step`, `leg` (None for a retried step), `point`, `from`,
 /// `to`).
 pub fn events<'py>(
@@ -134,9 +134,9 @@ pub fn events<'py>(
     retries: &[fbd_sim::RetryEvent],
     dt: f64,
 ) -> PyResult<Bound<'py, PyList>> {
-    let times = fbd_cli::steptime::StepTimes::new(dt);
+    let times = fbd_output::steptime::StepTimes::new(dt);
     let list = PyList::empty(py);
-    for (step, _, e) in fbd_cli::output::merge_events(events, limit_events, retries, &times) {
+    for (step, _, e) in fbd_output::output::merge_events(events, limit_events, retries, &times) {
         let d = PyDict::new(py);
         d.set_item("t", e.t)?;
         d.set_item("step", step)?;

@@ -6,7 +6,7 @@
 //! pickled; many simulators stepped at once on Rust threads
 //! ([`step_many`]).
 
-use fbd_cli::config::robot::LoadedRobot;
+use fbd_output::config::robot::LoadedRobot;
 use fbd_sim::robot::RobotSim;
 use fbd_sim::simulator::{Action, PdTargets, Readout, SimState, Simulator as Core};
 use fbd_sim::spatial::SpatialModel;
@@ -311,7 +311,7 @@ fn coordinate_names(plant: &Plant) -> Vec<String> {
             v
         }
         Plant::Robot(_, r) => {
-            let mut v: Vec<String> = fbd_cli::config::robot::MOTION_BASE_COLUMNS
+            let mut v: Vec<String> = fbd_output::config::robot::MOTION_BASE_COLUMNS
                 .map(String::from)
                 .to_vec();
             v.extend(r.model.joints.iter().map(|j| j.name.clone()));
@@ -537,7 +537,7 @@ impl Simulator {
                 let model = robot.sim().map_err(|e| {
                     config_error(
                         py,
-                        &fbd_cli::ConfigError::Semantic {
+                        &fbd_output::ConfigError::Semantic {
                             file: source.clone(),
                             message: e.to_string(),
                         },
@@ -559,7 +559,7 @@ impl Simulator {
                     if !h.is_dynamic() {
                         return Err(crate::errors::cli_error(
                             py,
-                            &fbd_cli::CliError::Usage(format!(
+                            &fbd_output::OutputError::Usage(format!(
                                 "{}: model = \"hexapod\" with a kinematic gait (dynamics = \"kinematic\"): Simulator steps the 3D dynamics; fbd.run(config) runs the kinematic gait",
                                 loaded.source
                             )),
@@ -572,7 +572,7 @@ impl Simulator {
                     let model = SpatialModel::new(&params).map_err(|e| {
                         crate::errors::cli_error(
                             py,
-                            &fbd_cli::CliError::Usage(format!("{}: {e}", loaded.source)),
+                            &fbd_output::OutputError::Usage(format!("{}: {e}", loaded.source)),
                             true,
                         )
                     })?;

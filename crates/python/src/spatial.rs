@@ -1,14 +1,14 @@
 //! `run(config)` of a dynamic hexapod configuration: the 3D FBD dynamics
-//! ([`fbd_cli::spatial::simulate`]), every column of its `trajectory.csv`
+//! ([`fbd_output::spatial::simulate`]), every column of its `trajectory.csv`
 //! in memory from the CLI's own row builder
-//! ([`fbd_cli::spatial::csv::row_values`]): the same names and values as
+//! ([`fbd_output::spatial::csv::row_values`]): the same names and values as
 //! the file.
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use fbd_cli::spatial::csv::{Slots, row_values};
-use fbd_cli::spatial::{Feet, Layout, SpatialRun, columns, simulate};
+use fbd_output::spatial::csv::{Slots, row_values};
+use fbd_output::spatial::{Feet, Layout, SpatialRun, columns, simulate};
 use fbd_scenario::{Config, HexapodConfig};
 use fbd_sim::spatial::SpatialRecord;
 use pyo3::prelude::*;

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use fbd_cli::CliError;
-use fbd_cli::sweep::{SweepArgs, sweep_command};
+use fbd_output::OutputError;
+use fbd_output::sweep::{SweepArgs, sweep_command};
 use pyo3::prelude::*;
 
 use crate::errors::{cli_error, guard};
@@ -41,7 +41,7 @@ pub fn sweep(
         let text = String::from_utf8_lossy(&text).into_owned();
         match result {
             Ok(()) => Ok((text, None)),
-            Err(CliError::Simulation(m)) if out.join("index.csv").is_file() => Ok((text, Some(m))),
+            Err(OutputError::Simulation(m)) if out.join("index.csv").is_file() => Ok((text, Some(m))),
             Err(e) => Err(cli_error(py, &e, true)),
         }
     })

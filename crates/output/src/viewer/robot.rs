@@ -60,7 +60,7 @@ use super::{
     Curve, Decimator, EventMark, Line, Marker, Panel, Scene, SceneKind, round, round_time,
     surface_view, value,
 };
-use crate::CliError;
+use crate::OutputError;
 
 /// Capsule radius as a share of the robot's size (see the module docs).
 pub const RADIUS_SHARE: f64 = 0.02;
@@ -351,9 +351,9 @@ impl RobotFrames {
 
     /// The complete scene, the rows decimated to at most
     /// [`super::MAX_FRAMES`] frames; an error for a malformed row.
-    pub fn finish(self) -> Result<RobotScene, CliError> {
+    pub fn finish(self) -> Result<RobotScene, OutputError> {
         if let Some(e) = &self.error {
-            return Err(CliError::Simulation(e.clone()));
+            return Err(OutputError::Simulation(e.clone()));
         }
         let (nj, nc) = (self.model.joints.len(), self.model.contacts.len());
         let nq = 6 + nj;
@@ -493,7 +493,7 @@ impl RobotFrames {
     }
 
     /// Writes `out_dir/viewer.html` all-or-nothing; returns its path.
-    pub fn write(self, out_dir: &Path) -> Result<PathBuf, CliError> {
+    pub fn write(self, out_dir: &Path) -> Result<PathBuf, OutputError> {
         let scene = self.finish()?;
         let page = super::render_json(&scene, &scene.scene.title)?;
         crate::output::write_file(out_dir, "viewer.html", page.as_bytes())

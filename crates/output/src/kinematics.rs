@@ -12,7 +12,7 @@ use fbd_kinematics::planar::{PlanarChains, PlanarGeometry};
 use fbd_kinematics::pose::BodyPose;
 use serde::Serialize;
 
-use crate::CliError;
+use crate::OutputError;
 use crate::config::{self, Config, HexapodConfig, PlanarConfig};
 
 /// The points of one leg (m, inertial frame).
@@ -133,28 +133,29 @@ fn one_item_per_line(value: &serde_json::Value) -> String {
 }
 
 /// `fbd kinematics CONFIG`.
-pub fn kinematics_command(path: &Path, out: &mut dyn Write) -> Result<(), CliError> {
+pub fn kinematics_command(path: &Path, out: &mut dyn Write) -> Result<(), OutputError> {
     let text = config::read_text(path)?;
     let json = if config::robot::is_robot(&text) {
         let robot = config::robot::load_str(&text, path)?;
         let value = serde_json::to_value(robot.kinematics())
-            .map_err(|e| CliError::stdout(std::io::Error::other(e)))?;
+            .map_err(|e| OutputError::stdout(std::io::Error::other(e)))?;
         one_item_per_line(&value)
     } else {
         initial_kinematics(&config::load(path)?).to_json()
     };
     out.write_all(json.as_bytes())
         .and_then(|()| out.flush())
-        .map_err(CliError::stdout)
+        .map_err(OutputError::stdout)
 }
 
 /// `fbd inverse CONFIG [--motion FILE [--out FILE]]` (an imported robot's
 /// configuration).
 pub fn inverse_command(
-    args: &crate::cli::InverseArgs,
+    path: &Path,
+    motion: Option<&Path>,
+    out_file: Option<&Path>,
     out: &mut dyn Write,
-) -> Result<(), CliError> {
-    let path = args.config.as_path();
+) -> Result<(), OutputError> {
     let text = config::read_text(path)?;
     if !config::robot::is_robot(&text) {
         return Err(config::ConfigError::Semantic {
@@ -166,18 +167,18 @@ pub fn inverse_command(
         .into());
     }
     let robot = config::robot::load_str(&text, path)?;
-    let Some(motion_path) = &args.motion else {
-        if args.out.is_some() {
-            return Err(CliError::Usage(
+    let Some(motion_path) = motion else {
+        if out_file.is_some() {
+            return Err(OutputError::Usage(
                 "fbd inverse: --out writes the CSV of --motion; give --motion FILE".to_owned(),
             ));
         }
         let value = serde_json::to_value(robot.inverse())
-            .map_err(|e| CliError::stdout(std::io::Error::other(e)))?;
+            .map_err(|e| OutputError::stdout(std::io::Error::other(e)))?;
         return out
             .write_all(one_item_per_line(&value).as_bytes())
             .and_then(|()| out.flush())
-            .map_err(CliError::stdout);
+            .map_err(OutputError::stdout);
     };
     let motion_text = config::read_text(motion_path)?;
     let motion = robot.read_motion(&motion_text, &motion_path.display().to_string())?;
@@ -189,7 +190,7 @@ pub fn inverse_command(
         csv.push_str(&cells.join(","));
         csv.push('\n');
     }
-    match &args.out {
+    match out_file {
         Some(dest) => {
             let dir = dest
                 .parent()
@@ -198,12 +199,12 @@ pub fn inverse_command(
             let mut tmp = crate::output::temp_in(dir, "inverse.csv")?;
             tmp.write_all(csv.as_bytes())
                 .and_then(|()| tmp.flush())
-                .map_err(|e| CliError::io(dest.display(), &e))?;
+                .map_err(|e| OutputError::io(dest.display(), &e))?;
             crate::output::persist(tmp, dest)
         }
         None => out
             .write_all(csv.as_bytes())
             .and_then(|()| out.flush())
-            .map_err(CliError::stdout),
+            .map_err(OutputError::stdout),
     }
 }

@@ -25,7 +25,7 @@ use parquet::file::writer::SerializedFileWriter;
 use parquet::schema::types::Type;
 use tempfile::NamedTempFile;
 
-use crate::CliError;
+use crate::OutputError;
 use crate::output::{self, RowSink};
 use crate::steptime::StepTimes;
 
@@ -75,7 +75,7 @@ fn err(e: impl std::fmt::Display) -> String {
 impl ParquetTable {
     /// Opens `dir/trajectory.parquet` (as a temporary file) for the columns
     /// `names`; `dt` is the time step of the times.
-    pub fn create(dir: &Path, names: Vec<String>, dt: f64) -> Result<Self, CliError> {
+    pub fn create(dir: &Path, names: Vec<String>, dt: f64) -> Result<Self, OutputError> {
         let tmp = output::temp_in(dir, "trajectory.parquet")?;
         let group_rows = (GROUP_BYTES / (8 * names.len().max(1))).max(256);
         Ok(Self {
@@ -244,8 +244,8 @@ impl ParquetTable {
 
     /// Writes the last row group and the footer and renames the file into
     /// place; the first error of the run, if any, naming the file.
-    pub fn finish(mut self) -> Result<PathBuf, CliError> {
-        let fail = |dest: &Path, e: String| CliError::Io(format!("{}: {e}", dest.display()));
+    pub fn finish(mut self) -> Result<PathBuf, OutputError> {
+        let fail = |dest: &Path, e: String| OutputError::Io(format!("{}: {e}", dest.display()));
         if let Some(e) = self.error.take() {
             return Err(fail(&self.dest, e));
         }
@@ -257,7 +257,7 @@ impl ParquetTable {
         let buf = w.into_inner().map_err(|e| fail(&self.dest, err(e)))?;
         let tmp = buf
             .into_inner()
-            .map_err(|e| CliError::io(self.dest.display(), e.error()))?;
+            .map_err(|e| OutputError::io(self.dest.display(), e.error()))?;
         output::persist(tmp, &self.dest)?;
         Ok(self.dest)
     }

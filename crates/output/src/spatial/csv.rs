@@ -10,7 +10,7 @@ use fbd_scenario::OutputFormat;
 use fbd_sim::spatial::{SpatialParams, SpatialRecord};
 
 use super::Layout;
-use crate::CliError;
+use crate::OutputError;
 use crate::output;
 
 /// The body pose columns after `t`.
@@ -198,7 +198,7 @@ pub struct TrajectoryWriter {
 
 impl TrajectoryWriter {
     /// Opens the temporary `trajectory.csv` in `dir` and writes the header.
-    pub fn create(dir: &Path, params: &SpatialParams) -> Result<Self, CliError> {
+    pub fn create(dir: &Path, params: &SpatialParams) -> Result<Self, OutputError> {
         Self::create_as(dir, params, OutputFormat::Csv)
     }
 
@@ -207,7 +207,7 @@ impl TrajectoryWriter {
         dir: &Path,
         params: &SpatialParams,
         format: OutputFormat,
-    ) -> Result<Self, CliError> {
+    ) -> Result<Self, OutputError> {
         let layout = Layout::of(params);
         Ok(Self {
             table: output::Table::create(dir, format, columns(&layout), params.dt)?,
@@ -236,7 +236,7 @@ impl TrajectoryWriter {
     }
 
     /// Flushes and renames the file into place.
-    pub fn finish(self) -> Result<PathBuf, CliError> {
+    pub fn finish(self) -> Result<PathBuf, OutputError> {
         self.table.finish()
     }
 }

@@ -18,7 +18,7 @@ use fbd_scenario::OutputConfig;
 use fbd_sim::RunSummary;
 use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_until};
 
-use crate::CliError;
+use crate::OutputError;
 use crate::config::ConfigError;
 use crate::output::{self, Ending};
 use crate::steptime::StepTimes;
@@ -196,7 +196,7 @@ pub struct SpatialRun {
     /// The content of `summary.json`.
     pub summary: SpatialSummary,
     /// The first failure writing a file (every file is still attempted).
-    pub io_error: Option<CliError>,
+    pub io_error: Option<OutputError>,
     /// The files written, in order (none without an output directory).
     pub files: Vec<&'static str>,
 }
@@ -227,7 +227,7 @@ impl Outputs {
         params: &SpatialParams,
         steps: usize,
         out_dir: Option<&Path>,
-    ) -> Result<Self, CliError> {
+    ) -> Result<Self, OutputError> {
         Self::new_as(params, steps, out_dir, &OutputConfig::default(), "hexapod")
     }
 
@@ -239,7 +239,7 @@ impl Outputs {
         out_dir: Option<&Path>,
         output: &OutputConfig,
         source: &str,
-    ) -> Result<Self, CliError> {
+    ) -> Result<Self, OutputError> {
         let format = output.format;
         let layout = Layout::of(params);
         let stride = params.stride.max(1);
@@ -323,8 +323,8 @@ impl Outputs {
                 files: Vec::new(),
             };
         };
-        let mut io_error: Option<CliError> = None;
-        let mut keep = |r: Result<PathBuf, CliError>| {
+        let mut io_error: Option<OutputError> = None;
+        let mut keep = |r: Result<PathBuf, OutputError>| {
             if let Err(e) = r
                 && io_error.is_none()
             {
@@ -348,7 +348,7 @@ impl Outputs {
                 ("energy.svg", plots::energy_svg(&plot)),
             ] {
                 keep(
-                    svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
+                    svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
                         .and_then(|s| output::write_file(&out_dir, name, s.as_bytes())),
                 );
             }
@@ -396,7 +396,7 @@ pub fn simulate(
     out_dir: Option<&Path>,
     stop: &AtomicBool,
     on_row: &mut dyn FnMut(&SpatialRecord),
-) -> Result<SpatialRun, CliError> {
+) -> Result<SpatialRun, OutputError> {
     // The plots and peaks want every step: stride is applied by Outputs.
     let mut every_step = params.clone();
     every_step.stride = 1;
@@ -425,7 +425,7 @@ pub fn run_command(
     source: &str,
     out_dir: &Path,
     out: &mut dyn Write,
-) -> Result<(), CliError> {
+) -> Result<(), OutputError> {
     let SpatialRun {
         run,
         summary,

@@ -9,7 +9,7 @@ use fbd_dynamics::PointKind;
 use fbd_kinematics::planar::PlanarChains;
 use fbd_sim::{Model, RunSummary, StepRecord};
 
-use crate::CliError;
+use crate::OutputError;
 use crate::config::{self, Config};
 use crate::output::{self, Ending, Energy, EventJson, PeakForce, Summary, TrajectoryWriter};
 use crate::plot::{self, PlotData, PlotRecorder, Stance};
@@ -266,7 +266,7 @@ pub struct Simulated {
     /// The names of the model's contact points, in record order.
     pub contacts: Vec<String>,
     /// The first failure writing a file (every file is still attempted).
-    pub io_error: Option<CliError>,
+    pub io_error: Option<OutputError>,
     /// The names of the files written, in order (none without an output
     /// directory).
     pub files: Vec<&'static str>,
@@ -286,11 +286,11 @@ pub fn simulate(
     out_dir: Option<&Path>,
     stop: &AtomicBool,
     on_row: &mut dyn FnMut(&StepRecord),
-) -> Result<Simulated, CliError> {
+) -> Result<Simulated, OutputError> {
     let planar = match config {
         Config::Planar(c) => c,
         Config::Hexapod(_) => {
-            return Err(CliError::Usage(format!(
+            return Err(OutputError::Usage(format!(
                 "{source}: model = \"hexapod\": a hexapod runs in `fbd_cli::spatial::simulate` (the 3D dynamics) or `fbd_cli::hexapod::simulate` (the kinematic gait), not in the planar `simulate`"
             )));
         }
@@ -359,8 +359,8 @@ pub fn simulate(
     };
 
     // Write every file even if one fails; report the first failure.
-    let mut io_error: Option<CliError> = None;
-    let mut keep = |r: Result<std::path::PathBuf, CliError>| {
+    let mut io_error: Option<OutputError> = None;
+    let mut keep = |r: Result<std::path::PathBuf, OutputError>| {
         if let Err(e) = r
             && io_error.is_none()
         {
@@ -393,7 +393,7 @@ pub fn simulate(
     });
     for (name, svg) in svgs.into_iter().flatten().chain(torques) {
         keep(
-            svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
+            svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
                 .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
         );
     }
@@ -424,13 +424,13 @@ pub fn simulate(
 /// `fbd run`: loads `config` (the built-in default when `None`), checks
 /// the output directory, simulates while streaming `trajectory.csv`, then
 /// writes the other files ([`simulate`]). On a simulation error every file
-/// is still written and the error is returned ([`CliError::Simulation`],
+/// is still written and the error is returned ([`OutputError::Simulation`],
 /// exit 3).
 pub fn run_command(
     config_path: Option<&Path>,
     out_dir: &Path,
     out: &mut dyn Write,
-) -> Result<(), CliError> {
+) -> Result<(), OutputError> {
     if let Some(p) = config_path {
         let text = config::read_text(p)?;
         if config::robot::is_robot(&text) {
@@ -464,7 +464,7 @@ pub fn run_command(
         // interruption): remove the planar files of an earlier run.
         if matches!(
             r,
-            Ok(()) | Err(CliError::Simulation(_) | CliError::Interrupted(_))
+            Ok(()) | Err(OutputError::Simulation(_) | OutputError::Interrupted(_))
         ) {
             output::remove_stale(
                 out_dir,

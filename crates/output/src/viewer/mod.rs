@@ -5,9 +5,9 @@
 //! robot at every frame with `fbd_kinematics`, the contact and joint force
 //! vectors, the contact states, the centre of mass, the time series — and
 //! embeds it as JSON in the page ([`Scene`]); the page's own script
-//! (`crates/cli/assets/viewer.js`) only draws, with three.js (vendored at a
-//! pinned version, `crates/cli/assets/three.min.js`, MIT licence in
-//! `crates/cli/assets/THREE_LICENSE`) inlined into the page.
+//! (`crates/output/assets/viewer.js`) only draws, with three.js (vendored at a
+//! pinned version, `crates/output/assets/three.min.js`, MIT licence in
+//! `crates/output/assets/THREE_LICENSE`) inlined into the page.
 //!
 //! * [`planar`] fills a scene from the planar model's step records, during
 //!   `fbd run` or from `trajectory.csv` in `fbd view DIR`;
@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use crate::CliError;
+use crate::OutputError;
 use crate::output;
 
 /// Most frames a page holds (see the module docs for which are kept).
@@ -372,16 +372,16 @@ fn script_safe(s: &str) -> String {
 }
 
 /// The complete page for `scene`.
-pub fn render(scene: &Scene) -> Result<String, CliError> {
+pub fn render(scene: &Scene) -> Result<String, OutputError> {
     render_json(scene, &scene.title)
 }
 
 /// The complete page for any serializable scene: a [`Scene`], or one with
 /// fields of its own beside a flattened [`Scene`] (a robot's
 /// [`robot::RobotScene`]), titled `title`.
-pub fn render_json<S: Serialize>(scene: &S, title: &str) -> Result<String, CliError> {
+pub fn render_json<S: Serialize>(scene: &S, title: &str) -> Result<String, OutputError> {
     let json = serde_json::to_string(scene)
-        .map_err(|e| CliError::Io(format!("viewer.html: cannot encode the scene: {e}")))?;
+        .map_err(|e| OutputError::Io(format!("viewer.html: cannot encode the scene: {e}")))?;
     let title = title
         .replace('&', "&amp;")
         .replace('<', "&lt;")
@@ -434,7 +434,7 @@ pub fn title_of(_source: &str, model: &str) -> String {
 }
 
 /// Writes `dir/viewer.html` all-or-nothing.
-pub fn write(dir: &Path, scene: &Scene) -> Result<PathBuf, CliError> {
+pub fn write(dir: &Path, scene: &Scene) -> Result<PathBuf, OutputError> {
     let page = render(scene)?;
     output::write_file(dir, "viewer.html", page.as_bytes())
 }

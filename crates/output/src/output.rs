@@ -15,7 +15,7 @@ use fbd_sim::{Event, LimitEvent, RetryEvent, RunSummary, StepRecord};
 use serde::Serialize;
 use tempfile::NamedTempFile;
 
-use crate::CliError;
+use crate::OutputError;
 use crate::steptime::StepTimes;
 
 /// Names of the files `fbd run` writes, in the order they are written.
@@ -61,7 +61,7 @@ pub const TAIL_COLUMNS: [&str; 12] = [
 
 /// A new temporary file in `dir`, readable like an ordinary file once
 /// renamed ([`persist`]).
-pub fn temp_in(dir: &Path, name: &str) -> Result<NamedTempFile, CliError> {
+pub fn temp_in(dir: &Path, name: &str) -> Result<NamedTempFile, OutputError> {
     let prefix = format!(".{name}.");
     let mut b = tempfile::Builder::new();
     b.prefix(&prefix).suffix(".tmp");
@@ -71,13 +71,13 @@ pub fn temp_in(dir: &Path, name: &str) -> Result<NamedTempFile, CliError> {
         b.permissions(std::fs::Permissions::from_mode(0o666));
     }
     b.tempfile_in(dir)
-        .map_err(|e| CliError::io(format!("{}: cannot create a file", dir.display()), &e))
+        .map_err(|e| OutputError::io(format!("{}: cannot create a file", dir.display()), &e))
 }
 
 /// Renames a finished temporary file to `dest` (all-or-nothing).
-pub fn persist(tmp: NamedTempFile, dest: &Path) -> Result<(), CliError> {
+pub fn persist(tmp: NamedTempFile, dest: &Path) -> Result<(), OutputError> {
     tmp.persist(dest)
-        .map_err(|e| CliError::io(dest.display(), &e.error))?;
+        .map_err(|e| OutputError::io(dest.display(), &e.error))?;
     Ok(())
 }
 
@@ -282,9 +282,9 @@ pub fn conclude(
     mut text: String,
     out_dir: &Path,
     files: &[&str],
-    io_error: Option<CliError>,
+    io_error: Option<OutputError>,
     ending: Ending,
-) -> Result<(), CliError> {
+) -> Result<(), OutputError> {
     if io_error.is_none() {
         text.push_str(&format!(
             "files in {}: {}\n",
@@ -294,7 +294,7 @@ pub fn conclude(
     }
     out.write_all(text.as_bytes())
         .and_then(|()| out.flush())
-        .map_err(CliError::stdout)?;
+        .map_err(OutputError::stdout)?;
     if let Some(e) = io_error {
         return Err(e);
     }
@@ -305,11 +305,11 @@ pub fn conclude(
             error,
             source,
             advice,
-        } => Err(CliError::Simulation(format!(
+        } => Err(OutputError::Simulation(format!(
             "{error} ({source}; {saved}){}",
             advice.map(|a| format!("; {a}")).unwrap_or_default()
         ))),
-        Ending::Interrupted(msg) => Err(CliError::Interrupted(format!("{msg}; {saved}"))),
+        Ending::Interrupted(msg) => Err(OutputError::Interrupted(format!("{msg}; {saved}"))),
     }
 }
 
@@ -322,22 +322,22 @@ pub fn write_run_files(
     events_csv: &str,
     summary: &impl Serialize,
     config_toml: &str,
-    keep: &mut impl FnMut(Result<PathBuf, CliError>),
+    keep: &mut impl FnMut(Result<PathBuf, OutputError>),
 ) {
     keep(write_file(dir, "events.csv", events_csv.as_bytes()));
     let json = serde_json::to_string_pretty(summary)
-        .map_err(|e| CliError::Io(format!("summary.json: {e}")));
+        .map_err(|e| OutputError::Io(format!("summary.json: {e}")));
     keep(json.and_then(|j| write_file(dir, "summary.json", format!("{j}\n").as_bytes())));
     keep(write_file(dir, "config.toml", config_toml.as_bytes()));
 }
 
 /// Writes `bytes` to `dir/name` all-or-nothing; returns the path.
-pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliError> {
+pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, OutputError> {
     let dest = dir.join(name);
     let mut tmp = temp_in(dir, name)?;
     tmp.write_all(bytes)
         .and_then(|()| tmp.flush())
-        .map_err(|e| CliError::io(dest.display(), &e))?;
+        .map_err(|e| OutputError::io(dest.display(), &e))?;
     persist(tmp, &dest)?;
     Ok(dest)
 }
@@ -349,7 +349,7 @@ pub fn write_file(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf, CliEr
 /// earlier run (its `torques.svg`, or the planar plots after a hexapod run)
 /// is left beside the new ones looking current. A file that cannot be
 /// removed is an input/output error.
-pub fn remove_stale(dir: &Path, written: &[&str]) -> Result<(), CliError> {
+pub fn remove_stale(dir: &Path, written: &[&str]) -> Result<(), OutputError> {
     let known = FILES
         .iter()
         .chain(&["torques.svg", "trajectory.parquet"])
@@ -359,7 +359,7 @@ pub fn remove_stale(dir: &Path, written: &[&str]) -> Result<(), CliError> {
         let path = dir.join(name);
         match std::fs::remove_file(&path) {
             Err(e) if e.kind() != io::ErrorKind::NotFound => {
-                return Err(CliError::io(
+                return Err(OutputError::io(
                     format!(
                         "{}: cannot remove the file of an earlier run",
                         path.display()
@@ -403,15 +403,15 @@ pub fn selected(
 }
 
 /// Creates `dir` if needed and checks that files can be created in it.
-pub fn prepare_dir(dir: &Path) -> Result<(), CliError> {
+pub fn prepare_dir(dir: &Path) -> Result<(), OutputError> {
     if dir.exists() && !dir.is_dir() {
-        return Err(CliError::Io(format!(
+        return Err(OutputError::Io(format!(
             "{}: exists and is not a directory",
             dir.display()
         )));
     }
     std::fs::create_dir_all(dir).map_err(|e| {
-        CliError::io(
+        OutputError::io(
             format!("{}: cannot create the output directory", dir.display()),
             &e,
         )
@@ -646,14 +646,14 @@ impl Table {
         format: fbd_scenario::OutputFormat,
         columns: Vec<String>,
         dt: f64,
-    ) -> Result<Self, CliError> {
+    ) -> Result<Self, OutputError> {
         match format {
             fbd_scenario::OutputFormat::Csv => {
                 let dest = dir.join("trajectory.csv");
                 let tmp = temp_in(dir, "trajectory.csv")?;
                 let mut out = BufWriter::with_capacity(1 << 16, tmp);
                 writeln!(out, "{}", columns.join(","))
-                    .map_err(|e| CliError::io(dest.display(), &e))?;
+                    .map_err(|e| OutputError::io(dest.display(), &e))?;
                 Ok(Self::Csv {
                     out,
                     dest,
@@ -704,17 +704,17 @@ impl Table {
     }
 
     /// Flushes (the Parquet footer) and renames the file into place.
-    pub fn finish(self) -> Result<PathBuf, CliError> {
+    pub fn finish(self) -> Result<PathBuf, OutputError> {
         match self {
             Self::Csv {
                 out, dest, error, ..
             } => {
                 if let Some(e) = error {
-                    return Err(CliError::io(dest.display(), &e));
+                    return Err(OutputError::io(dest.display(), &e));
                 }
                 let tmp = out
                     .into_inner()
-                    .map_err(|e| CliError::io(dest.display(), e.error()))?;
+                    .map_err(|e| OutputError::io(dest.display(), e.error()))?;
                 persist(tmp, &dest)?;
                 Ok(dest)
             }
@@ -735,7 +735,7 @@ impl TrajectoryWriter {
     /// Opens the temporary `trajectory.csv` in `dir` and writes the header
     /// for a model whose contact points are `contacts` (record order); `dt`
     /// is the time step (times are written as the decimal of k·Δt).
-    pub fn create(dir: &Path, contacts: &[ContactSpec], dt: f64) -> Result<Self, CliError> {
+    pub fn create(dir: &Path, contacts: &[ContactSpec], dt: f64) -> Result<Self, OutputError> {
         Self::create_as(dir, contacts, dt, fbd_scenario::OutputFormat::Csv)
     }
 
@@ -745,7 +745,7 @@ impl TrajectoryWriter {
         contacts: &[ContactSpec],
         dt: f64,
         format: fbd_scenario::OutputFormat,
-    ) -> Result<Self, CliError> {
+    ) -> Result<Self, OutputError> {
         let slots = ContactSlots::of(contacts);
         Ok(Self {
             table: Table::create(dir, format, slots.columns(), dt)?,
@@ -770,7 +770,7 @@ impl TrajectoryWriter {
     }
 
     /// Flushes and renames the file into place.
-    pub fn finish(self) -> Result<PathBuf, CliError> {
+    pub fn finish(self) -> Result<PathBuf, OutputError> {
         self.table.finish()
     }
 }

@@ -13,7 +13,7 @@ use std::sync::atomic::AtomicBool;
 use fbd_sim::gait::{GaitData, GaitEvent, GaitModel, GaitSummary, LEGS, run_gait};
 use serde::Serialize;
 
-use crate::CliError;
+use crate::OutputError;
 use crate::config::{Config, HexapodConfig};
 use crate::output::{self, Ending};
 use crate::viewer::hexapod::{HexFrame, HexapodScene};
@@ -130,7 +130,11 @@ struct Writer {
 }
 
 impl Writer {
-    fn create(dir: &Path, dt: f64, format: fbd_scenario::OutputFormat) -> Result<Self, CliError> {
+    fn create(
+        dir: &Path,
+        dt: f64,
+        format: fbd_scenario::OutputFormat,
+    ) -> Result<Self, OutputError> {
         Ok(Self {
             table: output::Table::create(dir, format, columns(), dt)?,
             rows: 0,
@@ -155,7 +159,7 @@ impl Writer {
         }
     }
 
-    fn finish(self) -> Result<PathBuf, CliError> {
+    fn finish(self) -> Result<PathBuf, OutputError> {
         self.table.finish()
     }
 }
@@ -329,7 +333,7 @@ pub struct HexapodRun {
     /// `summary.json`'s content.
     pub summary: HexapodSummary,
     /// The first file that could not be written, if any.
-    pub io_error: Option<CliError>,
+    pub io_error: Option<OutputError>,
 }
 
 /// Runs the hexapod configuration `h` (`config` is the same, for
@@ -344,7 +348,7 @@ pub fn simulate(
     out_dir: Option<&Path>,
     stop: &AtomicBool,
     on_row: &mut dyn FnMut(&GaitData),
-) -> Result<HexapodRun, CliError> {
+) -> Result<HexapodRun, OutputError> {
     let model = h.gait_model(source)?;
     let stride = h.output.stride.max(1);
     let mut traj = match out_dir {
@@ -396,8 +400,8 @@ pub fn simulate(
             io_error: None,
         });
     };
-    let mut io_error: Option<CliError> = None;
-    let mut keep = |r: Result<PathBuf, CliError>| {
+    let mut io_error: Option<OutputError> = None;
+    let mut keep = |r: Result<PathBuf, OutputError>| {
         if let Err(e) = r
             && io_error.is_none()
         {
@@ -419,7 +423,7 @@ pub fn simulate(
             ("joints.svg", joints_svg(&plot)),
         ] {
             keep(
-                svg.map_err(|e| CliError::Io(format!("{name}: {e}")))
+                svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
                     .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
             );
         }
@@ -444,7 +448,7 @@ pub fn run_command(
     source: &str,
     out_dir: &Path,
     out: &mut dyn Write,
-) -> Result<(), CliError> {
+) -> Result<(), OutputError> {
     let HexapodRun {
         run,
         summary,

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::CliError;
+use crate::OutputError;
 use crate::config::robot::{ColumnKind, LoadedRobot, RobotRun};
 use crate::output::{self, Ending, IterationsPerStep};
 use crate::steptime::StepTimes;
@@ -113,7 +113,7 @@ pub struct RobotRunOutput {
     /// `summary.json`'s content.
     pub summary: RobotSummary,
     /// The first error writing the files, if any.
-    pub io_error: Option<CliError>,
+    pub io_error: Option<OutputError>,
 }
 
 fn write_number(w: &mut impl Write, x: f64, buf: &mut ryu::Buffer) -> std::io::Result<()> {
@@ -181,7 +181,7 @@ pub fn simulate(
     source: &str,
     out_dir: &Path,
     stop: &std::sync::atomic::AtomicBool,
-) -> Result<RobotRunOutput, CliError> {
+) -> Result<RobotRunOutput, OutputError> {
     let sim = robot.sim().map_err(|e| crate::ConfigError::Semantic {
         file: source.to_owned(),
         message: e.to_string(),
@@ -242,7 +242,7 @@ pub fn simulate(
         })();
     });
     let mut io_error = None;
-    let mut keep = |r: Result<std::path::PathBuf, CliError>| {
+    let mut keep = |r: Result<std::path::PathBuf, OutputError>| {
         if let Err(e) = r
             && io_error.is_none()
         {
@@ -251,11 +251,11 @@ pub fn simulate(
     };
     let trajectory = io
         .and_then(|()| w.flush())
-        .map_err(|e| CliError::io(dest.display(), &e))
+        .map_err(|e| OutputError::io(dest.display(), &e))
         .and_then(|()| {
             let tmp = w
                 .into_inner()
-                .map_err(|e| CliError::io(dest.display(), e.error()))?;
+                .map_err(|e| OutputError::io(dest.display(), e.error()))?;
             output::persist(tmp, &dest)?;
             Ok(dest.clone())
         });
@@ -375,7 +375,7 @@ pub fn run_command(
     path: &Path,
     out_dir: &Path,
     out: &mut dyn Write,
-) -> Result<(), CliError> {
+) -> Result<(), OutputError> {
     let source = path.display().to_string();
     let robot = crate::config::robot::load_str(text, path)?;
     let RobotRunOutput {

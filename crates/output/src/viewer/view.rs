@@ -14,7 +14,7 @@ use fbd_sim::{Event, Joint, LimitEvent, Model, StepRecord};
 
 use super::hexapod::{HexDynamics, HexFrame, HexapodScene};
 use super::planar::PlanarScene;
-use crate::CliError;
+use crate::OutputError;
 use crate::config::{self, Config};
 
 /// The columns of a `trajectory.csv`, by name.
@@ -25,12 +25,12 @@ struct Table {
 }
 
 impl Table {
-    fn read(file: &Path) -> Result<Self, CliError> {
+    fn read(file: &Path) -> Result<Self, OutputError> {
         let mut reader = csv::Reader::from_path(file)
-            .map_err(|e| CliError::Io(format!("{}: {e}", file.display())))?;
+            .map_err(|e| OutputError::Io(format!("{}: {e}", file.display())))?;
         let columns = reader
             .headers()
-            .map_err(|e| CliError::Io(format!("{}: {e}", file.display())))?
+            .map_err(|e| OutputError::Io(format!("{}: {e}", file.display())))?
             .iter()
             .enumerate()
             .map(|(i, h)| (h.to_owned(), i))
@@ -38,7 +38,7 @@ impl Table {
         let rows = reader
             .records()
             .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| CliError::Io(format!("{}: {e}", file.display())))?;
+            .map_err(|e| OutputError::Io(format!("{}: {e}", file.display())))?;
         Ok(Self {
             file: file.to_owned(),
             columns,
@@ -46,19 +46,19 @@ impl Table {
         })
     }
 
-    fn column(&self, name: &str) -> Result<usize, CliError> {
+    fn column(&self, name: &str) -> Result<usize, OutputError> {
         self.columns.get(name).copied().ok_or_else(|| {
-            CliError::Io(format!(
+            OutputError::Io(format!(
                 "{}: no column `{name}` (was it written by `fbd run` of this configuration?)",
                 self.file.display()
             ))
         })
     }
 
-    fn number(&self, row: &csv::StringRecord, r: usize, c: usize) -> Result<f64, CliError> {
+    fn number(&self, row: &csv::StringRecord, r: usize, c: usize) -> Result<f64, OutputError> {
         let s = cell(row, c).trim();
         s.parse::<f64>().map_err(|_| {
-            CliError::Io(format!(
+            OutputError::Io(format!(
                 "{}: line {}: `{s}` is not a number",
                 self.file.display(),
                 r + 2
@@ -82,7 +82,7 @@ fn state(s: &str) -> Option<StateCode> {
 }
 
 /// The step records of a planar run's `trajectory.csv`.
-fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliError> {
+fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, OutputError> {
     let q_cols = [
         "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4",
     ]
@@ -97,7 +97,7 @@ fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliEr
             let [s, fa, n] = crate::output::contact_columns(c.leg, c.kind);
             Ok([table.column(&s)?, table.column(&fa)?, table.column(&n)?])
         })
-        .collect::<Result<_, CliError>>()?;
+        .collect::<Result<_, OutputError>>()?;
     let joints: Vec<[usize; 3]> = model
         .mech
         .joints
@@ -109,7 +109,7 @@ fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliEr
                 table.column(&format!("tau_{}", j.name))?,
             ])
         })
-        .collect::<Result<_, CliError>>()?;
+        .collect::<Result<_, OutputError>>()?;
     let (kin, pot) = (table.column("kinetic")?, table.column("potential")?);
     let mut out = Vec::with_capacity(table.rows.len());
     for (r, row) in table.rows.iter().enumerate() {
@@ -122,7 +122,7 @@ fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliEr
         for (c, cols) in contacts.iter().enumerate() {
             let s = cell(row, cols[0]);
             rec.state[c] = state(s).ok_or_else(|| {
-                CliError::Io(format!(
+                OutputError::Io(format!(
                     "{}: line {}: `{s}` is not a contact state (ST1, ST2 or ST3)",
                     table.file.display(),
                     r + 2
@@ -146,7 +146,7 @@ fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, CliEr
 }
 
 /// The events of `events.csv` (empty when the file is missing).
-fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, CliError> {
+fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, OutputError> {
     if !file.exists() {
         return Ok(Vec::new());
     }
@@ -157,7 +157,7 @@ fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, CliError> {
     let mut out = Vec::with_capacity(table.rows.len());
     for (r, row) in table.rows.iter().enumerate() {
         let bad = |what: &str| {
-            CliError::Io(format!(
+            OutputError::Io(format!(
                 "{}: line {}: bad `{what}`",
                 table.file.display(),
                 r + 2
@@ -199,7 +199,7 @@ fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, CliError> {
 /// The frames of a hexapod run's `trajectory.csv`: `t, rx, ry, rz, phi_x,
 /// phi_y, phi_z, theta{j}_{n}, stance{n}` and, when present, `com_x/y/z`
 /// and `margin`.
-pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
+pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, OutputError> {
     let table = Table::read(table_file)?;
     let t_col = table.column("t")?;
     let mut q_cols = Vec::with_capacity(NQ);
@@ -238,7 +238,7 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
                 "1" | "true" | "ST2" | "ST3" => true,
                 "0" | "false" | "ST1" => false,
                 _ => {
-                    return Err(CliError::Io(format!(
+                    return Err(OutputError::Io(format!(
                         "{}: line {}: stance{} = `{s}`: expected 0 or 1",
                         table.file.display(),
                         r + 2,
@@ -269,7 +269,7 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, CliError> {
 pub fn spatial_frames(
     table_file: &Path,
     params: &fbd_sim::spatial::SpatialParams,
-) -> Result<Vec<HexFrame>, CliError> {
+) -> Result<Vec<HexFrame>, OutputError> {
     let table = Table::read(table_file)?;
     let layout = crate::spatial::Layout::of(params);
     let t_col = table.column("t")?;
@@ -282,7 +282,7 @@ pub fn spatial_frames(
             q_cols.push(table.column(&format!("theta{j}_{n}"))?);
         }
     }
-    let triple = |name: &str, a: [&str; 3]| -> Result<[usize; 3], CliError> {
+    let triple = |name: &str, a: [&str; 3]| -> Result<[usize; 3], OutputError> {
         Ok([
             table.column(&format!("{name}{}", a[0]))?,
             table.column(&format!("{name}{}", a[1]))?,
@@ -310,7 +310,7 @@ pub fn spatial_frames(
                 ],
             ])
         })
-        .collect::<Result<_, CliError>>()?;
+        .collect::<Result<_, OutputError>>()?;
     // The knee and hip contact points: (leg, 0 knee / 1 hip, state
     // column, force columns).
     let points: Vec<(usize, usize, usize, [usize; 3])> = layout
@@ -326,7 +326,7 @@ pub fn spatial_frames(
                 triple(&format!("{prefix}{n}"), f)?,
             ))
         })
-        .collect::<Result<_, CliError>>()?;
+        .collect::<Result<_, OutputError>>()?;
     let mut feet = crate::spatial::Feet::new(params);
     let mut q = vec![0.0; q_cols.len()];
     let mut out = Vec::with_capacity(table.rows.len());
@@ -336,7 +336,7 @@ pub fn spatial_frames(
         }
         feet.update(&q);
         let mut d = HexDynamics::default();
-        let v3 = |c: [usize; 3]| -> Result<[f64; 3], CliError> {
+        let v3 = |c: [usize; 3]| -> Result<[f64; 3], OutputError> {
             Ok([
                 table.number(row, r, c[0])?,
                 table.number(row, r, c[1])?,
@@ -346,7 +346,7 @@ pub fn spatial_frames(
         for (&n, cols) in layout.legs.iter().zip(&legs) {
             let s = cell(row, cols[0][0]);
             d.state[n - 1] = state(s).ok_or_else(|| {
-                CliError::Io(format!(
+                OutputError::Io(format!(
                     "{}: line {}: state{n} = `{s}`: expected ST1, ST2 or ST3",
                     table.file.display(),
                     r + 2
@@ -361,7 +361,7 @@ pub fn spatial_frames(
         for &(n, k, state_col, force) in &points {
             let s = cell(row, state_col);
             let code = state(s).ok_or_else(|| {
-                CliError::Io(format!(
+                OutputError::Io(format!(
                     "{}: line {}: `{s}` is not a contact state (ST1, ST2 or ST3)",
                     table.file.display(),
                     r + 2
@@ -383,9 +383,9 @@ pub fn spatial_frames(
 
 /// Writes `dir/viewer.html` from the files of a finished run; returns its
 /// path.
-pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
+pub fn write_from_dir(dir: &Path) -> Result<PathBuf, OutputError> {
     if !dir.is_dir() {
-        return Err(CliError::Usage(format!(
+        return Err(OutputError::Usage(format!(
             "{}: not a directory (give the output folder of `fbd run`)",
             dir.display()
         )));
@@ -408,7 +408,7 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
         },
     );
     if !traj.exists() && dir.join("trajectory.parquet").exists() {
-        return Err(CliError::Usage(format!(
+        return Err(OutputError::Usage(format!(
             "{}: `fbd view` reads trajectory.csv, and this run wrote trajectory.parquet (`[output] format = \"parquet\"`); `fbd run` with `[output] viewer = true` writes the viewer itself",
             dir.display()
         )));
@@ -462,11 +462,11 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, CliError> {
 /// pose and the joint angles of `trajectory.csv` by name (`t, rx, ry, rz,
 /// phi_x, phi_y, phi_z`, one column per joint) and, when the file has them,
 /// each contact point's `<c>_state` and `<c>_fx, <c>_fy, <c>_fz`.
-fn robot_view(dir: &Path, config_file: &Path, text: &str) -> Result<PathBuf, CliError> {
+fn robot_view(dir: &Path, config_file: &Path, text: &str) -> Result<PathBuf, OutputError> {
     let robot = config::robot::load_str(text, config_file)?;
     let traj = dir.join("trajectory.csv");
     if !traj.exists() {
-        return Err(CliError::Io(format!(
+        return Err(OutputError::Io(format!(
             "{}: missing (give the output folder of `fbd run`)",
             traj.display()
         )));
@@ -499,7 +499,7 @@ fn robot_view(dir: &Path, config_file: &Path, text: &str) -> Result<PathBuf, Cli
                     table.column(&format!("{n}_fz"))?,
                 ])
             })
-            .collect::<Result<_, CliError>>()?
+            .collect::<Result<_, OutputError>>()?
     } else {
         Vec::new()
     };
@@ -521,7 +521,7 @@ fn robot_view(dir: &Path, config_file: &Path, text: &str) -> Result<PathBuf, Cli
                 Some(StateCode::St2) => 2,
                 Some(StateCode::St3) => 3,
                 None => {
-                    return Err(CliError::Io(format!(
+                    return Err(OutputError::Io(format!(
                         "{}: line {}: `{s}` is not a contact state (ST1, ST2 or ST3)",
                         table.file.display(),
                         r + 2
@@ -543,7 +543,7 @@ fn robot_view(dir: &Path, config_file: &Path, text: &str) -> Result<PathBuf, Cli
 }
 
 /// `fbd view DIR`: writes `DIR/viewer.html` and prints its path.
-pub fn view_command(dir: &Path, out: &mut dyn Write) -> Result<(), CliError> {
+pub fn view_command(dir: &Path, out: &mut dyn Write) -> Result<(), OutputError> {
     let path = write_from_dir(dir)?;
-    writeln!(out, "{}", path.display()).map_err(CliError::stdout)
+    writeln!(out, "{}", path.display()).map_err(OutputError::stdout)
 }

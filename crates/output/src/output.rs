@@ -272,6 +272,57 @@ pub enum Ending {
     Interrupted(String),
 }
 
+impl Ending {
+    /// How a dynamic run (planar, 3D hexapod, robot) of `steps_planned`
+    /// steps of `dt` ended: failed with its error (and `advice`),
+    /// interrupted after its last step, or completed.
+    pub fn of_run(
+        run: &RunSummary,
+        source: &str,
+        advice: Option<String>,
+        steps_planned: usize,
+        dt: f64,
+    ) -> Self {
+        if let Some(e) = &run.error {
+            Ending::Failed {
+                error: e.to_string(),
+                source: source.to_owned(),
+                advice,
+            }
+        } else if run.interrupted {
+            Ending::Interrupted(interrupted_after(run, steps_planned, dt))
+        } else {
+            Ending::Completed
+        }
+    }
+}
+
+/// `interrupted after 12 of 500 steps (t = 0.011 s)`.
+pub fn interrupted_after(run: &RunSummary, steps_planned: usize, dt: f64) -> String {
+    format!(
+        "interrupted after {} of {} steps (t = {} s)",
+        run.steps,
+        steps_planned,
+        StepTimes::new(dt).string(run.steps, run.steps as f64 * dt)
+    )
+}
+
+/// The first failure among the files of a run, every file being
+/// attempted ([`FirstError::keep`] each result).
+#[derive(Debug, Default)]
+pub struct FirstError(pub Option<OutputError>);
+
+impl FirstError {
+    /// Keeps `r`'s error unless an earlier one is kept.
+    pub fn keep(&mut self, r: Result<PathBuf, OutputError>) {
+        if let Err(e) = r
+            && self.0.is_none()
+        {
+            self.0 = Some(e);
+        }
+    }
+}
+
 /// The end of `fbd run` for every model: prints the report `text` (with
 /// the list of files unless writing them failed), then turns the outcome
 /// into the command's result: the I/O error first, then the simulation
@@ -315,20 +366,20 @@ pub fn conclude(
 
 /// The files every run writes beside its trajectory and plots:
 /// `events.csv`, `summary.json` (pretty JSON of `summary`) and `config.toml`,
-/// each all-or-nothing. Every file is attempted; each result goes to `keep`
-/// (which remembers the first failure).
+/// each all-or-nothing. Every file is attempted; `keep` remembers the
+/// first failure.
 pub fn write_run_files(
     dir: &Path,
     events_csv: &str,
     summary: &impl Serialize,
     config_toml: &str,
-    keep: &mut impl FnMut(Result<PathBuf, OutputError>),
+    keep: &mut FirstError,
 ) {
-    keep(write_file(dir, "events.csv", events_csv.as_bytes()));
+    keep.keep(write_file(dir, "events.csv", events_csv.as_bytes()));
     let json = serde_json::to_string_pretty(summary)
         .map_err(|e| OutputError::Io(format!("summary.json: {e}")));
-    keep(json.and_then(|j| write_file(dir, "summary.json", format!("{j}\n").as_bytes())));
-    keep(write_file(dir, "config.toml", config_toml.as_bytes()));
+    keep.keep(json.and_then(|j| write_file(dir, "summary.json", format!("{j}\n").as_bytes())));
+    keep.keep(write_file(dir, "config.toml", config_toml.as_bytes()));
 }
 
 /// Writes `bytes` to `dir/name` all-or-nothing; returns the path.
@@ -775,24 +826,6 @@ impl TrajectoryWriter {
     }
 }
 
-/// `events.csv`: header `t,leg,from,to,point`, one row per event; times
-/// as the decimal of k·Δt.
-pub fn events_csv(events: &[Event], dt: f64) -> String {
-    let mut s = String::from("t,leg,from,to,point\n");
-    let times = StepTimes::new(dt);
-    for e in events {
-        s.push_str(&times.string(e.step, e.t));
-        s.push_str(&format!(
-            ",{},{},{},{}\n",
-            e.leg,
-            e.from.as_str(),
-            e.to.as_str(),
-            e.point
-        ));
-    }
-    s
-}
-
 /// The `point` of a retried step's event (`events.csv`, `summary.json`).
 pub const RETRY_POINT: &str = "substeps";
 
@@ -863,36 +896,74 @@ pub fn merge_events(
     retries: &[RetryEvent],
     times: &StepTimes,
 ) -> Vec<(usize, f64, EventJson)> {
-    let mut all: Vec<(usize, f64, EventJson)> = events
+    merge_events_as(
+        events,
+        limit_events,
+        retries,
+        |e| EventJson::new(e, times),
+        |e| EventJson::limit(e, times),
+        |e| EventJson::retry(e, times),
+    )
+}
+
+/// The one merge of a run's events, each named by the run's own type `E`
+/// (the planar and hexapod runs' [`EventJson`], a robot's
+/// `RobotEvent`): contact, joint-limit and retried-step events in time
+/// order (contact events first at equal times), with the step and
+/// floating-point time of each.
+pub fn merge_events_as<E>(
+    events: &[Event],
+    limit_events: &[LimitEvent],
+    retries: &[RetryEvent],
+    contact: impl Fn(&Event) -> E,
+    limit: impl Fn(&LimitEvent) -> E,
+    retry: impl Fn(&RetryEvent) -> E,
+) -> Vec<(usize, f64, E)> {
+    let mut all: Vec<(usize, f64, E)> = events
         .iter()
-        .map(|e| (e.step, e.t, EventJson::new(e, times)))
-        .chain(
-            limit_events
-                .iter()
-                .map(|e| (e.step, e.t, EventJson::limit(e, times))),
-        )
-        .chain(
-            retries
-                .iter()
-                .map(|e| (e.step, e.t, EventJson::retry(e, times))),
-        )
+        .map(|e| (e.step, e.t, contact(e)))
+        .chain(limit_events.iter().map(|e| (e.step, e.t, limit(e))))
+        .chain(retries.iter().map(|e| (e.step, e.t, retry(e))))
         .collect();
     all.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     all
 }
 
-/// `events.csv` of a whole run ([`run_events`]): contact events as
-/// [`events_csv`] writes them, then joint-limit rows (`t,4,free,max,knee_limit`)
-/// and retried steps (`t,,1,8,substeps`: the leg is empty) in time order.
-pub fn run_events_csv(run: &RunSummary, dt: f64) -> String {
-    let mut s = String::from("t,leg,from,to,point\n");
-    let times = StepTimes::new(dt);
-    for (step, t, e) in run_events(run, &times) {
-        s.push_str(&times.string(step, t));
-        let leg = e.leg.map(|l| l.to_string()).unwrap_or_default();
-        s.push_str(&format!(",{leg},{},{},{}\n", e.from, e.to, e.point));
+/// The one writer of `events.csv`: `header`, then a row per event, its
+/// time as the decimal of k·Δt and then `rest` of it (the columns after
+/// `t`, without the leading comma).
+pub fn events_table<E>(
+    header: &str,
+    events: &[(usize, f64, E)],
+    times: &StepTimes,
+    rest: impl Fn(&E) -> String,
+) -> String {
+    let mut s = String::from(header);
+    for (step, t, e) in events {
+        s.push_str(&times.string(*step, *t));
+        s.push(',');
+        s.push_str(&rest(e));
+        s.push('\n');
     }
     s
+}
+
+/// `events.csv` of a whole run ([`run_events`], [`events_table`]):
+/// header `t,leg,from,to,point`, contact events (`t,4,ST1,ST2,tip`),
+/// joint-limit rows (`t,4,free,max,knee_limit`) and retried steps
+/// (`t,,1,8,substeps`: the leg is empty) in time order; times as the
+/// decimal of k·Δt.
+pub fn run_events_csv(run: &RunSummary, dt: f64) -> String {
+    let times = StepTimes::new(dt);
+    events_table(
+        "t,leg,from,to,point\n",
+        &run_events(run, &times),
+        &times,
+        |e| {
+            let leg = e.leg.map(|l| l.to_string()).unwrap_or_default();
+            format!("{leg},{},{},{}", e.from, e.to, e.point)
+        },
+    )
 }
 
 /// Newton iterations per step (`summary.json`).
@@ -940,9 +1011,10 @@ pub struct Energy {
     pub total: f64,
 }
 
-/// `summary.json`.
+/// The head of every dynamic run's `summary.json` (planar and 3D
+/// hexapod): how it ended and the solver's counters, in this order.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Summary {
+pub struct RunHead {
     /// `"ok"`, `"error"`, or `"interrupted"` (SIGINT/SIGTERM stopped the
     /// run; the steps before are written).
     pub status: &'static str,
@@ -971,8 +1043,43 @@ pub struct Summary {
     /// Contact-state patterns evicted from the solver's bounded cache (each
     /// analysed again if it comes back; docs/reference.md, "Speed").
     pub evicted_patterns: usize,
-    /// Contact, joint-limit and retried-step events, as `events.csv`.
-    pub events: Vec<EventJson>,
+}
+
+impl RunHead {
+    /// The head of `run`, a run of `steps_planned` steps whose most Newton
+    /// iterations in one step were `max_iterations`.
+    pub fn of(run: &RunSummary, steps_planned: usize, max_iterations: usize) -> Self {
+        Self {
+            status: run_status(run),
+            error: match &run.error {
+                Some(e) => Some(e.to_string()),
+                None if run.interrupted => Some(format!(
+                    "interrupted (SIGINT or SIGTERM) after {} of {steps_planned} steps",
+                    run.steps
+                )),
+                None => None,
+            },
+            steps: run.steps,
+            newton_iterations: run.newton_iterations,
+            newton_iterations_per_step: IterationsPerStep {
+                max: max_iterations,
+                ..IterationsPerStep::of(run)
+            },
+            chord_iterations: run.chord_iterations,
+            full_newton_iterations: run.newton_iterations.saturating_sub(run.chord_iterations),
+            numeric_factorizations: run.numeric_factorizations,
+            wall_seconds: run.wall_seconds,
+            steps_per_second: steps_per_second(run),
+            symbolic_factorizations: run.symbolic_factorizations,
+            evicted_patterns: run.evicted_patterns,
+        }
+    }
+}
+
+/// The retries, state-search closures and law audit of every dynamic
+/// run's `summary.json` (after its events), in this order.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunAudit {
     /// Steps that could not be solved whole and were solved in substeps
     /// of Δt/2, Δt/4, … (each is a `substeps` event).
     pub retried_steps: usize,
@@ -1002,10 +1109,71 @@ pub struct Summary {
     /// in the plane a slide kept in ST3 running backwards (the planar
     /// model is not audited: its friction then pushes along the slip).
     pub backward_slides: usize,
-    /// The largest violation of a contact or joint-limit law over the
-    /// written rows (N); never above 1e-7 of the weight: a step that cannot
-    /// be solved that exactly ends the run with an error instead.
+    /// The largest violation of a contact or joint-limit law over every
+    /// step solved (N); a step that cannot be solved within the run's
+    /// tolerance (1e-7 of the weight in the plane, 1e-6 in 3D) ends the run
+    /// with an error instead.
     pub max_law_violation: f64,
+}
+
+impl RunAudit {
+    /// The figures of `run`.
+    pub fn of(run: &RunSummary) -> Self {
+        Self {
+            retried_steps: run.retries.len(),
+            resolved_cycles: run.resolved_cycles,
+            enumerated_cycles: run.enumerated_cycles,
+            rejected_solutions: run.rejected_solutions,
+            newton_fallbacks: run.newton_fallbacks,
+            substeps: run.substeps,
+            reference_lu_retries: run.retries.iter().filter(|r| r.reference_lu).count(),
+            direction_refinements: run.direction_refinements,
+            backward_slides: run.backward_slides,
+            max_law_violation: run.max_law_violation,
+        }
+    }
+}
+
+/// `"ok"`, `"error"` or `"interrupted"` (every run's `summary.json`).
+pub fn run_status(run: &RunSummary) -> &'static str {
+    if run.error.is_some() {
+        "error"
+    } else if run.interrupted {
+        "interrupted"
+    } else {
+        "ok"
+    }
+}
+
+/// `steps / wall_seconds`, or `None` when not measurable.
+pub fn steps_per_second(run: &RunSummary) -> Option<f64> {
+    (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds)
+}
+
+impl Energy {
+    /// The energy of the step `step` at `t`, its time as written.
+    pub fn at(times: &StepTimes, step: usize, t: f64, kinetic: f64, potential: f64) -> Self {
+        Self {
+            t: times.value(step, t),
+            kinetic,
+            potential,
+            total: kinetic + potential,
+        }
+    }
+}
+
+/// `summary.json`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Summary {
+    /// Status, error and the solver's counters (as every dynamic run).
+    #[serde(flatten)]
+    pub head: RunHead,
+    /// Contact, joint-limit and retried-step events, as `events.csv`.
+    pub events: Vec<EventJson>,
+    /// Retries, state-search closures and the law audit (as every dynamic
+    /// run).
+    #[serde(flatten)]
+    pub audit: RunAudit,
     /// `"planar"`.
     pub model: &'static str,
     /// Time step (s).

@@ -132,45 +132,44 @@ pub fn robot_events(
     run: &fbd_sim::RunSummary,
     times: &StepTimes,
 ) -> Vec<(usize, f64, RobotEvent)> {
-    let mut all: Vec<(usize, f64, RobotEvent)> = Vec::new();
-    for e in &run.events {
-        all.push((
-            e.step,
-            e.t,
-            RobotEvent {
-                t: times.value(e.step, e.t),
-                point: sim.mech.contacts[e.contact].name.clone(),
-                from: e.from.as_str().to_owned(),
-                to: e.to.as_str().to_owned(),
-            },
-        ));
-    }
-    for e in &run.limit_events {
-        all.push((
-            e.step,
-            e.t,
-            RobotEvent {
-                t: times.value(e.step, e.t),
-                point: format!("{}_limit", robot.model.joints[e.joint_index].name),
-                from: e.from.as_str().to_owned(),
-                to: e.to.as_str().to_owned(),
-            },
-        ));
-    }
-    for e in &run.retries {
-        all.push((
-            e.step,
-            e.t,
-            RobotEvent {
-                t: times.value(e.step, e.t),
-                point: output::RETRY_POINT.to_owned(),
-                from: "1".to_owned(),
-                to: e.substeps.to_string(),
-            },
-        ));
-    }
-    all.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    all
+    let event = |point: String, from: &str, to: String, step, t| RobotEvent {
+        t: times.value(step, t),
+        point,
+        from: from.to_owned(),
+        to,
+    };
+    output::merge_events_as(
+        &run.events,
+        &run.limit_events,
+        &run.retries,
+        |e| {
+            event(
+                sim.mech.contacts[e.contact].name.clone(),
+                e.from.as_str(),
+                e.to.as_str().to_owned(),
+                e.step,
+                e.t,
+            )
+        },
+        |e| {
+            event(
+                format!("{}_limit", robot.model.joints[e.joint_index].name),
+                e.from.as_str(),
+                e.to.as_str().to_owned(),
+                e.step,
+                e.t,
+            )
+        },
+        |e| {
+            event(
+                output::RETRY_POINT.to_owned(),
+                "1",
+                e.substeps.to_string(),
+                e.step,
+                e.t,
+            )
+        },
+    )
 }
 
 /// Simulates `robot` and writes its files in `out_dir` (created if
@@ -241,14 +240,7 @@ pub fn simulate(
             Ok(())
         })();
     });
-    let mut io_error = None;
-    let mut keep = |r: Result<std::path::PathBuf, OutputError>| {
-        if let Err(e) = r
-            && io_error.is_none()
-        {
-            io_error = Some(e);
-        }
-    };
+    let mut keep = output::FirstError::default();
     let trajectory = io
         .and_then(|()| w.flush())
         .map_err(|e| OutputError::io(dest.display(), &e))
@@ -259,38 +251,19 @@ pub fn simulate(
             output::persist(tmp, &dest)?;
             Ok(dest.clone())
         });
-    keep(trajectory);
+    keep.keep(trajectory);
     let dt = robot.config.time.dt;
     let times = StepTimes::new(dt);
     let s = &run.summary;
     let events = robot_events(robot, &sim, s, &times);
-    let mut events_csv = String::from(EVENTS_HEADER);
-    for (step, t, e) in &events {
-        events_csv.push_str(&format!(
-            "{},{},{},{}\n",
-            times.string(*step, *t),
-            e.point,
-            e.from,
-            e.to
-        ));
-    }
-    let interrupted = format!(
-        "interrupted after {} of {} steps (t = {} s)",
-        s.steps,
-        run.steps_planned,
-        times.string(s.steps, s.steps as f64 * dt)
-    );
+    let events_csv = output::events_table(EVENTS_HEADER, &events, &times, |e| {
+        format!("{},{},{}", e.point, e.from, e.to)
+    });
     let summary = RobotSummary {
-        status: if s.error.is_some() {
-            "error"
-        } else if s.interrupted {
-            "interrupted"
-        } else {
-            "ok"
-        },
+        status: output::run_status(s),
         error: match (&s.error, s.interrupted) {
             (Some(e), _) => Some(e.to_string()),
-            (None, true) => Some(interrupted),
+            (None, true) => Some(output::interrupted_after(s, run.steps_planned, dt)),
             (None, false) => None,
         },
         model: crate::config::robot::MODEL,
@@ -324,7 +297,7 @@ pub fn simulate(
         newton_iterations: s.newton_iterations,
         newton_iterations_per_step: IterationsPerStep::of(s),
         wall_seconds: s.wall_seconds,
-        steps_per_second: (s.wall_seconds > 0.0).then(|| s.steps as f64 / s.wall_seconds),
+        steps_per_second: output::steps_per_second(s),
         symbolic_factorizations: s.symbolic_factorizations,
         events: events.into_iter().map(|(_, _, e)| e).collect(),
         retried_steps: s.retries.len(),
@@ -344,15 +317,15 @@ pub fn simulate(
             f = f.with_surface(robot.config.terrain.surface());
         }
         f.set_event_rows(events_csv.lines().count() - 1);
-        keep(f.write(out_dir));
+        keep.keep(f.write(out_dir));
     }
-    if io_error.is_none() {
-        io_error = output::remove_stale(out_dir, files(robot)).err();
+    if keep.0.is_none() {
+        keep.0 = output::remove_stale(out_dir, files(robot)).err();
     }
     Ok(RobotRunOutput {
         run,
         summary,
-        io_error,
+        io_error: keep.0,
     })
 }
 
@@ -380,7 +353,7 @@ pub fn run_command(
     let robot = crate::config::robot::load_str(text, path)?;
     let RobotRunOutput {
         run,
-        summary,
+        summary: _,
         io_error,
     } = simulate(&robot, &source, out_dir, crate::interrupt::flag())?;
     let s = &run.summary;
@@ -390,16 +363,6 @@ pub fn run_command(
         s.newton_iterations,
         s.wall_seconds,
     );
-    let ending = if let Some(e) = &s.error {
-        Ending::Failed {
-            error: e.to_string(),
-            source,
-            advice: None,
-        }
-    } else if s.interrupted {
-        Ending::Interrupted(summary.error.clone().unwrap_or_default())
-    } else {
-        Ending::Completed
-    };
+    let ending = Ending::of_run(s, &source, None, run.steps_planned, robot.config.time.dt);
     output::conclude(out, text, out_dir, files(&robot), io_error, ending)
 }

@@ -174,47 +174,13 @@ fn summary(
             })
             .collect()
     };
-    let steps_per_second = (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds);
     Summary {
-        status: if run.error.is_some() {
-            "error"
-        } else if run.interrupted {
-            "interrupted"
-        } else {
-            "ok"
-        },
-        error: match &run.error {
-            Some(e) => Some(e.to_string()),
-            None if run.interrupted => Some(format!(
-                "interrupted (SIGINT or SIGTERM) after {} of {} steps",
-                run.steps, model.steps
-            )),
-            None => None,
-        },
-        steps: run.steps,
-        newton_iterations: run.newton_iterations,
-        newton_iterations_per_step: output::IterationsPerStep::of(run),
-        chord_iterations: run.chord_iterations,
-        full_newton_iterations: run.newton_iterations.saturating_sub(run.chord_iterations),
-        numeric_factorizations: run.numeric_factorizations,
-        wall_seconds: run.wall_seconds,
-        steps_per_second,
-        symbolic_factorizations: run.symbolic_factorizations,
-        evicted_patterns: run.evicted_patterns,
+        head: output::RunHead::of(run, model.steps, run.max_newton_iterations),
         events: output::run_events(run, &times)
             .into_iter()
             .map(|e| e.2)
             .collect(),
-        retried_steps: run.retries.len(),
-        resolved_cycles: run.resolved_cycles,
-        enumerated_cycles: run.enumerated_cycles,
-        rejected_solutions: run.rejected_solutions,
-        newton_fallbacks: run.newton_fallbacks,
-        substeps: run.substeps,
-        reference_lu_retries: run.retries.iter().filter(|r| r.reference_lu).count(),
-        direction_refinements: run.direction_refinements,
-        backward_slides: run.backward_slides,
-        max_law_violation: run.max_law_violation,
+        audit: output::RunAudit::of(run),
         model: "planar",
         dt: model.params.dt,
         duration: model.params.duration,
@@ -233,12 +199,7 @@ fn summary(
             .zip(joints.iter().copied())
             .collect(),
         peak_joint_force_max: joints.iter().copied().fold(0.0, f64::max),
-        final_energy: last.map(|r| Energy {
-            t: times.value(r.step, r.t),
-            kinetic: r.kinetic,
-            potential: r.potential,
-            total: r.kinetic + r.potential,
-        }),
+        final_energy: last.map(|r| Energy::at(&times, r.step, r.t, r.kinetic, r.potential)),
     }
 }
 
@@ -359,16 +320,9 @@ pub fn simulate(
     };
 
     // Write every file even if one fails; report the first failure.
-    let mut io_error: Option<OutputError> = None;
-    let mut keep = |r: Result<std::path::PathBuf, OutputError>| {
-        if let Err(e) = r
-            && io_error.is_none()
-        {
-            io_error = Some(e);
-        }
-    };
+    let mut keep = output::FirstError::default();
     if let Some(t) = traj {
-        keep(t.finish());
+        keep.keep(t.finish());
     }
     output::write_run_files(
         out_dir,
@@ -392,7 +346,7 @@ pub fn simulate(
         ]
     });
     for (name, svg) in svgs.into_iter().flatten().chain(torques) {
-        keep(
+        keep.keep(
             svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
                 .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
         );
@@ -400,23 +354,23 @@ pub fn simulate(
     if let Some(v) = view {
         let mut scene = v.finish(&run.events);
         scene.event_rows = output::run_events(&run, &StepTimes::new(model.dt())).len();
-        keep(viewer::write(out_dir, &scene));
+        keep.keep(viewer::write(out_dir, &scene));
     }
     let mut files = output::selected(
         output::files_as(&output::FILES, planar.output.format),
         &planar.output,
     );
     files.extend(torques_written.then_some("torques.svg"));
-    if io_error.is_none()
+    if keep.0.is_none()
         && let Err(e) = output::remove_stale(out_dir, &files)
     {
-        io_error = Some(e);
+        keep.0 = Some(e);
     }
     Ok(Simulated {
         run,
         summary: s,
         contacts: names,
-        io_error,
+        io_error: keep.0,
         files,
     })
 }
@@ -502,24 +456,10 @@ pub fn run_command(
         run.newton_iterations,
         run.wall_seconds,
     ));
-    let ending = if let Some(e) = &run.error {
-        Ending::Failed {
-            error: e.to_string(),
-            source: source.to_string(),
-            advice: match &config {
-                Config::Planar(p) => p.advice(e),
-                Config::Hexapod(_) => None,
-            },
-        }
-    } else if run.interrupted {
-        Ending::Interrupted(format!(
-            "interrupted after {} of {} steps (t = {} s)",
-            run.steps,
-            summary.steps_planned,
-            times.string(run.steps, run.steps as f64 * summary.dt)
-        ))
-    } else {
-        Ending::Completed
+    let advice = match (&config, &run.error) {
+        (Config::Planar(p), Some(e)) => p.advice(e),
+        _ => None,
     };
+    let ending = Ending::of_run(&run, &source, advice, summary.steps_planned, summary.dt);
     output::conclude(out, text, out_dir, &files, io_error, ending)
 }

@@ -3,7 +3,6 @@
 //! memory ([`fbd_output::hexapod::columns`]), the same values as the file.
 
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
 use fbd_output::hexapod::{HexapodRun, ROW_VALUES, columns, row_values, simulate};
 use fbd_output::steptime::StepTimes;
@@ -12,8 +11,7 @@ use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::errors::cli_error;
-use crate::run::{SignalWatch, finish};
+use crate::run::{finish, watched};
 
 /// The hexapod's `run` dict: `columns` (names of `trajectory.csv`),
 /// `data` (float64 arrays; `stance{n}` is 1.0 or 0.0), `events` (dicts
@@ -29,23 +27,20 @@ pub fn run<'py>(
     out: Option<&Path>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let names = columns();
-    let outcome = py.detach(|| {
+    let ((sim, data), signal) = watched(py, from_text, |stop, watch| {
         let mut data: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
-        let stop = AtomicBool::new(false);
-        let mut watch = SignalWatch::default();
         let times = StepTimes::new(h.time.dt);
         let mut row = [0.0; ROW_VALUES];
-        simulate(h, config, source, out, &stop, &mut |d| {
+        simulate(h, config, source, out, stop, &mut |d| {
             data[0].push(times.value(d.step, d.t));
             row_values(d, &mut row);
             for (col, v) in data[1..].iter_mut().zip(row) {
                 col.push(v);
             }
-            watch.row(&stop);
+            watch.row(stop);
         })
-        .map(|r| (r, data, watch))
+        .map(|r| (r, data))
     });
-    let (sim, data, signal) = outcome.map_err(|e| cli_error(py, &e, from_text))?;
     let HexapodRun {
         run,
         summary,

@@ -42,6 +42,23 @@ impl SignalWatch {
     }
 }
 
+/// The one run binding of the planar, kinematic-hexapod and dynamic
+/// hexapod runs: `go` runs with the GIL released, given the stop flag and
+/// the [`SignalWatch`] its row callback calls; an error it returns becomes
+/// the Python exception of that error.
+pub fn watched<T: Send>(
+    py: Python<'_>,
+    from_text: bool,
+    go: impl FnOnce(&AtomicBool, &mut SignalWatch) -> Result<T, fbd_output::OutputError> + Send,
+) -> PyResult<(T, SignalWatch)> {
+    py.detach(|| {
+        let stop = AtomicBool::new(false);
+        let mut watch = SignalWatch::default();
+        go(&stop, &mut watch).map(|t| (t, watch))
+    })
+    .map_err(|e| cli_error(py, &e, from_text))
+}
+
 impl SignalWatch {
     /// After the run of `source` that stopped after `steps` steps: an
     /// output file that could not be written (`io_error`, as the CLI's
@@ -188,7 +205,7 @@ pub fn run<'py>(
                 out.as_deref(),
             );
         }
-        let outcome = py.detach(|| {
+        let ((sim, cols, dt), signal) = watched(py, loaded.from_text, |stop, watch| {
             // The columns' names and capacity; an invalid model is reported
             // by `simulate` itself.
             let (slots, dt, rows) = match &loaded.config {
@@ -203,21 +220,18 @@ pub fn run<'py>(
                 fbd_scenario::Config::Hexapod(c) => (ContactSlots::default(), c.time.dt, 0),
             };
             let mut cols = Columns::new(slots, dt, rows);
-            let stop = AtomicBool::new(false);
-            let mut watch = SignalWatch::default();
             simulate(
                 &loaded.config,
                 &loaded.source,
                 out.as_deref(),
-                &stop,
+                stop,
                 &mut |r| {
                     cols.push(r);
-                    watch.row(&stop);
+                    watch.row(stop);
                 },
             )
-            .map(|s| (s, cols, dt, watch))
+            .map(|s| (s, cols, dt))
         });
-        let (sim, cols, dt, signal) = outcome.map_err(|e| cli_error(py, &e, loaded.from_text))?;
         let Simulated {
             run,
             summary,

@@ -5,7 +5,6 @@
 //! the file.
 
 use std::path::Path;
-use std::sync::atomic::AtomicBool;
 
 use fbd_output::spatial::csv::{Slots, row_values};
 use fbd_output::spatial::{Feet, Layout, SpatialRun, columns, simulate};
@@ -15,8 +14,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::columns::Columns;
-use crate::errors::{cli_error, config_error};
-use crate::run::{SignalWatch, dynamics_result};
+use crate::errors::config_error;
+use crate::run::{SignalWatch, dynamics_result, watched};
 
 /// The dynamic hexapod's `run` dict, as the planar run's: `columns`,
 /// `data` (float64 arrays; `state{n}` and `*point{n}_state` lists of
@@ -36,7 +35,7 @@ pub fn run<'py>(
         .spatial_params(source)
         .map_err(|e| config_error(py, &e, from_text))?;
     let dt = params.dt;
-    let outcome = py.detach(|| {
+    let ((sim, cols), signal) = watched(py, from_text, |stop, watch| {
         let layout = Layout::of(&params);
         let stride = params.stride.max(1);
         // Room for the rows planned, at most 2^16 up front (some 230
@@ -47,23 +46,20 @@ pub fn run<'py>(
         let mut cols = Columns::named(columns(&layout), dt, rows);
         let mut feet = Feet::new(&params);
         let mut slots: Option<Slots> = None;
-        let stop = AtomicBool::new(false);
-        let mut watch = SignalWatch::default();
         simulate(
             &params,
             &config.to_toml(),
             source,
             out,
-            &stop,
+            stop,
             &mut |r: &SpatialRecord| {
                 let s = slots.get_or_insert_with(|| Slots::of(&layout, r));
                 row_values(&layout, s, &mut feet, r, &mut cols.sink());
-                watch.row(&stop);
+                watch.row(stop);
             },
         )
-        .map(|s| (s, cols, watch))
+        .map(|s| (s, cols))
     });
-    let (sim, cols, signal) = outcome.map_err(|e| cli_error(py, &e, from_text))?;
     let SpatialRun {
         run,
         summary,

@@ -400,15 +400,8 @@ pub fn simulate(
             io_error: None,
         });
     };
-    let mut io_error: Option<OutputError> = None;
-    let mut keep = |r: Result<PathBuf, OutputError>| {
-        if let Err(e) = r
-            && io_error.is_none()
-        {
-            io_error = Some(e);
-        }
-    };
-    keep(traj.finish());
+    let mut keep = output::FirstError::default();
+    keep.keep(traj.finish());
     output::write_run_files(
         out_dir,
         &events_csv(&run.events),
@@ -422,7 +415,7 @@ pub fn simulate(
             ("footprints.svg", footprints_svg(&plot)),
             ("joints.svg", joints_svg(&plot)),
         ] {
-            keep(
+            keep.keep(
                 svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
                     .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
             );
@@ -431,12 +424,12 @@ pub fn simulate(
     if let Some(view) = view {
         let mut scene = view.finish();
         scene.event_rows = run.events.len();
-        keep(crate::viewer::write(out_dir, &scene));
+        keep.keep(crate::viewer::write(out_dir, &scene));
     }
     Ok(HexapodRun {
         run,
         summary: s,
-        io_error,
+        io_error: keep.0,
     })
 }
 

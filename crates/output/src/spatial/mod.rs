@@ -323,15 +323,8 @@ impl Outputs {
                 files: Vec::new(),
             };
         };
-        let mut io_error: Option<OutputError> = None;
-        let mut keep = |r: Result<PathBuf, OutputError>| {
-            if let Err(e) = r
-                && io_error.is_none()
-            {
-                io_error = Some(e);
-            }
-        };
-        keep(traj.finish());
+        let mut keep = output::FirstError::default();
+        keep.keep(traj.finish());
         output::write_run_files(
             &out_dir,
             &output::run_events_csv(&run, params.dt),
@@ -347,7 +340,7 @@ impl Outputs {
                 ("body.svg", plots::body_svg(&plot)),
                 ("energy.svg", plots::energy_svg(&plot)),
             ] {
-                keep(
+                keep.keep(
                     svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
                         .and_then(|s| output::write_file(&out_dir, name, s.as_bytes())),
                 );
@@ -356,18 +349,18 @@ impl Outputs {
         if let Some(view) = self.view {
             let mut scene = view.finish();
             scene.event_rows = output::run_events(&run, &StepTimes::new(params.dt)).len();
-            keep(crate::viewer::write(&out_dir, &scene));
+            keep.keep(crate::viewer::write(&out_dir, &scene));
         }
         let files = output::selected(output::files_as(&FILES, self.output.format), &self.output);
-        if io_error.is_none()
+        if keep.0.is_none()
             && let Err(e) = output::remove_stale(&out_dir, &files)
         {
-            io_error = Some(e);
+            keep.0 = Some(e);
         }
         SpatialRun {
             run,
             summary: s,
-            io_error,
+            io_error: keep.0,
             files,
         }
     }
@@ -460,22 +453,7 @@ pub fn run_command(
             output::fixed(h, 4)
         ));
     }
-    let ending = if let Some(e) = &run.error {
-        Ending::Failed {
-            error: e.to_string(),
-            source: source.to_owned(),
-            advice: None,
-        }
-    } else if run.interrupted {
-        Ending::Interrupted(format!(
-            "interrupted after {} of {} steps (t = {} s)",
-            run.steps,
-            summary.steps_planned,
-            times.string(run.steps, run.steps as f64 * params.dt)
-        ))
-    } else {
-        Ending::Completed
-    };
+    let ending = Ending::of_run(&run, source, None, summary.steps_planned, params.dt);
     output::conclude(out, text, out_dir, &files, io_error, ending)
 }
 
@@ -575,7 +553,7 @@ mod tests {
             ..RunSummary::default()
         };
         let r = out.finish(&p, run, "# config\n");
-        assert!(r.io_error.is_none(), "{:?}", r.io_error);
+        assert!(r.keep.0.is_none(), "{:?}", r.io_error);
         assert_eq!(written, 6);
         for f in FILES {
             assert!(dir.path().join(f).exists(), "{f}");
@@ -642,7 +620,7 @@ mod tests {
             out.push(&record(&p, k), &mut |_| {});
         }
         let r = out.finish(&p, RunSummary::default(), "");
-        assert!(r.io_error.is_none());
+        assert!(r.keep.0.is_none());
         let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
         let header: Vec<&str> = lines[0].split(',').collect();

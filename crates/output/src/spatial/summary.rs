@@ -15,15 +15,6 @@ use super::csv::Slots;
 use crate::output::{self, Energy, EventJson, PeakForce};
 use crate::steptime::StepTimes;
 
-/// Mean and largest Newton iterations of a step.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct PerStep {
-    /// Over the solved steps (0 when none).
-    pub mean: f64,
-    /// Largest of one step.
-    pub max: usize,
-}
-
 /// The largest actuator torque and power of one joint over the run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct JointPeak {
@@ -40,34 +31,9 @@ pub struct JointPeak {
 /// `summary.json` of a dynamic hexapod run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SpatialSummary {
-    /// `"ok"`, `"error"`, or `"interrupted"` (SIGINT/SIGTERM stopped the
-    /// run; the steps before are written).
-    pub status: &'static str,
-    /// The error message, or null.
-    pub error: Option<String>,
-    /// Steps solved.
-    pub steps: usize,
-    /// Newton iterations over the whole run.
-    pub newton_iterations: usize,
-    /// Newton iterations of one step (every state trial): mean and largest.
-    pub newton_iterations_per_step: PerStep,
-    /// Of `newton_iterations`, the chord steps (a factorisation kept from
-    /// an earlier iterate or step).
-    pub chord_iterations: usize,
-    /// Of `newton_iterations`, the full Newton steps (the Jacobian factored
-    /// at the iterate).
-    pub full_newton_iterations: usize,
-    /// Numeric LU factorisations over the whole run.
-    pub numeric_factorizations: u64,
-    /// Time in the stepping loop alone (s).
-    pub wall_seconds: f64,
-    /// `steps / wall_seconds` (null when not measurable).
-    pub steps_per_second: Option<f64>,
-    /// Symbolic LU factorisations performed.
-    pub symbolic_factorizations: usize,
-    /// Contact-state patterns evicted from the solver's bounded cache (each
-    /// analysed again if it comes back; docs/reference.md, "Speed").
-    pub evicted_patterns: usize,
+    /// Status, error and the solver's counters (as every dynamic run).
+    #[serde(flatten)]
+    pub head: output::RunHead,
     /// Wall time (s) of the start-up stability check of the joint
     /// controller (before the stepping loop, not in `wall_seconds`); near
     /// zero when an earlier run of the process had the same robot and
@@ -75,38 +41,10 @@ pub struct SpatialSummary {
     pub stability_check_seconds: f64,
     /// Contact, joint-limit and retried-step events, as `events.csv`.
     pub events: Vec<EventJson>,
-    /// Steps solved again in substeps.
-    pub retried_steps: usize,
-    /// State searches closed by their least inconsistent combination.
-    pub resolved_cycles: usize,
-    /// State searches closed by a consistent combination found by trying
-    /// every combination of the few points involved.
-    pub enumerated_cycles: usize,
-    /// Solutions consistent by the switching rules that broke a contact or
-    /// limit law (the law audit) and were solved again in substeps.
-    pub rejected_solutions: usize,
-    /// Failed Newton solves the state search recovered from by sticking
-    /// its slowest slide.
-    pub newton_fallbacks: usize,
-    /// Substeps solved in retries, failed attempts included.
-    pub substeps: usize,
-    /// Of `retried_steps`, those solved with faer's reference LU after
-    /// every attempt with the compiled LU had failed (docs/reference.md,
-    /// "Speed").
-    pub reference_lu_retries: usize,
-    /// Re-solves that moved a fixed friction direction to the step's own
-    /// slip (slides Newton could not solve with the implicit direction).
-    pub direction_refinements: usize,
-    /// Accepted slides whose slip ran against their reference direction:
-    /// in 3D a slide turning back (its friction follows the slip: lawful);
-    /// in the plane a slide kept in ST3 running backwards (the planar
-    /// model is not audited: its friction then pushes along the slip).
-    pub backward_slides: usize,
-    /// The largest violation of a contact or joint-limit law over every
-    /// step solved (substeps included), written or not (N); never above
-    /// 1e-6 of the weight: a step that cannot be solved that exactly ends
-    /// the run with an error instead.
-    pub max_law_violation: f64,
+    /// Retries, state-search closures and the law audit (as every dynamic
+    /// run).
+    #[serde(flatten)]
+    pub audit: output::RunAudit,
     /// `"hexapod"`.
     pub model: &'static str,
     /// `"dynamic"` (the 3D FBD dynamics; a kinematic run says `walking` or
@@ -281,53 +219,13 @@ impl Collector {
             _ => [0.0; 3],
         };
         SpatialSummary {
-            status: if run.error.is_some() {
-                "error"
-            } else if run.interrupted {
-                "interrupted"
-            } else {
-                "ok"
-            },
-            error: match &run.error {
-                Some(e) => Some(e.to_string()),
-                None if run.interrupted => Some(format!(
-                    "interrupted (SIGINT or SIGTERM) after {} of {} steps",
-                    run.steps, steps_planned
-                )),
-                None => None,
-            },
-            steps: run.steps,
-            newton_iterations: run.newton_iterations,
-            newton_iterations_per_step: PerStep {
-                mean: if run.steps > 0 {
-                    run.newton_iterations as f64 / run.steps as f64
-                } else {
-                    0.0
-                },
-                max: self.iter_max,
-            },
-            chord_iterations: run.chord_iterations,
-            full_newton_iterations: run.newton_iterations.saturating_sub(run.chord_iterations),
-            numeric_factorizations: run.numeric_factorizations,
-            wall_seconds: run.wall_seconds,
-            steps_per_second: (run.wall_seconds > 0.0).then(|| run.steps as f64 / run.wall_seconds),
-            symbolic_factorizations: run.symbolic_factorizations,
-            evicted_patterns: run.evicted_patterns,
+            head: output::RunHead::of(run, steps_planned, self.iter_max),
             stability_check_seconds: 0.0,
             events: output::run_events(run, &times)
                 .into_iter()
                 .map(|e| e.2)
                 .collect(),
-            retried_steps: run.retries.len(),
-            resolved_cycles: run.resolved_cycles,
-            enumerated_cycles: run.enumerated_cycles,
-            rejected_solutions: run.rejected_solutions,
-            newton_fallbacks: run.newton_fallbacks,
-            substeps: run.substeps,
-            reference_lu_retries: run.retries.iter().filter(|r| r.reference_lu).count(),
-            direction_refinements: run.direction_refinements,
-            backward_slides: run.backward_slides,
-            max_law_violation: run.max_law_violation,
+            audit: output::RunAudit::of(run),
             model: "hexapod",
             run: "dynamic",
             control: match params.control {
@@ -361,11 +259,8 @@ impl Collector {
             distance: displacement[0].hypot(displacement[2]),
             path_length: self.path,
             final_height: last.as_ref().map(|l| l.2[1]),
-            final_energy: last.map(|(step, t, _, kinetic, potential)| Energy {
-                t: times.value(step, t),
-                kinetic,
-                potential,
-                total: kinetic + potential,
+            final_energy: last.map(|(step, t, _, kinetic, potential)| {
+                Energy::at(&times, step, t, kinetic, potential)
             }),
         }
     }

@@ -40,7 +40,7 @@ pub fn run<'py>(
             watch.row(stop);
         })
         .map(|r| (r, data))
-    });
+    })?;
     let HexapodRun {
         run,
         summary,

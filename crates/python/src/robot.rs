@@ -227,8 +227,13 @@ pub fn run<'py>(
         );
     }
     let path = dir.join("trajectory.csv");
-    let text = std::fs::read_to_string(&path)
-        .map_err(|e| cli_error(py, &fbd_output::OutputError::io(path.display(), &e), from_text))?;
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        cli_error(
+            py,
+            &fbd_output::OutputError::io(path.display(), &e),
+            from_text,
+        )
+    })?;
     table.read_csv(&text).ok_or_else(|| {
         pyo3::exceptions::PyRuntimeError::new_err(format!(
             "{}: not a robot's trajectory.csv",

@@ -231,7 +231,7 @@ pub fn run<'py>(
                 },
             )
             .map(|s| (s, cols, dt))
-        });
+        })?;
         let Simulated {
             run,
             summary,

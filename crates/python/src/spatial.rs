@@ -15,14 +15,14 @@ use pyo3::types::PyDict;
 
 use crate::columns::Columns;
 use crate::errors::config_error;
-use crate::run::{SignalWatch, dynamics_result, watched};
+use crate::run::{dynamics_result, watched};
 
 /// The dynamic hexapod's `run` dict, as the planar run's: `columns`,
 /// `data` (float64 arrays; `state{n}` and `*point{n}_state` lists of
 /// `"ST1"`/`"ST2"`/`"ST3"`; `newton_iterations` int64), `events` (dicts
 /// `t`, `step`, `leg`, `point`, `from`, `to`, as `events.csv`), `summary`
 /// (JSON text), `error`, `source`. Runs with the GIL released; Ctrl-C
-/// stops it ([`SignalWatch`]).
+/// stops it ([`crate::run::SignalWatch`]).
 pub fn run<'py>(
     py: Python<'py>,
     h: &HexapodConfig,
@@ -59,7 +59,7 @@ pub fn run<'py>(
             },
         )
         .map(|s| (s, cols))
-    });
+    })?;
     let SpatialRun {
         run,
         summary,

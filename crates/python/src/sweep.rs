@@ -41,7 +41,9 @@ pub fn sweep(
         let text = String::from_utf8_lossy(&text).into_owned();
         match result {
             Ok(()) => Ok((text, None)),
-            Err(OutputError::Simulation(m)) if out.join("index.csv").is_file() => Ok((text, Some(m))),
+            Err(OutputError::Simulation(m)) if out.join("index.csv").is_file() => {
+                Ok((text, Some(m)))
+            }
             Err(e) => Err(cli_error(py, &e, true)),
         }
     })

@@ -553,7 +553,7 @@ mod tests {
             ..RunSummary::default()
         };
         let r = out.finish(&p, run, "# config\n");
-        assert!(r.keep.0.is_none(), "{:?}", r.io_error);
+        assert!(r.io_error.is_none(), "{:?}", r.io_error);
         assert_eq!(written, 6);
         for f in FILES {
             assert!(dir.path().join(f).exists(), "{f}");
@@ -579,7 +579,7 @@ mod tests {
         assert_eq!(events, "t,leg,from,to,point\n0.005,4,ST1,ST2,tip\n");
         let s = r.summary;
         assert_eq!(s.rows_written, 6);
-        assert_eq!(s.newton_iterations_per_step.max, 4);
+        assert_eq!(s.head.newton_iterations_per_step.max, 4);
         assert_eq!(s.first_touchdown["leg4"], Some(0.005));
         assert_eq!(s.first_touchdown["leg3"], None);
         let peak = &s.peak_actuation[5];
@@ -620,7 +620,7 @@ mod tests {
             out.push(&record(&p, k), &mut |_| {});
         }
         let r = out.finish(&p, RunSummary::default(), "");
-        assert!(r.keep.0.is_none());
+        assert!(r.io_error.is_none());
         let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
         let header: Vec<&str> = lines[0].split(',').collect();

@@ -70,8 +70,9 @@
 //!   demand (never shrinking). Their fill depends on the numerical row
 //!   pivoting, so a later refactorisation of the same pattern could need
 //!   more room than the first one and would then allocate. To rule that
-//!   out, [`Factors::new`] grows new storage to that of a dense `n × n` LU
-//!   ([`Factors::warm_up`]):
+//!   out, new storage is grown to that of a dense `n × n` LU before faer's
+//!   first factorisation into it ([`Factors::warm_up`]; a dimension whose
+//!   patterns all factor by their compiled programs never pays it):
 //!   any `n × n` factorisation needs at most the storage of the dense one
 //!   (faer asks, at column `j`, for the entries so far plus the column's
 //!   reach, both at most the dense LU's), so every later one fits. A dense
@@ -167,9 +168,36 @@ pub(crate) struct Pattern {
     pub(crate) chords_since: usize,
     /// Chord steps of the last solve after its last factorisation.
     last_chords: usize,
-    /// The compiled numeric LU (empty until the first factorisation with
-    /// the compiled path enabled).
-    compiled: CompiledLu,
+    /// The compiled numeric LUs of this pattern, each with the
+    /// [`zero_signature`] of the values it was compiled on (empty until
+    /// the first factorisation with the compiled path enabled; at most
+    /// [`MAX_PROGRAMS`]).
+    programs: Vec<(u64, CompiledLu)>,
+    /// The zero signatures that fell back to faer's LU once, without a
+    /// program of their own (compiled at their second fallback).
+    failed: Vec<u64>,
+}
+
+/// The most compiled programs one pattern keeps (see [`Factors::factor`]):
+/// one per set of exact zeros among its values, the first ones met.
+pub(crate) const MAX_PROGRAMS: usize = 8;
+
+/// A hash of which of `values` are exactly zero. A complementarity row
+/// switches its branch inside one sparsity pattern by turning entries to
+/// exact zeros (a lifted point's normal row becomes `N = 0`), and a row
+/// order chosen on one such set of zeros fails pivots of another: on the
+/// 3D drop of `bench/peer`, 830 of the 831 factorisations that left the
+/// compiled program had other zeros than the values it was compiled on.
+fn zero_signature(values: &[f64]) -> u64 {
+    let mut h = 0x9E37_79B9_7F4A_7C15u64;
+    for (i, &v) in values.iter().enumerate() {
+        if v == 0.0 {
+            h = (h ^ (i as u64 + 1))
+                .wrapping_mul(0x0100_0000_01B3)
+                .rotate_left(17);
+        }
+    }
+    h
 }
 
 impl Pattern {
@@ -306,7 +334,8 @@ impl Pattern {
             solves_since: 0,
             chords_since: 0,
             last_chords: 0,
-            compiled: CompiledLu::default(),
+            programs: Vec::new(),
+            failed: Vec::new(),
         }
     }
 
@@ -379,6 +408,10 @@ pub(crate) struct Factors {
     /// The pattern whose factorisation this holds (none after the dense
     /// warm-up or a failed factorisation).
     owner: Option<usize>,
+    /// Whether faer's storage was grown by [`Self::warm_up`] (at its
+    /// first use: a dimension whose patterns all factor by their compiled
+    /// programs never calls faer).
+    warmed: bool,
 }
 
 impl Factors {
@@ -388,13 +421,13 @@ impl Factors {
         factorize_simplicial_numeric_lu_scratch::<usize, f64>(n, n)
     }
 
-    /// Storage for (reduced) dimension `n`, grown to that of a dense
-    /// `n × n` LU by two triangular warm-ups ([`Self::warm_up`], see the
-    /// module docs). Allocates; `mem` must hold [`Self::scratch`].
-    pub(crate) fn new(n: usize, mem: &mut MemBuffer) -> Self {
+    /// Storage for (reduced) dimension `n`; faer's is grown to that of a
+    /// dense `n × n` LU by two triangular warm-ups at its first use
+    /// ([`Self::warm_up`], see the module docs). Allocates.
+    pub(crate) fn new(n: usize) -> Self {
         // The sweeps' streams index rows and columns as `u32`.
         assert!(u32::try_from(n).is_ok(), "dimension {n} beyond u32");
-        let mut f = Self {
+        Self {
             n,
             lu: SimplicialLu::new(),
             row_perm: vec![0; n],
@@ -414,11 +447,8 @@ impl Factors {
             check_s: vec![0.0; n],
             row_choice: Vec::with_capacity(n),
             owner: None,
-        };
-        if n > 0 {
-            f.warm_up(mem);
+            warmed: false,
         }
-        f
     }
 
     /// Grows faer's storage to that of a dense `n × n` LU by two
@@ -503,8 +533,32 @@ impl Factors {
         }
         pattern.coupling.copy_from_slice(couplings);
         let mut path = FactorPath::Faer;
-        if compiled && n > 0 && pattern.compiled.is_compiled() {
-            let program = &mut pattern.compiled;
+        // The program compiled on values with these exact zeros, else the
+        // pattern's first one.
+        let zeros = if compiled && n > 0 {
+            zero_signature(reduced)
+        } else {
+            0
+        };
+        if compiled && n > 0 && pattern.programs.is_empty() {
+            // The pattern's first program, compiled on these values (it
+            // allocates, as the pattern's registration does): the row order
+            // by threshold Markowitz (less fill than faer's partial
+            // pivoting); where that finds no pivot, faer's LU below and
+            // its row order.
+            let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
+            let fwd = pattern.col_perm.arrays().0;
+            let mut program = CompiledLu::default();
+            if let Some(order) = program.choose_rows(col_ptr, row_idx, fwd, reduced) {
+                self.row_choice.clear();
+                self.row_choice.extend_from_slice(order);
+                program.compile(col_ptr, row_idx, fwd, &self.row_choice, true);
+                pattern.programs.push((zeros, program));
+            }
+        }
+        let known = pattern.programs.iter().position(|(z, _)| *z == zeros);
+        if compiled && n > 0 && !pattern.programs.is_empty() {
+            let program = &mut pattern.programs[known.unwrap_or(0)].1;
             if program
                 .factor(reduced, &mut self.pivot_inv, &mut self.perturbed)
                 .is_ok()
@@ -535,7 +589,7 @@ impl Factors {
                         pattern.structure.col_ptr(),
                         pattern.structure.row_idx(),
                         reduced,
-                        &pattern.compiled.row_perm,
+                        &program.row_perm,
                         fwd,
                     );
                 if ok {
@@ -552,6 +606,10 @@ impl Factors {
             path = FactorPath::Fallback;
         }
         self.perturbed.clear();
+        if n > 0 && !self.warmed {
+            self.warm_up(mem);
+            self.warmed = true;
+        }
         if n > 0 {
             let matrix = SparseColMatRef::new(pattern.structure.as_ref(), reduced);
             match factorize_simplicial_numeric_lu(
@@ -598,17 +656,36 @@ impl Factors {
                     self.upper.push((i as u32, j as u32, v * pivot_inv));
                 }
             }
-            if compiled && !pattern.compiled.is_compiled() {
-                // Compiled on these values, at the pattern's first
-                // factorisation (it allocates, as the pattern's
-                // registration does). A fallback keeps the program: the
-                // next factorisation tries it again (a failed pivot is
-                // mostly a passing cancellation, an entry that is zero at
-                // that state; recompiling on such values was measured
+            // A set of zeros gets its program at its second fallback: most
+            // pass once (a contact's branch for one iterate).
+            let recurring = if path == FactorPath::Fallback && known.is_none() {
+                match pattern.failed.iter().position(|&z| z == zeros) {
+                    Some(i) => {
+                        pattern.failed.swap_remove(i);
+                        true
+                    }
+                    None => {
+                        if pattern.failed.len() == 2 * MAX_PROGRAMS {
+                            pattern.failed.remove(0);
+                        }
+                        pattern.failed.push(zeros);
+                        false
+                    }
+                }
+            } else {
+                path == FactorPath::Faer
+            };
+            if compiled && known.is_none() && recurring && pattern.programs.len() < MAX_PROGRAMS {
+                // Compiled on these values, at the first factorisation of
+                // the pattern with these exact zeros (it allocates, as the
+                // pattern's registration does). A fallback of a known
+                // set of zeros keeps its program: the next factorisation
+                // tries it again (a failed pivot then is mostly a passing
+                // cancellation; recompiling on such values was measured
                 // dearer, 1.6 M instructions a time on the hexapod walk).
                 let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
                 let fwd = pattern.col_perm.arrays().0;
-                let program = &mut pattern.compiled;
+                let mut program = CompiledLu::default();
                 // The row order: threshold Markowitz on these values (less
                 // fill than faer's partial pivoting), else faer's.
                 let rows = match program.choose_rows(col_ptr, row_idx, fwd, reduced) {
@@ -619,7 +696,8 @@ impl Factors {
                     }
                     None => &self.row_perm,
                 };
-                program.compile(col_ptr, row_idx, fwd, rows, path == FactorPath::Faer);
+                program.compile(col_ptr, row_idx, fwd, rows, true);
+                pattern.programs.push((zeros, program));
             }
         }
         self.owner = Some(pattern.id);
@@ -964,7 +1042,7 @@ mod tests {
                         symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
                     ),
                 ));
-            let mut factors = Factors::new(pattern.m, &mut mem);
+            let mut factors = Factors::new(pattern.m);
             factors
                 .factor(&mut pattern, &values, &mut mem, false)
                 .expect("nonsingular");
@@ -1032,7 +1110,7 @@ mod tests {
         let mut entries: Vec<(usize, usize)> = triplets.iter().map(|t| (t.0, t.1)).collect();
         let pattern = Pattern::build(0, n, &mut entries);
         let mut mem = MemBuffer::new(Factors::scratch(n));
-        let factors = Factors::new(pattern.m, &mut mem);
+        let factors = Factors::new(pattern.m);
         let b = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
         (n, pattern, mem, factors, b)
     }
@@ -1055,7 +1133,11 @@ mod tests {
             };
             let first = values_at(0.0);
             let (_, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
-            assert_eq!(path, FactorPath::Faer, "the first factorisation compiles");
+            assert_eq!(
+                path,
+                FactorPath::Compiled,
+                "the first factorisation compiles and runs the program"
+            );
             for eps in [0.0, 1e-3, 0.05] {
                 let values = values_at(eps);
                 let (ours, path) =
@@ -1094,11 +1176,11 @@ mod tests {
             v
         };
         let mut mem = MemBuffer::new(Factors::scratch(n));
-        let mut factors = Factors::new(pattern.m, &mut mem);
+        let mut factors = Factors::new(pattern.m);
         let b = [1.0, 2.0];
         let first = values_for(2.0);
         let (_, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
-        assert_eq!(path, FactorPath::Faer);
+        assert_eq!(path, FactorPath::Compiled);
         let (x, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
         assert_eq!(path, FactorPath::Compiled);
         // 2x + y = 1, x + y = 2: x = −1, y = 3.
@@ -1159,7 +1241,11 @@ mod tests {
                 };
                 let (_, path) =
                     solve_with(&mut factors, &mut pattern, &draw(0), &b, &mut mem, true);
-                assert_eq!(path, FactorPath::Faer, "the first factorisation compiles");
+                assert_eq!(
+                    path,
+                    FactorPath::Compiled,
+                    "the first factorisation compiles and runs the program"
+                );
                 for d in 1..40 {
                     let values = draw(d);
                     let (ours, path) =
@@ -1180,6 +1266,68 @@ mod tests {
             }
         }
         assert!(corrected >= 20, "only {corrected} corrected factorisations");
+    }
+
+    #[test]
+    fn each_set_of_exact_zeros_gets_its_program() {
+        // A complementarity row switching branch inside one pattern: rows
+        // become `x_i = c` (their other entries exact zeros). The program
+        // compiled without those zeros fails their pivots; the second
+        // fallback of that set of zeros compiles a program of its own, used
+        // from then on, and each solution equals faer's to round-off.
+        let n = 64;
+        let triplets = matrix(n, 4);
+        let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
+        let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
+        let draw = |d: u64, switched: bool| {
+            let mut values = vec![0.0; nnz];
+            for (k, &(i, j, v)) in triplets.iter().enumerate() {
+                let x = ((k as u64 * 7919 + d * 104_729) as f64 * 0.618).sin();
+                let lifted = switched && i % 6 == 0;
+                let v = match (lifted, i == j) {
+                    (true, true) => 1.0,
+                    (true, false) => 0.0,
+                    (false, _) => v * (1.0 + 0.1 * x),
+                };
+                values[slot[i * n + j] as usize] += v;
+            }
+            values
+        };
+        let mut paths = Vec::new();
+        for d in 0..12 {
+            let values = draw(d, d % 2 == 1);
+            let (ours, path) = solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, true);
+            let (theirs, _) = solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, false);
+            let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            for i in 0..n {
+                assert!(
+                    (ours[i] - theirs[i]).abs() <= 1e-9 * scale,
+                    "draw {d} ({path:?}), x[{i}]: ours {} faer {}",
+                    ours[i],
+                    theirs[i]
+                );
+            }
+            paths.push(path);
+        }
+        assert_eq!(
+            paths[0],
+            FactorPath::Compiled,
+            "the first factorisation compiles and runs the program"
+        );
+        assert_eq!(
+            paths[1],
+            FactorPath::Fallback,
+            "other zeros fail the first program"
+        );
+        assert_eq!(
+            paths[3],
+            FactorPath::Fallback,
+            "compiled at the second fallback"
+        );
+        assert_eq!(pattern.programs.len(), 2);
+        for (d, path) in paths.iter().enumerate().skip(4) {
+            assert_ne!(*path, FactorPath::Fallback, "draw {d}");
+        }
     }
 
     #[test]
@@ -1209,7 +1357,7 @@ mod tests {
             values[pattern.slot[i * n + (i + 1) % n] as usize] = (i + 1) as f64;
         }
         let mut mem = MemBuffer::new(Factors::scratch(1));
-        let mut factors = Factors::new(0, &mut mem);
+        let mut factors = Factors::new(0);
         factors
             .factor(&mut pattern, &values, &mut mem, false)
             .unwrap();

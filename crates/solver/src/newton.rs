@@ -440,7 +440,7 @@ impl NewtonSolver {
                 pattern.factors = match self.factors.iter().position(|f| f.dim() == m) {
                     Some(f) => f,
                     None => {
-                        self.factors.push(Factors::new(m, &mut self.ws.mem));
+                        self.factors.push(Factors::new(m));
                         self.factors.len() - 1
                     }
                 };

@@ -32,7 +32,8 @@ pub struct RobotSim {
     pub steps: usize,
     /// Contact state of each point at `t = 0`.
     pub initial_states: Vec<SpatialState>,
-    /// Finest subdivision of a step that cannot be solved whole. Default 64.
+    /// Finest subdivision of a step that cannot be solved whole. Default
+    /// 256 (an impact on many points at once may close only below Δt/64).
     pub max_substeps: usize,
     /// A cycling state search is closed by its least inconsistent trial
     /// when its violation is at most this force (N). Default `1e-7 ×`
@@ -210,7 +211,7 @@ impl RobotSim {
             },
             steps: (p.duration / p.dt).round() as usize + 1,
             initial_states,
-            max_substeps: 64,
+            max_substeps: 256,
             cycle_tolerance: 1e-7 * total_mass * p.gravity.abs().max(1.0),
             complementarity: true,
             no_ground: fbd_contact::Surface::default(),

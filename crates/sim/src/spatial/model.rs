@@ -28,7 +28,8 @@ pub struct SpatialModel {
     pub contact_bumper: Vec<f64>,
     /// Contact state of each point at `t = 0`.
     pub initial_states: Vec<SpatialState>,
-    /// Finest subdivision of a step that cannot be solved whole. Default 64.
+    /// Finest subdivision of a step that cannot be solved whole. Default
+    /// 256 (an impact on many points at once may close only below Δt/64).
     pub max_substeps: usize,
     /// A cycling state search is closed by its least inconsistent trial
     /// when its violation is at most this force (N). Default `1e-7 ×`
@@ -275,7 +276,7 @@ impl SpatialModel {
             },
             contact_bumper,
             initial_states,
-            max_substeps: 64,
+            max_substeps: 256,
             cycle_tolerance: 1e-7 * total_mass * p.gravity.abs().max(1.0),
             stability_check_seconds,
             complementarity: true,

@@ -14,6 +14,7 @@
 pub mod columnar;
 /// The configuration: the `fbd-scenario` crate.
 pub use fbd_scenario as config;
+pub mod driver;
 pub mod error;
 pub mod hexapod;
 pub mod interrupt;

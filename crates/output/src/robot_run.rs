@@ -7,12 +7,16 @@
 //! all-or-nothing, also after a simulation error or an interruption.
 
 use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+use fbd_sim::robot::RobotRecord;
 
 use serde::Serialize;
 
 use crate::OutputError;
 use crate::config::robot::{ColumnKind, LoadedRobot, RobotRun};
+use crate::driver::{self, Recording, RunFiles, RunOutput, Stepper};
 use crate::output::{self, Ending, IterationsPerStep};
 use crate::steptime::StepTimes;
 
@@ -105,16 +109,9 @@ pub struct RobotSummary {
     pub max_law_violation: f64,
 }
 
-/// What [`simulate`] did.
-#[derive(Debug)]
-pub struct RobotRunOutput {
-    /// How the run ended.
-    pub run: RobotRun,
-    /// `summary.json`'s content.
-    pub summary: RobotSummary,
-    /// The first error writing the files, if any.
-    pub io_error: Option<OutputError>,
-}
+/// What [`simulate`] did: how the run ended, `summary.json`'s content,
+/// the files written.
+pub type RobotRunOutput = RunOutput<RobotRun, RobotSummary>;
 
 fn write_number(w: &mut impl Write, x: f64, buf: &mut ryu::Buffer) -> std::io::Result<()> {
     if x.is_finite() {
@@ -172,6 +169,189 @@ pub fn robot_events(
     )
 }
 
+/// A robot's stepping: the engine on its simulator ([`LoadedRobot::run_sim`],
+/// which hands over every `[output] stride`-th step).
+struct RobotStepper<'a> {
+    robot: &'a LoadedRobot,
+    sim: &'a fbd_sim::robot::RobotSim,
+}
+
+impl Stepper<RobotRecord> for RobotStepper<'_> {
+    type Run = RobotRun;
+    fn step(&self, stop: &AtomicBool, mut each: impl FnMut(&RobotRecord)) -> RobotRun {
+        self.robot.run_sim(self.sim, stop, &mut each)
+    }
+}
+
+/// A robot's files ([`RunFiles`]): `trajectory.csv` streamed, the peaks,
+/// the viewer's frames.
+struct RobotFiles<'a> {
+    robot: &'a LoadedRobot,
+    sim: &'a fbd_sim::robot::RobotSim,
+    dest: PathBuf,
+    w: Option<BufWriter<tempfile::NamedTempFile>>,
+    io: std::io::Result<()>,
+    rows: usize,
+    row: Vec<f64>,
+    kinds: Vec<ColumnKind>,
+    buf: ryu::Buffer,
+    frames: Option<crate::viewer::robot::RobotFrames>,
+    states: Vec<u8>,
+    forces: Vec<[f64; 3]>,
+    peak_torque: f64,
+    peak_normal: f64,
+    events_csv: String,
+}
+
+impl RunFiles for RobotFiles<'_> {
+    type Record = RobotRecord;
+    type Run = RobotRun;
+    type Summary = RobotSummary;
+
+    /// Every record is a row: the engine applies the stride.
+    fn step_of(_: &RobotRecord) -> usize {
+        0
+    }
+
+    fn row(&mut self, r: &RobotRecord) {
+        for c in &r.contacts {
+            self.peak_normal = self.peak_normal.max(c.normal);
+        }
+        for t in &r.torque {
+            self.peak_torque = self.peak_torque.max(t.abs());
+        }
+        let contacts = self.states.len();
+        if let Some(f) = self.frames.as_mut() {
+            for (i, c) in r.contacts.iter().enumerate() {
+                self.states[i] = c.state as u8 + 1;
+                self.forces[i] = c.force;
+            }
+            f.push(
+                r.t,
+                &r.q,
+                (contacts > 0).then_some((&self.states[..], &self.forces[..])),
+            );
+        }
+        if self.io.is_err() {
+            return;
+        }
+        LoadedRobot::row(r, &mut self.row);
+        self.rows += 1;
+        let last = self.kinds.len() - 1;
+        let (Some(w), buf) = (self.w.as_mut(), &mut self.buf) else {
+            return;
+        };
+        self.io = (|| {
+            for (i, (&x, kind)) in self.row.iter().zip(&self.kinds).enumerate() {
+                match kind {
+                    ColumnKind::Number => write_number(w, x, buf)?,
+                    ColumnKind::State => write!(w, "ST{}", x as u8)?,
+                    ColumnKind::Count => write!(w, "{}", x as usize)?,
+                }
+                w.write_all(if i == last { b"\n" } else { b"," })?;
+            }
+            Ok(())
+        })();
+    }
+
+    fn observe(&mut self, _: &RobotRecord) {}
+
+    /// The rows counted are those written before a failure.
+    fn summary(&mut self, run: &RobotRun, _: usize) -> RobotSummary {
+        let (robot, sim) = (self.robot, self.sim);
+        let dt = robot.config.time.dt;
+        let times = StepTimes::new(dt);
+        let s = &run.summary;
+        let events = robot_events(robot, sim, s, &times);
+        self.events_csv = output::events_table(EVENTS_HEADER, &events, &times, |e| {
+            format!("{},{},{}", e.point, e.from, e.to)
+        });
+        RobotSummary {
+            status: output::run_status(s),
+            error: match (&s.error, s.interrupted) {
+                (Some(e), _) => Some(e.to_string()),
+                (None, true) => Some(output::interrupted_after(s, run.steps_planned, dt)),
+                (None, false) => None,
+            },
+            model: crate::config::robot::MODEL,
+            robot: robot.model.name.clone(),
+            dt,
+            duration: robot.config.time.duration,
+            steps: s.steps,
+            steps_planned: run.steps_planned,
+            stride: robot.config.output.stride,
+            rows_written: self.rows,
+            contact_points: sim.mech.contacts.iter().map(|c| c.name.clone()).collect(),
+            distance: (run.final_q[0] - robot.params().q0[0])
+                .hypot(run.final_q[2] - robot.params().q0[2]),
+            final_height: run.final_q[1],
+            peak_torque_max: self.peak_torque,
+            peak_normal_force: self.peak_normal,
+            first_touchdown: sim
+                .mech
+                .contacts
+                .iter()
+                .enumerate()
+                .map(|(c, tc)| {
+                    let t = s
+                        .events
+                        .iter()
+                        .find(|e| e.contact == c && e.from == fbd_contact::StateCode::St1)
+                        .map(|e| times.value(e.step, e.t));
+                    (tc.name.clone(), t)
+                })
+                .collect(),
+            newton_iterations: s.newton_iterations,
+            newton_iterations_per_step: IterationsPerStep::of(s),
+            wall_seconds: s.wall_seconds,
+            steps_per_second: output::steps_per_second(s),
+            symbolic_factorizations: s.symbolic_factorizations,
+            events: events.into_iter().map(|(_, _, e)| e).collect(),
+            retried_steps: s.retries.len(),
+            substeps: s.substeps,
+            resolved_cycles: s.resolved_cycles,
+            max_law_violation: s.max_law_violation,
+        }
+    }
+
+    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
+        let dest = self.dest.clone();
+        let io = std::mem::replace(&mut self.io, Ok(()));
+        let mut w = self.w.take()?;
+        Some(
+            io.and_then(|()| w.flush().map(|()| w))
+                .map_err(|e| OutputError::io(dest.display(), &e))
+                .and_then(|w| {
+                    let tmp = w
+                        .into_inner()
+                        .map_err(|e| OutputError::io(dest.display(), e.error()))?;
+                    output::persist(tmp, &dest)?;
+                    Ok(dest.clone())
+                }),
+        )
+    }
+
+    fn events_csv(&self, _: &RobotRun) -> String {
+        self.events_csv.clone()
+    }
+
+    fn write_extras(
+        self,
+        dir: &Path,
+        _: &RobotRun,
+        keep: &mut output::FirstError,
+    ) -> Vec<&'static str> {
+        if let Some(mut f) = self.frames {
+            if !self.states.is_empty() {
+                f = f.with_surface(self.robot.config.terrain.surface());
+            }
+            f.set_event_rows(self.events_csv.lines().count() - 1);
+            keep.keep(f.write(dir));
+        }
+        files(self.robot).to_vec()
+    }
+}
+
 /// Simulates `robot` and writes its files in `out_dir` (created if
 /// needed; files of an earlier run that this one does not write are
 /// removed). The run stops before its next step once `stop` is set.
@@ -179,7 +359,7 @@ pub fn simulate(
     robot: &LoadedRobot,
     source: &str,
     out_dir: &Path,
-    stop: &std::sync::atomic::AtomicBool,
+    stop: &AtomicBool,
 ) -> Result<RobotRunOutput, OutputError> {
     let sim = robot.sim().map_err(|e| crate::ConfigError::Semantic {
         file: source.to_owned(),
@@ -190,143 +370,37 @@ pub fn simulate(
     let dest = out_dir.join("trajectory.csv");
     let tmp = output::temp_in(out_dir, "trajectory.csv")?;
     let mut w = BufWriter::new(tmp);
-    let mut io: std::io::Result<()> =
-        w.write_all(format!("{}\n", columns.names.join(",")).as_bytes());
-    let mut rows = 0;
-    let mut row = Vec::with_capacity(columns.names.len());
-    let mut buf = ryu::Buffer::new();
-    let last = columns.names.len() - 1;
+    let io: std::io::Result<()> = w.write_all(format!("{}\n", columns.names.join(",")).as_bytes());
     let contacts = sim.mech.contacts.len();
-    let mut frames = robot
-        .config
-        .output
-        .viewer
-        .then(|| crate::viewer::robot::RobotFrames::new(&robot.model, contacts > 0));
-    let mut states = vec![0u8; contacts];
-    let mut forces = vec![[0.0; 3]; contacts];
-    let (mut peak_torque, mut peak_normal) = (0.0f64, 0.0f64);
-    let run = robot.run_sim(&sim, stop, &mut |r| {
-        for c in &r.contacts {
-            peak_normal = peak_normal.max(c.normal);
-        }
-        for t in &r.torque {
-            peak_torque = peak_torque.max(t.abs());
-        }
-        if let Some(f) = frames.as_mut() {
-            for (i, c) in r.contacts.iter().enumerate() {
-                states[i] = c.state as u8 + 1;
-                forces[i] = c.force;
-            }
-            f.push(
-                r.t,
-                &r.q,
-                (contacts > 0).then_some((&states[..], &forces[..])),
-            );
-        }
-        if io.is_err() {
-            return;
-        }
-        LoadedRobot::row(r, &mut row);
-        rows += 1;
-        io = (|| {
-            for (i, (&x, kind)) in row.iter().zip(&columns.kinds).enumerate() {
-                match kind {
-                    ColumnKind::Number => write_number(&mut w, x, &mut buf)?,
-                    ColumnKind::State => write!(w, "ST{}", x as u8)?,
-                    ColumnKind::Count => write!(w, "{}", x as usize)?,
-                }
-                w.write_all(if i == last { b"\n" } else { b"," })?;
-            }
-            Ok(())
-        })();
-    });
-    let mut keep = output::FirstError::default();
-    let trajectory = io
-        .and_then(|()| w.flush())
-        .map_err(|e| OutputError::io(dest.display(), &e))
-        .and_then(|()| {
-            let tmp = w
-                .into_inner()
-                .map_err(|e| OutputError::io(dest.display(), e.error()))?;
-            output::persist(tmp, &dest)?;
-            Ok(dest.clone())
-        });
-    keep.keep(trajectory);
-    let dt = robot.config.time.dt;
-    let times = StepTimes::new(dt);
-    let s = &run.summary;
-    let events = robot_events(robot, &sim, s, &times);
-    let events_csv = output::events_table(EVENTS_HEADER, &events, &times, |e| {
-        format!("{},{},{}", e.point, e.from, e.to)
-    });
-    let summary = RobotSummary {
-        status: output::run_status(s),
-        error: match (&s.error, s.interrupted) {
-            (Some(e), _) => Some(e.to_string()),
-            (None, true) => Some(output::interrupted_after(s, run.steps_planned, dt)),
-            (None, false) => None,
-        },
-        model: crate::config::robot::MODEL,
-        robot: robot.model.name.clone(),
-        dt,
-        duration: robot.config.time.duration,
-        steps: s.steps,
-        steps_planned: run.steps_planned,
-        stride: robot.config.output.stride,
-        rows_written: rows,
-        contact_points: sim.mech.contacts.iter().map(|c| c.name.clone()).collect(),
-        distance: (run.final_q[0] - robot.params().q0[0])
-            .hypot(run.final_q[2] - robot.params().q0[2]),
-        final_height: run.final_q[1],
-        peak_torque_max: peak_torque,
-        peak_normal_force: peak_normal,
-        first_touchdown: sim
-            .mech
-            .contacts
-            .iter()
-            .enumerate()
-            .map(|(c, tc)| {
-                let t = s
-                    .events
-                    .iter()
-                    .find(|e| e.contact == c && e.from == fbd_contact::StateCode::St1)
-                    .map(|e| times.value(e.step, e.t));
-                (tc.name.clone(), t)
-            })
-            .collect(),
-        newton_iterations: s.newton_iterations,
-        newton_iterations_per_step: IterationsPerStep::of(s),
-        wall_seconds: s.wall_seconds,
-        steps_per_second: output::steps_per_second(s),
-        symbolic_factorizations: s.symbolic_factorizations,
-        events: events.into_iter().map(|(_, _, e)| e).collect(),
-        retried_steps: s.retries.len(),
-        substeps: s.substeps,
-        resolved_cycles: s.resolved_cycles,
-        max_law_violation: s.max_law_violation,
+    let files = RobotFiles {
+        robot,
+        sim: &sim,
+        dest,
+        w: Some(w),
+        io,
+        rows: 0,
+        row: Vec::with_capacity(columns.names.len()),
+        kinds: columns.kinds,
+        buf: ryu::Buffer::new(),
+        frames: robot
+            .config
+            .output
+            .viewer
+            .then(|| crate::viewer::robot::RobotFrames::new(&robot.model, contacts > 0)),
+        states: vec![0u8; contacts],
+        forces: vec![[0.0; 3]; contacts],
+        peak_torque: 0.0,
+        peak_normal: 0.0,
+        events_csv: String::new(),
     };
-    output::write_run_files(
-        out_dir,
-        &events_csv,
-        &summary,
+    let stepper = RobotStepper { robot, sim: &sim };
+    Ok(driver::drive(
+        &stepper,
+        Recording::new(files, 1, Some(out_dir)),
+        stop,
         &robot.config.to_toml(),
-        &mut keep,
-    );
-    if let Some(mut f) = frames {
-        if contacts > 0 {
-            f = f.with_surface(robot.config.terrain.surface());
-        }
-        f.set_event_rows(events_csv.lines().count() - 1);
-        keep.keep(f.write(out_dir));
-    }
-    if keep.0.is_none() {
-        keep.0 = output::remove_stale(out_dir, files(robot)).err();
-    }
-    Ok(RobotRunOutput {
-        run,
-        summary,
-        io_error: keep.0,
-    })
+        &mut |_| {},
+    ))
 }
 
 /// The files a run of `robot` writes ([`FILES`], `viewer.html` only with
@@ -355,6 +429,7 @@ pub fn run_command(
         run,
         summary: _,
         io_error,
+        files,
     } = simulate(&robot, &source, out_dir, crate::interrupt::flag())?;
     let s = &run.summary;
     let text = output::solved_line(
@@ -364,5 +439,5 @@ pub fn run_command(
         s.wall_seconds,
     );
     let ending = Ending::of_run(s, &source, None, run.steps_planned, robot.config.time.dt);
-    output::conclude(out, text, out_dir, files(&robot), io_error, ending)
+    output::conclude(out, text, out_dir, &files, io_error, ending)
 }

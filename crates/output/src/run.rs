@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use fbd_dynamics::PointKind;
@@ -11,6 +11,7 @@ use fbd_sim::{Model, RunSummary, StepRecord};
 
 use crate::OutputError;
 use crate::config::{self, Config};
+use crate::driver::{self, Recording, RunFiles, RunOutput};
 use crate::output::{self, Ending, Energy, EventJson, PeakForce, Summary, TrajectoryWriter};
 use crate::plot::{self, PlotData, PlotRecorder, Stance};
 use crate::steptime::StepTimes;
@@ -218,19 +219,95 @@ pub fn event_line(t: &str, e: &EventJson) -> String {
     format!("t={t} s  {leg}{point}{} -> {}", e.from, e.to)
 }
 
-/// What [`simulate`] produced.
-pub struct Simulated {
-    /// The run: steps, events, and the error that stopped it, if any.
-    pub run: RunSummary,
-    /// The content of `summary.json`.
-    pub summary: Summary,
-    /// The names of the model's contact points, in record order.
-    pub contacts: Vec<String>,
-    /// The first failure writing a file (every file is still attempted).
-    pub io_error: Option<OutputError>,
-    /// The names of the files written, in order (none without an output
-    /// directory).
-    pub files: Vec<&'static str>,
+/// What [`simulate`] produced: the planar run, its `summary.json`, the
+/// files written.
+pub type Simulated = RunOutput<RunSummary, Summary>;
+
+/// The planar model's files ([`RunFiles`]): the trajectory, the plots'
+/// and peaks' collector, the viewer.
+struct PlanarFiles<'a> {
+    model: &'a Model,
+    planar: &'a fbd_scenario::PlanarConfig,
+    names: Vec<String>,
+    traj: Option<TrajectoryWriter>,
+    collect: Option<Collector>,
+    view: Option<PlanarScene<'a>>,
+    plot: Option<PlotData>,
+}
+
+impl RunFiles for PlanarFiles<'_> {
+    type Record = StepRecord;
+    type Run = RunSummary;
+    type Summary = Summary;
+
+    fn step_of(r: &StepRecord) -> usize {
+        r.step
+    }
+
+    fn row(&mut self, r: &StepRecord) {
+        if let Some(t) = self.traj.as_mut() {
+            t.write(r);
+        }
+        if let Some(v) = self.view.as_mut() {
+            v.push(r);
+        }
+    }
+
+    fn observe(&mut self, r: &StepRecord) {
+        if let Some(c) = self.collect.as_mut() {
+            c.push(r);
+        }
+    }
+
+    fn summary(&mut self, run: &RunSummary, rows: usize) -> Summary {
+        let collect = self.collect.take().expect("summarised once");
+        let (plot, last, peaks, joints) = collect.finish(self.model, run);
+        self.plot = Some(plot);
+        summary(self.model, &self.names, run, rows, last, peaks, joints)
+    }
+
+    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
+        self.traj.take().map(TrajectoryWriter::finish)
+    }
+
+    fn events_csv(&self, run: &RunSummary) -> String {
+        output::run_events_csv(run, self.model.dt())
+    }
+
+    fn write_extras(
+        self,
+        dir: &Path,
+        run: &RunSummary,
+        keep: &mut output::FirstError,
+    ) -> Vec<&'static str> {
+        let plot_data = self.plot.expect("summarised");
+        let plots = self.planar.output.plots;
+        let torques = plots
+            .then(|| plot::torques_svg(&plot_data).map(|svg| ("torques.svg", svg)))
+            .flatten();
+        let torques_written = torques.is_some();
+        let svgs = plots.then(|| {
+            [
+                ("tips.svg", plot::tips_svg(&plot_data)),
+                ("forces.svg", plot::forces_svg(&plot_data)),
+                ("stance.svg", plot::stance_svg(&plot_data)),
+                ("joints.svg", plot::joints_svg(&plot_data)),
+                ("energy.svg", plot::energy_svg(&plot_data)),
+            ]
+        });
+        driver::write_svgs(dir, svgs.into_iter().flatten().chain(torques), keep);
+        if let Some(v) = self.view {
+            let mut scene = v.finish(&run.events);
+            scene.event_rows = output::run_events(run, &StepTimes::new(self.model.dt())).len();
+            keep.keep(viewer::write(dir, &scene));
+        }
+        let mut files = output::selected(
+            output::files_as(&output::FILES, self.planar.output.format),
+            &self.planar.output,
+        );
+        files.extend(torques_written.then_some("torques.svg"));
+        files
+    }
 }
 
 /// Simulates the loaded `config` (named `source` in messages), handing every
@@ -259,7 +336,7 @@ pub fn simulate(
     let model = planar.model(source)?;
 
     let names: Vec<String> = model.mech.contacts.iter().map(|c| c.name.clone()).collect();
-    let mut traj = match out_dir {
+    let traj = match out_dir {
         Some(dir) => {
             output::prepare_dir(dir)?;
             output::warn_size(
@@ -279,100 +356,37 @@ pub fn simulate(
         }
         None => None,
     };
-    let mut collect = Collector::new(&model);
+    let collect = Collector::new(&model);
     // The simulator hands over every `stride`-th step; the plots and peaks
-    // want them all, so stride is applied here.
+    // want them all, so stride is applied by the driver.
     let stride = model.params.stride.max(1);
     let mut every_step = model.clone();
     every_step.params.stride = 1;
-    let mut rows = 0;
     // viewer.html: one frame per trajectory row (decimated when long).
-    let mut view = out_dir.filter(|_| planar.output.viewer).map(|_| {
+    let view = out_dir.filter(|_| planar.output.viewer).map(|_| {
         PlanarScene::new(
             &model,
             model.steps.div_ceil(stride),
             &viewer::title_of(source, "planar model"),
         )
     });
-    let run = fbd_sim::run_until(&every_step, stop, |r: &StepRecord| {
-        if r.step.is_multiple_of(stride) {
-            if let Some(t) = traj.as_mut() {
-                t.write(r);
-            }
-            if let Some(v) = view.as_mut() {
-                v.push(r);
-            }
-            on_row(r);
-            rows += 1;
-        }
-        collect.push(r);
-    });
-    let (plot_data, last, peaks, joints) = collect.finish(&model, &run);
-    let s = summary(&model, &names, &run, rows, last, peaks, joints);
-    let Some(out_dir) = out_dir else {
-        return Ok(Simulated {
-            run,
-            summary: s,
-            contacts: names,
-            io_error: None,
-            files: Vec::new(),
-        });
+    let files = PlanarFiles {
+        model: &model,
+        planar,
+        names,
+        traj,
+        collect: Some(collect),
+        view,
+        plot: None,
     };
-
-    // Write every file even if one fails; report the first failure.
-    let mut keep = output::FirstError::default();
-    if let Some(t) = traj {
-        keep.keep(t.finish());
-    }
-    output::write_run_files(
-        out_dir,
-        &output::run_events_csv(&run, model.dt()),
-        &s,
+    let rec = Recording::new(files, stride, out_dir);
+    Ok(driver::drive(
+        &every_step,
+        rec,
+        stop,
         &config.to_toml(),
-        &mut keep,
-    );
-    let plots = planar.output.plots;
-    let torques = plots
-        .then(|| plot::torques_svg(&plot_data).map(|svg| ("torques.svg", svg)))
-        .flatten();
-    let torques_written = torques.is_some();
-    let svgs = plots.then(|| {
-        [
-            ("tips.svg", plot::tips_svg(&plot_data)),
-            ("forces.svg", plot::forces_svg(&plot_data)),
-            ("stance.svg", plot::stance_svg(&plot_data)),
-            ("joints.svg", plot::joints_svg(&plot_data)),
-            ("energy.svg", plot::energy_svg(&plot_data)),
-        ]
-    });
-    for (name, svg) in svgs.into_iter().flatten().chain(torques) {
-        keep.keep(
-            svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
-                .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
-        );
-    }
-    if let Some(v) = view {
-        let mut scene = v.finish(&run.events);
-        scene.event_rows = output::run_events(&run, &StepTimes::new(model.dt())).len();
-        keep.keep(viewer::write(out_dir, &scene));
-    }
-    let mut files = output::selected(
-        output::files_as(&output::FILES, planar.output.format),
-        &planar.output,
-    );
-    files.extend(torques_written.then_some("torques.svg"));
-    if keep.0.is_none()
-        && let Err(e) = output::remove_stale(out_dir, &files)
-    {
-        keep.0 = Some(e);
-    }
-    Ok(Simulated {
-        run,
-        summary: s,
-        contacts: names,
-        io_error: keep.0,
-        files,
-    })
+        on_row,
+    ))
 }
 
 /// `fbd run`: loads `config` (the built-in default when `None`), checks
@@ -413,29 +427,13 @@ pub fn run_command(
         return crate::spatial::run_command(&params, &config.to_toml(), &source, out_dir, out);
     }
     if let Config::Hexapod(h) = &config {
-        let r = crate::hexapod::run_command(h, &config, &source, out_dir, out);
-        // Every file was written (also after a simulation error or an
-        // interruption): remove the planar files of an earlier run.
-        if matches!(
-            r,
-            Ok(()) | Err(OutputError::Simulation(_) | OutputError::Interrupted(_))
-        ) {
-            output::remove_stale(
-                out_dir,
-                &output::selected(
-                    output::files_as(&crate::hexapod::FILES, h.output.format),
-                    &h.output,
-                ),
-            )?;
-        }
-        return r;
+        return crate::hexapod::run_command(h, &config, &source, out_dir, out);
     }
     let Simulated {
         run,
         io_error,
         summary,
         files,
-        ..
     } = simulate(
         &config,
         &source,

@@ -4,14 +4,14 @@
 
 use std::path::Path;
 
-use fbd_output::hexapod::{HexapodRun, ROW_VALUES, columns, row_values, simulate};
+use fbd_output::hexapod::{ROW_VALUES, columns, row_values, simulate};
 use fbd_output::steptime::StepTimes;
 use fbd_scenario::{Config, HexapodConfig};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::run::{finish, watched};
+use crate::run::{run_result, watched};
 
 /// The hexapod's `run` dict: `columns` (names of `trajectory.csv`),
 /// `data` (float64 arrays; `stance{n}` is 1.0 or 0.0), `events` (dicts
@@ -41,36 +41,22 @@ pub fn run<'py>(
         })
         .map(|r| (r, data))
     })?;
-    let HexapodRun {
-        run,
-        summary,
-        io_error,
-    } = sim;
-    signal.raise(io_error, from_text, source, run.steps)?;
-    let d = PyDict::new(py);
-    let arrays = PyDict::new(py);
-    for (name, v) in names.iter().zip(data) {
-        arrays.set_item(name, PyArray1::from_vec(py, v))?;
-    }
-    d.set_item("columns", PyList::new(py, &names)?)?;
-    d.set_item("data", arrays)?;
-    let events = PyList::empty(py);
-    for e in &run.events {
-        let ev = PyDict::new(py);
-        ev.set_item("t", fbd_output::hexapod::tidy(e.t))?;
-        ev.set_item("leg", e.leg)?;
-        ev.set_item("event", e.kind.as_str())?;
-        ev.set_item("margin", e.margin)?;
-        events.append(ev)?;
-    }
-    d.set_item("events", events)?;
-    // The failing step is the one after the last computed.
-    let error = run.error.as_ref().map(|e| {
-        (
-            e.to_string(),
-            Some(run.steps),
-            Some(run.steps as f64 * h.time.dt),
-        )
-    });
-    finish(d, &summary, source, error)
+    run_result(py, sim, signal, from_text, source, h.time.dt, |d, run| {
+        let arrays = PyDict::new(py);
+        for (name, v) in names.iter().zip(data) {
+            arrays.set_item(name, PyArray1::from_vec(py, v))?;
+        }
+        d.set_item("columns", PyList::new(py, &names)?)?;
+        d.set_item("data", arrays)?;
+        let events = PyList::empty(py);
+        for e in &run.events {
+            let ev = PyDict::new(py);
+            ev.set_item("t", fbd_output::hexapod::tidy(e.t))?;
+            ev.set_item("leg", e.leg)?;
+            ev.set_item("event", e.kind.as_str())?;
+            ev.set_item("margin", e.margin)?;
+            events.append(ev)?;
+        }
+        d.set_item("events", events)
+    })
 }

@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::errors::{cli_error, config_error};
-use crate::run::finish;
+use crate::run::run_result;
 
 /// The values of one column of a robot's trajectory.
 enum Values {
@@ -211,44 +211,24 @@ pub fn run<'py>(
             )));
         }
     };
-    if let Some(e) = &output.io_error {
-        return Err(cli_error(py, e, from_text));
-    }
-    if let Some(e) = signal {
-        return Err(
-            if e.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) {
-                pyo3::exceptions::PyKeyboardInterrupt::new_err(format!(
-                    "{source}: interrupted after {} steps",
-                    output.run.summary.steps
-                ))
-            } else {
-                e
-            },
-        );
-    }
-    let path = dir.join("trajectory.csv");
-    let text = std::fs::read_to_string(&path).map_err(|e| {
-        cli_error(
-            py,
-            &fbd_output::OutputError::io(path.display(), &e),
-            from_text,
-        )
-    })?;
-    table.read_csv(&text).ok_or_else(|| {
-        pyo3::exceptions::PyRuntimeError::new_err(format!(
-            "{}: not a robot's trajectory.csv",
-            path.display()
-        ))
-    })?;
-    let d = PyDict::new(py);
-    table.into_py(py, &d)?;
-    d.set_item("events", events(py, robot, &sim, &output.run.summary)?)?;
     let dt = sim.params.dt;
-    let error = output
-        .run
-        .summary
-        .error
-        .as_ref()
-        .map(|e| (e.to_string(), e.step(), e.step().map(|k| k as f64 * dt)));
-    finish(d, &output.summary, source, error)
+    let signal = crate::run::SignalWatch::caught(signal);
+    run_result(py, output, signal, from_text, source, dt, |d, run| {
+        let path = dir.join("trajectory.csv");
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            cli_error(
+                py,
+                &fbd_output::OutputError::io(path.display(), &e),
+                from_text,
+            )
+        })?;
+        table.read_csv(&text).ok_or_else(|| {
+            pyo3::exceptions::PyRuntimeError::new_err(format!(
+                "{}: not a robot's trajectory.csv",
+                path.display()
+            ))
+        })?;
+        table.into_py(py, d)?;
+        d.set_item("events", events(py, robot, &sim, &run.summary)?)
+    })
 }

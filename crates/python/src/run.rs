@@ -5,8 +5,9 @@
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+use fbd_output::driver::{Outcome, RunOutput};
 use fbd_output::output::ContactSlots;
-use fbd_output::run::{Simulated, simulate};
+use fbd_output::run::simulate;
 use pyo3::exceptions::PyKeyboardInterrupt;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -29,6 +30,12 @@ pub struct SignalWatch {
 }
 
 impl SignalWatch {
+    /// A watch that caught `signal` already (a run watched in a thread of
+    /// its own).
+    pub fn caught(signal: Option<PyErr>) -> Self {
+        Self { signal, rows: 0 }
+    }
+
     /// Counts one row; every [`SIGNAL_CHECK`] rows, looks at the signals.
     pub fn row(&mut self, stop: &AtomicBool) {
         self.rows += 1;
@@ -115,29 +122,47 @@ pub fn finish<'py>(
     Ok(d)
 }
 
-/// The dict of a dynamics run (planar or 3D) of `source`: its columns,
-/// its events as `events.csv` lists them, then [`finish`].
-pub fn dynamics_result<'py>(
+/// The one unpacking of a run's result ([`RunOutput`], every model's):
+/// a file that could not be written or a signal raised first
+/// ([`SignalWatch::raise`]), then the dict: what `fill` puts in it (the
+/// columns and the events of the model), `summary`, `source`, `error`
+/// ([`finish`], the failing step at time step `dt`).
+pub fn run_result<'py, R: Outcome, S: serde::Serialize>(
     py: Python<'py>,
-    cols: Columns,
-    run: &fbd_sim::RunSummary,
-    summary: &impl serde::Serialize,
+    out: RunOutput<R, S>,
+    signal: SignalWatch,
+    from_text: bool,
     source: &str,
     dt: f64,
+    fill: impl FnOnce(&Bound<'py, PyDict>, &R) -> PyResult<()>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let RunOutput {
+        run,
+        summary,
+        io_error,
+        ..
+    } = out;
+    signal.raise(io_error, from_text, source, run.steps())?;
     let d = PyDict::new(py);
+    fill(&d, &run)?;
+    finish(d, &summary, source, run.failure(dt))
+}
+
+/// The `columns`, `data` and `events` of a dynamics run (planar or 3D).
+pub fn dynamics_columns<'py>(
+    d: &Bound<'py, PyDict>,
+    cols: Columns,
+    run: &fbd_sim::RunSummary,
+    dt: f64,
+) -> PyResult<()> {
+    let py = d.py();
     let (names, data) = cols.into_py(py)?;
     d.set_item("columns", names)?;
     d.set_item("data", data)?;
     d.set_item(
         "events",
         events(py, &run.events, &run.limit_events, &run.retries, dt)?,
-    )?;
-    let error = run
-        .error
-        .as_ref()
-        .map(|e| (e.to_string(), e.step(), e.step().map(|k| k as f64 * dt)));
-    finish(d, summary, source, error)
+    )
 }
 
 /// Every event of a run — contact, joint-limit and retried-step events, as
@@ -232,13 +257,14 @@ pub fn run<'py>(
             )
             .map(|s| (s, cols, dt))
         })?;
-        let Simulated {
-            run,
-            summary,
-            io_error,
-            ..
-        } = sim;
-        signal.raise(io_error, loaded.from_text, &loaded.source, run.steps)?;
-        dynamics_result(py, cols, &run, &summary, &loaded.source, dt)
+        run_result(
+            py,
+            sim,
+            signal,
+            loaded.from_text,
+            &loaded.source,
+            dt,
+            |d, run| dynamics_columns(d, cols, run, dt),
+        )
     })
 }

@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use fbd_output::spatial::csv::{Slots, row_values};
-use fbd_output::spatial::{Feet, Layout, SpatialRun, columns, simulate};
+use fbd_output::spatial::{Feet, Layout, columns, simulate};
 use fbd_scenario::{Config, HexapodConfig};
 use fbd_sim::spatial::SpatialRecord;
 use pyo3::prelude::*;
@@ -15,7 +15,7 @@ use pyo3::types::PyDict;
 
 use crate::columns::Columns;
 use crate::errors::config_error;
-use crate::run::{dynamics_result, watched};
+use crate::run::{dynamics_columns, run_result, watched};
 
 /// The dynamic hexapod's `run` dict, as the planar run's: `columns`,
 /// `data` (float64 arrays; `state{n}` and `*point{n}_state` lists of
@@ -60,12 +60,7 @@ pub fn run<'py>(
         )
         .map(|s| (s, cols))
     })?;
-    let SpatialRun {
-        run,
-        summary,
-        io_error,
-        ..
-    } = sim;
-    signal.raise(io_error, from_text, source, run.steps)?;
-    dynamics_result(py, cols, &run, &summary, source, dt)
+    run_result(py, sim, signal, from_text, source, dt, |d, run| {
+        dynamics_columns(d, cols, run, dt)
+    })
 }

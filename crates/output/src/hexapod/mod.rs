@@ -10,11 +10,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use fbd_sim::gait::{GaitData, GaitEvent, GaitModel, GaitSummary, LEGS, run_gait};
+use fbd_sim::gait::{GaitData, GaitEvent, GaitModel, GaitSummary, LEGS};
 use serde::Serialize;
 
 use crate::OutputError;
 use crate::config::{Config, HexapodConfig};
+use crate::driver::{Recording, RunFiles, RunOutput};
 use crate::output::{self, Ending};
 use crate::viewer::hexapod::{HexFrame, HexapodScene};
 
@@ -326,21 +327,86 @@ fn summary(model: &GaitModel, stride: usize, rows: usize, s: &GaitSummary) -> He
     }
 }
 
-/// What a hexapod run produced.
-pub struct HexapodRun {
-    /// The library's summary.
-    pub run: GaitSummary,
-    /// `summary.json`'s content.
-    pub summary: HexapodSummary,
-    /// The first file that could not be written, if any.
-    pub io_error: Option<OutputError>,
+/// What a hexapod run produced: the library's summary, `summary.json`'s
+/// content, the files written.
+pub type HexapodRun = RunOutput<GaitSummary, HexapodSummary>;
+
+/// The kinematic gait's files ([`RunFiles`]).
+struct GaitFiles {
+    model: GaitModel,
+    output: fbd_scenario::OutputConfig,
+    traj: Option<Writer>,
+    plot: Option<GaitPlotData>,
+    view: Option<HexapodScene>,
+}
+
+impl RunFiles for GaitFiles {
+    type Record = GaitData;
+    type Run = GaitSummary;
+    type Summary = HexapodSummary;
+
+    fn step_of(d: &GaitData) -> usize {
+        d.step
+    }
+
+    fn row(&mut self, d: &GaitData) {
+        if let Some(t) = self.traj.as_mut() {
+            t.write(d);
+        }
+        if let Some(v) = self.view.as_mut() {
+            v.push(&HexFrame::of_gait(d));
+        }
+    }
+
+    fn observe(&mut self, d: &GaitData) {
+        if let Some(p) = self.plot.as_mut() {
+            p.push(d);
+        }
+    }
+
+    fn summary(&mut self, run: &GaitSummary, rows: usize) -> HexapodSummary {
+        summary(&self.model, self.output.stride.max(1), rows, run)
+    }
+
+    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
+        self.traj.take().map(Writer::finish)
+    }
+
+    fn events_csv(&self, run: &GaitSummary) -> String {
+        events_csv(&run.events)
+    }
+
+    fn write_extras(
+        self,
+        dir: &Path,
+        run: &GaitSummary,
+        keep: &mut output::FirstError,
+    ) -> Vec<&'static str> {
+        if let Some(plot) = self.plot {
+            crate::driver::write_svgs(
+                dir,
+                [
+                    ("gait.svg", gait_svg(&plot)),
+                    ("footprints.svg", footprints_svg(&plot)),
+                    ("joints.svg", joints_svg(&plot)),
+                ],
+                keep,
+            );
+        }
+        if let Some(view) = self.view {
+            let mut scene = view.finish();
+            scene.event_rows = run.events.len();
+            keep.keep(crate::viewer::write(dir, &scene));
+        }
+        output::selected(output::files_as(&FILES, self.output.format), &self.output)
+    }
 }
 
 /// Runs the hexapod configuration `h` (`config` is the same, for
 /// `config.toml`), handing every `output.stride`-th step to `on_row`; when
 /// `out_dir` is given, writes every file there, even after a run error
-/// (which is in `run.error`). The run stops before its next step once
-/// `stop` is set.
+/// (which is in `run.error`), and removes those of an earlier run of
+/// another kind. The run stops before its next step once `stop` is set.
 pub fn simulate(
     h: &HexapodConfig,
     config: &Config,
@@ -351,7 +417,7 @@ pub fn simulate(
 ) -> Result<HexapodRun, OutputError> {
     let model = h.gait_model(source)?;
     let stride = h.output.stride.max(1);
-    let mut traj = match out_dir {
+    let traj = match out_dir {
         Some(dir) => {
             output::prepare_dir(dir)?;
             output::warn_size(
@@ -364,11 +430,11 @@ pub fn simulate(
         }
         None => None,
     };
-    let mut plot = out_dir
+    let plot = out_dir
         .filter(|_| h.output.plots)
         .map(|_| GaitPlotData::new(&model));
     // viewer.html: one frame per trajectory row (decimated when long).
-    let mut view = out_dir.filter(|_| h.output.viewer).map(|_| {
+    let view = out_dir.filter(|_| h.output.viewer).map(|_| {
         HexapodScene::new(
             model.kin.clone(),
             model.surface.clone(),
@@ -376,61 +442,21 @@ pub fn simulate(
             &crate::viewer::title_of(source, "hexapod, kinematic gait"),
         )
     });
-    let mut rows = 0;
-    let run = run_gait(&model, stop, |d: &GaitData| {
-        if d.step.is_multiple_of(stride) {
-            if let Some(t) = traj.as_mut() {
-                t.write(d);
-            }
-            if let Some(v) = view.as_mut() {
-                v.push(&HexFrame::of_gait(d));
-            }
-            on_row(d);
-            rows += 1;
-        }
-        if let Some(p) = plot.as_mut() {
-            p.push(d);
-        }
-    });
-    let s = summary(&model, stride, rows, &run);
-    let (Some(out_dir), Some(traj)) = (out_dir, traj) else {
-        return Ok(HexapodRun {
-            run,
-            summary: s,
-            io_error: None,
-        });
+    let files = GaitFiles {
+        model: model.clone(),
+        output: h.output.clone(),
+        traj,
+        plot,
+        view,
     };
-    let mut keep = output::FirstError::default();
-    keep.keep(traj.finish());
-    output::write_run_files(
-        out_dir,
-        &events_csv(&run.events),
-        &s,
+    let rec = Recording::new(files, stride, out_dir);
+    Ok(crate::driver::drive(
+        &model,
+        rec,
+        stop,
         &config.to_toml(),
-        &mut keep,
-    );
-    if let Some(plot) = plot {
-        for (name, svg) in [
-            ("gait.svg", gait_svg(&plot)),
-            ("footprints.svg", footprints_svg(&plot)),
-            ("joints.svg", joints_svg(&plot)),
-        ] {
-            keep.keep(
-                svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
-                    .and_then(|s| output::write_file(out_dir, name, s.as_bytes())),
-            );
-        }
-    }
-    if let Some(view) = view {
-        let mut scene = view.finish();
-        scene.event_rows = run.events.len();
-        keep.keep(crate::viewer::write(out_dir, &scene));
-    }
-    Ok(HexapodRun {
-        run,
-        summary: s,
-        io_error: keep.0,
-    })
+        on_row,
+    ))
 }
 
 /// `fbd run` of a hexapod configuration: simulates, writes the files,
@@ -446,6 +472,7 @@ pub fn run_command(
         run,
         summary,
         io_error,
+        files,
     } = simulate(
         h,
         config,
@@ -514,6 +541,5 @@ pub fn run_command(
     } else {
         Ending::Completed
     };
-    let files = output::selected(output::files_as(&FILES, h.output.format), &h.output);
     output::conclude(out, text, out_dir, &files, io_error, ending)
 }

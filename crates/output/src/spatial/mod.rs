@@ -16,10 +16,11 @@ use fbd_dynamics::PointKind;
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
 use fbd_scenario::OutputConfig;
 use fbd_sim::RunSummary;
-use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_until};
+use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord};
 
 use crate::OutputError;
 use crate::config::ConfigError;
+use crate::driver::{Recording, RunFiles, RunOutput};
 use crate::output::{self, Ending};
 use crate::steptime::StepTimes;
 use crate::viewer::hexapod::{HexDynamics, HexFrame, HexapodScene};
@@ -190,44 +191,33 @@ fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &SpatialRecord
 }
 
 /// What a dynamic hexapod run produced.
-pub struct SpatialRun {
-    /// The run: steps, events, and the error that stopped it, if any.
-    pub run: RunSummary,
-    /// The content of `summary.json`.
-    pub summary: SpatialSummary,
-    /// The first failure writing a file (every file is still attempted).
-    pub io_error: Option<OutputError>,
-    /// The files written, in order (none without an output directory).
-    pub files: Vec<&'static str>,
-}
+pub type SpatialRun = RunOutput<RunSummary, SpatialSummary>;
 
-/// Everything a run writes, fed one record per step ([`Outputs::push`])
-/// and completed by [`Outputs::finish`].
+/// Everything a run writes ([`RunFiles`]), fed by the driver
+/// ([`Outputs::recording`]).
 pub struct Outputs {
+    params: SpatialParams,
     layout: Layout,
-    stride: usize,
     steps: usize,
-    dir: Option<PathBuf>,
     traj: Option<TrajectoryWriter>,
     output: OutputConfig,
     plot: Option<plots::Recorder>,
     view: Option<HexapodScene>,
-    collect: summary::Collector,
+    collect: Option<summary::Collector>,
     feet: Feet,
     slots: Option<csv::Slots>,
-    rows: usize,
     /// The model's start-up stability check (s), for `summary.json`.
     pub stability_check_seconds: f64,
 }
 
 impl Outputs {
-    /// For a run of `params` solving `steps` steps; with `out_dir`, creates
-    /// it and opens `trajectory.csv` there.
+    /// A recording of a run of `params` solving `steps` steps, with every
+    /// file; with `out_dir`, creates it and opens `trajectory.csv` there.
     pub fn new(
         params: &SpatialParams,
         steps: usize,
         out_dir: Option<&Path>,
-    ) -> Result<Self, OutputError> {
+    ) -> Result<Recording<Self>, OutputError> {
         Self::new_as(params, steps, out_dir, &OutputConfig::default(), "hexapod")
     }
 
@@ -239,7 +229,7 @@ impl Outputs {
         out_dir: Option<&Path>,
         output: &OutputConfig,
         source: &str,
-    ) -> Result<Self, OutputError> {
+    ) -> Result<Recording<Self>, OutputError> {
         let format = output.format;
         let layout = Layout::of(params);
         let stride = params.stride.max(1);
@@ -257,9 +247,9 @@ impl Outputs {
             None => None,
         };
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
-        Ok(Self {
+        let files = Self {
             stability_check_seconds: 0.0,
-            collect: summary::Collector::new(&layout, &params.terrain),
+            collect: Some(summary::Collector::new(&layout, &params.terrain)),
             plot: out_dir
                 .filter(|_| output.plots)
                 .map(|_| plots::Recorder::new(&layout, t_end).with_surface(&params.terrain)),
@@ -274,95 +264,93 @@ impl Outputs {
                 )
             }),
             feet: Feet::new(params),
-            dir: out_dir.map(Path::to_owned),
+            params: params.clone(),
             traj,
             output: output.clone(),
             layout,
-            stride,
             steps,
             slots: None,
-            rows: 0,
-        })
+        };
+        Ok(Recording::new(files, stride, out_dir))
     }
 
-    /// Adds the record of one solved step (every step: the plots and peaks
-    /// see them all; the files every `stride`-th), handing the written ones
-    /// to `on_row`.
-    pub fn push(&mut self, r: &SpatialRecord, on_row: &mut dyn FnMut(&SpatialRecord)) {
-        let s = self
-            .slots
-            .get_or_insert_with(|| csv::Slots::of(&self.layout, r));
-        if r.step.is_multiple_of(self.stride) {
-            if let Some(t) = self.traj.as_mut() {
-                t.write(r);
-            }
-            if let Some(v) = self.view.as_mut() {
-                v.push(&frame(&mut self.feet, &self.layout, s, r));
-            }
-            on_row(r);
-            self.rows += 1;
+    fn slots(&mut self, r: &SpatialRecord) -> &csv::Slots {
+        self.slots
+            .get_or_insert_with(|| csv::Slots::of(&self.layout, r))
+    }
+}
+
+impl RunFiles for Outputs {
+    type Record = SpatialRecord;
+    type Run = RunSummary;
+    type Summary = SpatialSummary;
+
+    fn step_of(r: &SpatialRecord) -> usize {
+        r.step
+    }
+
+    fn row(&mut self, r: &SpatialRecord) {
+        self.slots(r);
+        let s = self.slots.as_ref().expect("set");
+        if let Some(t) = self.traj.as_mut() {
+            t.write(r);
         }
-        self.collect.push(r, s);
+        if let Some(v) = self.view.as_mut() {
+            v.push(&frame(&mut self.feet, &self.layout, s, r));
+        }
+    }
+
+    fn observe(&mut self, r: &SpatialRecord) {
+        self.slots(r);
+        let s = self.slots.as_ref().expect("set");
+        if let Some(c) = self.collect.as_mut() {
+            c.push(r, s);
+        }
         if let Some(p) = self.plot.as_mut() {
             p.push(r, s);
         }
     }
 
-    /// Writes every file (each attempted, the first failure kept) and
-    /// removes those of an earlier run of another kind.
-    pub fn finish(self, params: &SpatialParams, run: RunSummary, config_toml: &str) -> SpatialRun {
-        let mut s = self
-            .collect
-            .finish(params, self.steps, &self.layout, &run, self.rows);
+    fn summary(&mut self, run: &RunSummary, rows: usize) -> SpatialSummary {
+        let collect = self.collect.take().expect("summarised once");
+        let mut s = collect.finish(&self.params, self.steps, &self.layout, run, rows);
         s.stability_check_seconds = self.stability_check_seconds;
-        let (Some(out_dir), Some(traj)) = (self.dir, self.traj) else {
-            return SpatialRun {
-                run,
-                summary: s,
-                io_error: None,
-                files: Vec::new(),
-            };
-        };
-        let mut keep = output::FirstError::default();
-        keep.keep(traj.finish());
-        output::write_run_files(
-            &out_dir,
-            &output::run_events_csv(&run, params.dt),
-            &s,
-            config_toml,
-            &mut keep,
-        );
+        s
+    }
+
+    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
+        self.traj.take().map(TrajectoryWriter::finish)
+    }
+
+    fn events_csv(&self, run: &RunSummary) -> String {
+        output::run_events_csv(run, self.params.dt)
+    }
+
+    fn write_extras(
+        self,
+        dir: &Path,
+        run: &RunSummary,
+        keep: &mut output::FirstError,
+    ) -> Vec<&'static str> {
         if let Some(plot) = self.plot {
-            let plot = plot.finish(&run);
-            for (name, svg) in [
-                ("feet.svg", plots::feet_svg(&plot)),
-                ("torques.svg", plots::torques_svg(&plot)),
-                ("body.svg", plots::body_svg(&plot)),
-                ("energy.svg", plots::energy_svg(&plot)),
-            ] {
-                keep.keep(
-                    svg.map_err(|e| OutputError::Io(format!("{name}: {e}")))
-                        .and_then(|s| output::write_file(&out_dir, name, s.as_bytes())),
-                );
-            }
+            let plot = plot.finish(run);
+            crate::driver::write_svgs(
+                dir,
+                [
+                    ("feet.svg", plots::feet_svg(&plot)),
+                    ("torques.svg", plots::torques_svg(&plot)),
+                    ("body.svg", plots::body_svg(&plot)),
+                    ("energy.svg", plots::energy_svg(&plot)),
+                ],
+                keep,
+            );
         }
         if let Some(view) = self.view {
             let mut scene = view.finish();
-            scene.event_rows = output::run_events(&run, &StepTimes::new(params.dt)).len();
-            keep.keep(crate::viewer::write(&out_dir, &scene));
+            scene.event_rows = output::run_events(run, &StepTimes::new(self.params.dt)).len();
+            keep.keep(crate::viewer::write(dir, &scene));
         }
-        let files = output::selected(output::files_as(&FILES, self.output.format), &self.output);
-        if keep.0.is_none()
-            && let Err(e) = output::remove_stale(&out_dir, &files)
-        {
-            keep.0 = Some(e);
-        }
-        SpatialRun {
-            run,
-            summary: s,
-            io_error: keep.0,
-            files,
-        }
+        output::selected(output::files_as(&FILES, self.output.format), &self.output)
     }
 }
 
@@ -397,16 +385,15 @@ pub fn simulate(
         file: source.to_owned(),
         message: e.to_string(),
     })?;
-    let mut out = Outputs::new_as(
+    let mut rec = Outputs::new_as(
         params,
         model.steps,
         out_dir,
         &output_of(config_toml),
         source,
     )?;
-    out.stability_check_seconds = model.stability_check_seconds;
-    let run = run_until(&model, stop, |r: &SpatialRecord| out.push(r, on_row));
-    Ok(out.finish(params, run, config_toml))
+    rec.files_mut().stability_check_seconds = model.stability_check_seconds;
+    Ok(crate::driver::drive(&model, rec, stop, config_toml, on_row))
 }
 
 /// `fbd run` of a dynamic hexapod configuration: simulates, writes the
@@ -552,7 +539,7 @@ mod tests {
             }],
             ..RunSummary::default()
         };
-        let r = out.finish(&p, run, "# config\n");
+        let r = out.finish(run, "# config\n");
         assert!(r.io_error.is_none(), "{:?}", r.io_error);
         assert_eq!(written, 6);
         for f in FILES {
@@ -619,7 +606,7 @@ mod tests {
         for k in 0..3 {
             out.push(&record(&p, k), &mut |_| {});
         }
-        let r = out.finish(&p, RunSummary::default(), "");
+        let r = out.finish(RunSummary::default(), "");
         assert!(r.io_error.is_none());
         let csv = std::fs::read_to_string(dir.path().join("trajectory.csv")).unwrap();
         let lines: Vec<&str> = csv.lines().collect();

@@ -1109,7 +1109,7 @@ mod tests {
         let n = 1 + triplets.iter().map(|t| t.0.max(t.1)).max().unwrap();
         let mut entries: Vec<(usize, usize)> = triplets.iter().map(|t| (t.0, t.1)).collect();
         let pattern = Pattern::build(0, n, &mut entries);
-        let mut mem = MemBuffer::new(Factors::scratch(n));
+        let mem = MemBuffer::new(Factors::scratch(n));
         let factors = Factors::new(pattern.m);
         let b = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
         (n, pattern, mem, factors, b)

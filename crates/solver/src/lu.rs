@@ -451,6 +451,30 @@ impl Factors {
         }
     }
 
+    /// Compiles a program of `pattern` on `reduced`, values whose exact
+    /// zeros have the signature `zeros`, and keeps it. The row order is
+    /// chosen by threshold Markowitz on these values (less fill than
+    /// faer's partial pivoting); where that finds no pivot, the row order
+    /// of faer's factorisation of these values just made when `faer_rows`,
+    /// else nothing is compiled. Allocates, as a pattern's registration
+    /// does.
+    fn add_program(&mut self, pattern: &mut Pattern, reduced: &[f64], zeros: u64, faer_rows: bool) {
+        let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
+        let fwd = pattern.col_perm.arrays().0;
+        let mut program = CompiledLu::default();
+        let rows = match program.choose_rows(col_ptr, row_idx, fwd, reduced) {
+            Some(order) => {
+                self.row_choice.clear();
+                self.row_choice.extend_from_slice(order);
+                &self.row_choice
+            }
+            None if faer_rows => &self.row_perm,
+            None => return,
+        };
+        program.compile(col_ptr, row_idx, fwd, rows, true);
+        pattern.programs.push((zeros, program));
+    }
+
     /// Grows faer's storage to that of a dense `n × n` LU by two
     /// triangular warm-ups (see the module docs). Allocates.
     fn warm_up(&mut self, mem: &mut MemBuffer) {
@@ -541,20 +565,9 @@ impl Factors {
             0
         };
         if compiled && n > 0 && pattern.programs.is_empty() {
-            // The pattern's first program, compiled on these values (it
-            // allocates, as the pattern's registration does): the row order
-            // by threshold Markowitz (less fill than faer's partial
-            // pivoting); where that finds no pivot, faer's LU below and
-            // its row order.
-            let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
-            let fwd = pattern.col_perm.arrays().0;
-            let mut program = CompiledLu::default();
-            if let Some(order) = program.choose_rows(col_ptr, row_idx, fwd, reduced) {
-                self.row_choice.clear();
-                self.row_choice.extend_from_slice(order);
-                program.compile(col_ptr, row_idx, fwd, &self.row_choice, true);
-                pattern.programs.push((zeros, program));
-            }
+            // The pattern's first program, before any factorisation; where
+            // the row choice finds no pivot, faer's LU below and its rows.
+            self.add_program(pattern, reduced, zeros, false);
         }
         let known = pattern.programs.iter().position(|(z, _)| *z == zeros);
         if compiled && n > 0 && !pattern.programs.is_empty() {
@@ -676,28 +689,12 @@ impl Factors {
                 path == FactorPath::Faer
             };
             if compiled && known.is_none() && recurring && pattern.programs.len() < MAX_PROGRAMS {
-                // Compiled on these values, at the first factorisation of
-                // the pattern with these exact zeros (it allocates, as the
-                // pattern's registration does). A fallback of a known
-                // set of zeros keeps its program: the next factorisation
-                // tries it again (a failed pivot then is mostly a passing
-                // cancellation; recompiling on such values was measured
-                // dearer, 1.6 M instructions a time on the hexapod walk).
-                let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
-                let fwd = pattern.col_perm.arrays().0;
-                let mut program = CompiledLu::default();
-                // The row order: threshold Markowitz on these values (less
-                // fill than faer's partial pivoting), else faer's.
-                let rows = match program.choose_rows(col_ptr, row_idx, fwd, reduced) {
-                    Some(order) => {
-                        self.row_choice.clear();
-                        self.row_choice.extend_from_slice(order);
-                        &self.row_choice
-                    }
-                    None => &self.row_perm,
-                };
-                program.compile(col_ptr, row_idx, fwd, rows, true);
-                pattern.programs.push((zeros, program));
+                // A fallback of a known set of zeros keeps its program: the
+                // next factorisation tries it again (a failed pivot then is
+                // mostly a passing cancellation; recompiling on such values
+                // was measured dearer, 1.6 M instructions a time on the
+                // hexapod walk).
+                self.add_program(pattern, reduced, zeros, true);
             }
         }
         self.owner = Some(pattern.id);

@@ -1031,12 +1031,12 @@ fn hexapod_landing_sweep_of_1000_runs() {
     );
     r.count(
         " the most, run ",
-        "); 837",
+        "); ",
         l.most_events_run,
         "3D landings: the run with most events",
     );
     r.count(
-        "most, run 522); ",
+        "); ",
         " steps were retried",
         l.retried_steps as usize,
         "3D landings: retried steps",
@@ -1087,7 +1087,7 @@ fn hexapod_landing_sweep_of_1000_runs() {
     );
     r.count(
         "cannot-be-closed));\n",
-        " steps, in 26 runs, closed",
+        " steps, in ",
         l.cycle_steps as usize,
         "3D landings: cycle steps",
     );

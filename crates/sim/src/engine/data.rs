@@ -103,6 +103,12 @@ pub struct RunData<M: Engine> {
     /// Per contact, the anchor of its last sticking trial (meaningful when
     /// bit 1 of `seen` is set).
     pub(crate) stick_anchor: Vec<<M::State as ContactMode>::Anchor>,
+    /// Per contact, whether the point slides since a step whose search
+    /// tried sticking it and needed more than μS·N: while its slip runs
+    /// forward it is not tried again ([`super::search`]).
+    pub(crate) stick_refused: Vec<bool>,
+    /// `stick_refused` at the step's start, kept for a retry in substeps.
+    pub(crate) grid_stick_refused: Vec<bool>,
     /// The step's start, kept for a retry in substeps: `q[k]`, `q[k−1]`,
     /// `q[k−2]`, the accepted states and the event counts.
     pub(crate) grid_q: Vec<f64>,
@@ -207,6 +213,8 @@ impl<M: Engine> RunData<M> {
             seen: vec![0; contacts],
             stick_ft: vec![Default::default(); contacts],
             stick_anchor: vec![Default::default(); contacts],
+            stick_refused: vec![false; contacts],
+            grid_stick_refused: vec![false; contacts],
             grid_q: q0.clone(),
             grid_q_prev: q0.clone(),
             grid_q_prev2: q0.clone(),
@@ -283,6 +291,8 @@ where
             seen: self.seen.clone(),
             stick_ft: self.stick_ft.clone(),
             stick_anchor: self.stick_anchor.clone(),
+            stick_refused: self.stick_refused.clone(),
+            grid_stick_refused: self.grid_stick_refused.clone(),
             grid_q: self.grid_q.clone(),
             grid_q_prev: self.grid_q_prev.clone(),
             grid_q_prev2: self.grid_q_prev2.clone(),

@@ -10,7 +10,23 @@
 //! others (at an impact of several points, switching them all together
 //! chases its tail): lift-offs and releases first (most negative `N`, or
 //! stop moment over the length scale), then slips (largest `|Ft| − μS·N`),
-//! then the ends of slides.
+//! then the ends of slides — which the exact models (the 3D ones,
+//! [`super::Settings::exact`]) apply together, every slide whose slip has
+//! stopped at once ([`end_slides`]).
+//!
+//! **A slide that could not stop** (exact models). A sliding point whose slip stops is
+//! tried sticking; when sticking needs more than μS·N it slides on at
+//! μD·N, and the search does not try it again in that step. It keeps that
+//! mark across steps while it keeps sliding forwards
+//! ([`RunData::stick_refused`]): it is tried sticking again only when its
+//! slip reverses (or when its complementarity rows find it inside its μD
+//! disc, a stop that needs no trial). A slide at μD·N whose slip is
+//! (almost) zero obeys Coulomb's law either way (`μD·N ≤ μS·N`); tried
+//! every step, it cost two to a dozen solves a step and wrote an ST3 → ST2
+//! → ST3 pair of events whenever one of them went through (a robot on its
+//! knees with its feet braced against the ground). The planar model keeps
+//! the paper's machine, every end of a slide tried one at a time in each
+//! step.
 //!
 //! **Cycles.** A repeated state combination means no combination the
 //! rules reach is consistent. Before giving up, a point that flip-flopped
@@ -231,8 +247,10 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
         };
         // ST3 → ST2 needs the slip to stop *and* |Ft| ≤ μS·N: a point that
         // already tried sticking in this search and had to slide again
-        // stays sliding at the friction limit.
-        let stick_failed = data.seen[c] & 0b110 == 0b110;
+        // stays sliding at the friction limit, as does one that could not
+        // stick in an earlier step and slides on forwards (module docs).
+        let stick_failed = data.seen[c] & 0b110 == 0b110
+            || model.exact() && data.stick_refused[c] && trial.slip_speed(&state) > 0.0;
         // Priority: lift-off > slip > end of a slide, then the violation.
         let priority = match (state.code(), next.code()) {
             (StateCode::St1, _) => {
@@ -293,10 +311,45 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
         {
             data.visited.clear();
         }
+        let ends = data.trial[c].code() == StateCode::St3 && next.code() == StateCode::St2;
         data.trial[c] = next;
+        if ends && model.exact() {
+            end_slides(model, data);
+        }
     }
     rigid_anchors(model, data);
     true
+}
+
+/// Every other slide of the trial whose slip has stopped sticks too (its
+/// switching rule says ST3 → ST2 and it has not failed to stick in this
+/// search): the ends of slides are applied together, as touchdowns are.
+/// Tried one at a time, a point that stops while its neighbours still
+/// slide at μD·N can need more than μS·N alone where all of them stick
+/// together well inside their cones; the complementarity rows then return
+/// any that must slide to ST3 at once.
+fn end_slides<M: Engine>(model: &M, data: &mut RunData<M>) {
+    for c in 0..model.contacts() {
+        let state = data.trial[c];
+        if state.code() != StateCode::St3 || data.seen[c] & 0b110 == 0b110 {
+            continue;
+        }
+        let trial = model.trial(data, c);
+        if data.stick_refused[c] && trial.slip_speed(&state) > 0.0 {
+            continue;
+        }
+        let friction = model.friction_at(trial.location());
+        if let Some(next) = switch(
+            &state,
+            &trial,
+            model.ground(),
+            &friction,
+            model.contact_params(),
+        ) && next.code() == StateCode::St2
+        {
+            data.trial[c] = next;
+        }
+    }
 }
 
 /// Anchors of points that share a rigid body. A touchdown is anchored

@@ -24,7 +24,7 @@ use super::{Engine, RunData};
 use crate::SimError;
 use crate::record::{Event, LimitCode, LimitEvent, RetryEvent};
 use crate::rules::Failure;
-use fbd_contact::ContactMode;
+use fbd_contact::{ContactMode, StateCode};
 use fbd_dynamics::History;
 
 /// Solves step `data.k` (its record in `data.record`) and advances the
@@ -201,6 +201,15 @@ fn accept<M: Engine>(model: &M, data: &mut RunData<M>, t: f64) -> bool {
             });
         }
     }
+    // A point that slides on after its search tried sticking it (and
+    // sticking needed more than μS·N), or that has slid on since, is not
+    // tried again while its slip runs forward ([`super::search`]).
+    for c in 0..model.contacts() {
+        let slides = data.trial[c].code() == StateCode::St3;
+        let failed = data.seen[c] & 0b110 == 0b110;
+        let kept = data.stick_refused[c] && data.states[c].code() == StateCode::St3;
+        data.stick_refused[c] = slides && (failed || kept);
+    }
     let same = data
         .states
         .iter()
@@ -226,6 +235,7 @@ fn save_grid<M: Engine>(data: &mut RunData<M>) {
     data.grid_q_prev2.copy_from_slice(&data.q_prev2);
     data.grid_states.copy_from_slice(&data.states);
     data.grid_limits.copy_from_slice(&data.limit_states);
+    data.grid_stick_refused.copy_from_slice(&data.stick_refused);
     data.grid_events = [data.events.len(), data.limit_events.len()];
 }
 
@@ -236,6 +246,7 @@ fn restore_grid<M: Engine>(model: &M, data: &mut RunData<M>) {
     data.q_prev2.copy_from_slice(&data.grid_q_prev2);
     data.states.copy_from_slice(&data.grid_states);
     data.limit_states.copy_from_slice(&data.grid_limits);
+    data.stick_refused.copy_from_slice(&data.grid_stick_refused);
     data.events.truncate(data.grid_events[0]);
     data.limit_events.truncate(data.grid_events[1]);
     model.reset_kinematics(data);

@@ -107,6 +107,9 @@ pub struct RunData<M: Engine> {
     /// tried sticking it and needed more than μS·N: while its slip runs
     /// forward it is not tried again ([`super::search`]).
     pub(crate) stick_refused: Vec<bool>,
+    /// Per contact, the ST2 state of a slide that has stopped, from the last
+    /// check of the switching rules (`None`: no such end).
+    pub(crate) stops: Vec<Option<M::State>>,
     /// `stick_refused` at the step's start, kept for a retry in substeps.
     pub(crate) grid_stick_refused: Vec<bool>,
     /// The step's start, kept for a retry in substeps: `q[k]`, `q[k−1]`,
@@ -214,6 +217,7 @@ impl<M: Engine> RunData<M> {
             stick_ft: vec![Default::default(); contacts],
             stick_anchor: vec![Default::default(); contacts],
             stick_refused: vec![false; contacts],
+            stops: vec![None; contacts],
             grid_stick_refused: vec![false; contacts],
             grid_q: q0.clone(),
             grid_q_prev: q0.clone(),
@@ -292,6 +296,7 @@ where
             stick_ft: self.stick_ft.clone(),
             stick_anchor: self.stick_anchor.clone(),
             stick_refused: self.stick_refused.clone(),
+            stops: self.stops.clone(),
             grid_stick_refused: self.grid_stick_refused.clone(),
             grid_q: self.grid_q.clone(),
             grid_q_prev: self.grid_q_prev.clone(),

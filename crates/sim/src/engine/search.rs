@@ -12,7 +12,10 @@
 //! stop moment over the length scale), then slips (largest `|Ft| − μS·N`),
 //! then the ends of slides — which the exact models (the 3D ones,
 //! [`super::Settings::exact`]) apply together, every slide whose slip has
-//! stopped at once ([`end_slides`]).
+//! stopped at once: tried one at a time, a foot that stops while the
+//! others still slide at μD·N can need more than μS·N alone where all of
+//! them together stick inside their cones (the complementarity rows then
+//! return any that must slide to ST3 at once).
 //!
 //! **A slide that could not stop** (exact models). A sliding point whose slip stops is
 //! tried sticking; when sticking needs more than μS·N it slides on at
@@ -236,6 +239,7 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
             data.stick_ft[c] = trial.tangential();
             data.stick_anchor[c] = anchor;
         }
+        data.stops[c] = None;
         let Some(next) = switch(
             &state,
             &trial,
@@ -259,6 +263,10 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
                 continue;
             }
             (StateCode::St3, StateCode::St2) if stick_failed => continue,
+            (StateCode::St3, StateCode::St2) => {
+                data.stops[c] = Some(next);
+                0.0
+            }
             (_, StateCode::St1) => 2e12 - trial.normal(),
             (StateCode::St2, _) => {
                 1e12 + M::State::tangent_norm(trial.tangential()) - mu_s * trial.normal()
@@ -311,45 +319,19 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
         {
             data.visited.clear();
         }
-        let ends = data.trial[c].code() == StateCode::St3 && next.code() == StateCode::St2;
         data.trial[c] = next;
-        if ends && model.exact() {
-            end_slides(model, data);
+        if data.stops[c].is_some() && model.exact() {
+            // An end of a slide: every slide that has stopped sticks
+            // together (module docs).
+            for (state, stop) in data.trial.iter_mut().zip(&data.stops) {
+                if let Some(stop) = stop {
+                    *state = *stop;
+                }
+            }
         }
     }
     rigid_anchors(model, data);
     true
-}
-
-/// Every other slide of the trial whose slip has stopped sticks too (its
-/// switching rule says ST3 → ST2 and it has not failed to stick in this
-/// search): the ends of slides are applied together, as touchdowns are.
-/// Tried one at a time, a point that stops while its neighbours still
-/// slide at μD·N can need more than μS·N alone where all of them stick
-/// together well inside their cones; the complementarity rows then return
-/// any that must slide to ST3 at once.
-fn end_slides<M: Engine>(model: &M, data: &mut RunData<M>) {
-    for c in 0..model.contacts() {
-        let state = data.trial[c];
-        if state.code() != StateCode::St3 || data.seen[c] & 0b110 == 0b110 {
-            continue;
-        }
-        let trial = model.trial(data, c);
-        if data.stick_refused[c] && trial.slip_speed(&state) > 0.0 {
-            continue;
-        }
-        let friction = model.friction_at(trial.location());
-        if let Some(next) = switch(
-            &state,
-            &trial,
-            model.ground(),
-            &friction,
-            model.contact_params(),
-        ) && next.code() == StateCode::St2
-        {
-            data.trial[c] = next;
-        }
-    }
 }
 
 /// Anchors of points that share a rigid body. A touchdown is anchored

@@ -253,7 +253,7 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
         // already tried sticking in this search and had to slide again
         // stays sliding at the friction limit, as does one that could not
         // stick in an earlier step and slides on forwards (module docs).
-        let stick_failed = data.seen[c] & 0b110 == 0b110
+        let stick_failed = stick_failed_in_search(data.seen[c])
             || model.exact() && data.stick_refused[c] && trial.slip_speed(&state) > 0.0;
         // Priority: lift-off > slip > end of a slide, then the violation.
         let priority = match (state.code(), next.code()) {
@@ -332,6 +332,12 @@ fn check_states<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
     }
     rigid_anchors(model, data);
     true
+}
+
+/// Whether a point's search solved it both sticking and sliding (`seen`
+/// bits of ST2 and ST3): it tried sticking and had to slide.
+pub(crate) fn stick_failed_in_search(seen: u8) -> bool {
+    seen & 0b110 == 0b110
 }
 
 /// Anchors of points that share a rigid body. A touchdown is anchored

@@ -19,7 +19,7 @@
 //! ([`RetryEvent::reference_lu`]): both solve the same systems to
 //! round-off, and a hard step's state search can turn on round-off.
 
-use super::search::{describe_states, solve, start_search};
+use super::search::{describe_states, solve, start_search, stick_failed_in_search};
 use super::{Engine, RunData};
 use crate::SimError;
 use crate::record::{Event, LimitCode, LimitEvent, RetryEvent};
@@ -203,12 +203,15 @@ fn accept<M: Engine>(model: &M, data: &mut RunData<M>, t: f64) -> bool {
     }
     // A point that slides on after its search tried sticking it (and
     // sticking needed more than μS·N), or that has slid on since, is not
-    // tried again while its slip runs forward ([`super::search`]).
-    for c in 0..model.contacts() {
-        let slides = data.trial[c].code() == StateCode::St3;
-        let failed = data.seen[c] & 0b110 == 0b110;
-        let kept = data.stick_refused[c] && data.states[c].code() == StateCode::St3;
-        data.stick_refused[c] = slides && (failed || kept);
+    // tried again while its slip runs forward ([`super::search`]; the
+    // exact models only).
+    if model.exact() {
+        for c in 0..model.contacts() {
+            let slides = data.trial[c].code() == StateCode::St3;
+            let failed = stick_failed_in_search(data.seen[c]);
+            let kept = data.stick_refused[c] && data.states[c].code() == StateCode::St3;
+            data.stick_refused[c] = slides && (failed || kept);
+        }
     }
     let same = data
         .states

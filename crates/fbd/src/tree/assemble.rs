@@ -12,7 +12,7 @@
 //! [`set_configuration`], [`set_previous`], [`prepare_step`], [`eval`],
 //! [`pattern_key`], [`pattern`], [`evaluate_next`], [`advance`].
 
-use super::kin::TreeKin;
+use super::kin::{Columns, TreeKin};
 use super::mechanism::TreeMechanism;
 use crate::assemble::{History, JacobianSink, LimitEquation};
 use crate::assembly::{self, At, ContactView, Dims, FbdModel, Reaction, RowState, Slip, StopView};
@@ -297,10 +297,8 @@ pub fn eval<S: JacobianSink>(
 }
 
 #[inline]
-fn columns(cols: impl Iterator<Item = (usize, Vector3<f64>)>, mut f: impl FnMut(usize, &[f64; 3])) {
-    for (i, v) in cols {
-        f(i, &[v.x, v.y, v.z]);
-    }
+fn columns(cols: Columns<'_>, mut f: impl FnMut(usize, &[f64; 3])) {
+    cols.for_each(|i, v| f(i, &[v.x, v.y, v.z]));
 }
 
 /// Any robot's part of the assembly.
@@ -528,18 +526,14 @@ impl FbdModel for TreeMechanism {
 
     #[inline]
     fn com_columns(&self, data: &TreeFbdData, b: usize, f: impl FnMut(usize, &[f64; 3])) {
-        columns(
-            data.kin_next.com_jacobian(self.bodies[b].model_body).iter(),
-            f,
-        );
+        columns(data.kin_next.com_jacobian(self.bodies[b].model_body), f);
     }
 
     #[inline]
     fn contact_columns(&self, data: &TreeFbdData, c: usize, f: impl FnMut(usize, &[f64; 3])) {
         columns(
             data.kin_next
-                .contact_jacobian(self.contacts[c].model_contact)
-                .iter(),
+                .contact_jacobian(self.contacts[c].model_contact),
             f,
         );
     }
@@ -554,15 +548,13 @@ impl FbdModel for TreeMechanism {
         jac: &mut J,
     ) {
         let d = &data.rot_d[b];
-        for (i, w) in data
-            .kin_next
+        data.kin_next
             .angular_jacobian(self.bodies[b].model_body)
-            .iter()
-        {
-            let col = d * w;
-            for a in 0..3 {
-                jac.add(row + a, i, col[a]);
-            }
-        }
+            .for_each(|i, w| {
+                let col = d * w;
+                for a in 0..3 {
+                    jac.add(row + a, i, col[a]);
+                }
+            });
     }
 }

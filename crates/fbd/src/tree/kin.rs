@@ -26,7 +26,7 @@
 
 use fbd_kinematics::pose::BodyPose;
 use fbd_robot::RobotModel;
-use fbd_robot::nalgebra::{Matrix3, Rotation3, Vector3};
+use fbd_robot::nalgebra::{Matrix3, Vector3};
 
 /// Number of floating-base coordinates at the front of `q`.
 pub const BASE_DOF: usize = 6;
@@ -76,6 +76,151 @@ pub struct TreeKin {
     pub phi_axes: [Vector3<f64>; 3],
     /// The body each contact point is on (from the model).
     contact_body: Vec<usize>,
+    /// Each joint's constants, made once from the model.
+    joints: Vec<JointConst>,
+    /// Each body's centre of mass in its frame (from the model).
+    body_com: Vec<Vector3<f64>>,
+    /// Each contact point's position in its body's frame (from the model).
+    contact_local: Vec<Vector3<f64>>,
+}
+
+/// The axis of a joint in its child's frame, as the rotation about it is
+/// computed: a coordinate axis (`±x`, `±y`, `±z`) turns two columns of the
+/// frame in place; any other axis by Rodrigues' formula.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum AxisKind {
+    /// `sign·e_k` (`k` 0–2).
+    Coordinate { k: usize, sign: f64 },
+    /// Any other unit axis.
+    General(Vector3<f64>),
+}
+
+/// A joint's fixed origin rotation `O`, as `F = R_parent·O` is computed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum FixedRotation {
+    /// `O = I` (to 1e-15): `F = R_parent`.
+    Identity,
+    /// `O` a signed permutation (to 1e-15; a D-H `α` of ±90°, an axis
+    /// swap): column `i` of `F` is `sign[i]` times column `from[i]` of
+    /// `R_parent`.
+    Permutation { from: [usize; 3], sign: [f64; 3] },
+    /// Any other rotation.
+    General(Matrix3<f64>),
+}
+
+impl FixedRotation {
+    fn of(r: &Matrix3<f64>) -> Self {
+        let tol = 1e-15;
+        let mut from = [0; 3];
+        let mut sign = [0.0; 3];
+        for i in 0..3 {
+            let col = r.column(i);
+            let Some(k) = (0..3).find(|&k| (col[k].abs() - 1.0).abs() <= tol) else {
+                return Self::General(*r);
+            };
+            if (0..3).any(|m| m != k && col[m].abs() > tol) {
+                return Self::General(*r);
+            }
+            from[i] = k;
+            sign[i] = col[k].signum();
+        }
+        if from == [0, 1, 2] && sign == [1.0; 3] {
+            Self::Identity
+        } else {
+            Self::Permutation { from, sign }
+        }
+    }
+
+    /// `R_parent·O`.
+    #[inline]
+    fn apply(&self, rp: &Matrix3<f64>) -> Matrix3<f64> {
+        match self {
+            Self::Identity => *rp,
+            Self::Permutation { from, sign } => Matrix3::from_columns(&[
+                sign[0] * rp.column(from[0]),
+                sign[1] * rp.column(from[1]),
+                sign[2] * rp.column(from[2]),
+            ]),
+            Self::General(r) => rp * r,
+        }
+    }
+}
+
+/// One joint's constants (made once from the model by [`TreeKin::new`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct JointConst {
+    parent: usize,
+    child: usize,
+    /// The child's frame in the parent's at zero angle: rotation and
+    /// translation.
+    rotation: FixedRotation,
+    translation: Vector3<f64>,
+    axis: AxisKind,
+}
+
+impl JointConst {
+    fn of(joint: &fbd_robot::Joint) -> Self {
+        let r = joint.origin.rotation.to_rotation_matrix().into_inner();
+        let u = joint.axis.into_inner();
+        let axis = (0..3)
+            .find_map(|k| {
+                let mut e = Vector3::zeros();
+                e[k] = 1.0;
+                if u == e {
+                    Some(AxisKind::Coordinate { k, sign: 1.0 })
+                } else if u == -e {
+                    Some(AxisKind::Coordinate { k, sign: -1.0 })
+                } else {
+                    None
+                }
+            })
+            .unwrap_or(AxisKind::General(u));
+        Self {
+            parent: joint.parent,
+            child: joint.child,
+            rotation: FixedRotation::of(&r),
+            translation: joint.origin.translation.vector,
+            axis,
+        }
+    }
+
+    /// The child's rotation `F·T(θ)` and the joint's axis `F·u`, with
+    /// `F` the parent's rotation times the fixed origin rotation and
+    /// `T(θ)` the turn by `θ` about `u`.
+    #[inline]
+    fn turn(&self, f: &Matrix3<f64>, theta: f64) -> (Matrix3<f64>, Vector3<f64>) {
+        match self.axis {
+            AxisKind::Coordinate { k, sign } => {
+                let (s, c) = (sign * theta).sin_cos();
+                // T turns column a towards column b, (a, b, k) cyclic; the
+                // columns are named, not indexed, so that the result stays
+                // in registers.
+                let [f0, f1, f2] = [0, 1, 2].map(|i| f.column(i).into_owned());
+                let turn = |fa: Vector3<f64>, fb: Vector3<f64>| (c * fa + s * fb, c * fb - s * fa);
+                let (cols, axis) = match k {
+                    0 => {
+                        let (a, b) = turn(f1, f2);
+                        ([f0, a, b], f0)
+                    }
+                    1 => {
+                        let (a, b) = turn(f2, f0);
+                        ([b, f1, a], f1)
+                    }
+                    _ => {
+                        let (a, b) = turn(f0, f1);
+                        ([a, b, f2], f2)
+                    }
+                };
+                (Matrix3::from_columns(&cols), sign * axis)
+            }
+            AxisKind::General(u) => {
+                let (s, c) = theta.sin_cos();
+                let k = u.cross_matrix();
+                let t = Matrix3::identity() + s * k + (1.0 - c) * (k * k);
+                (f * t, f * u)
+            }
+        }
+    }
 }
 
 impl TreeKin {
@@ -138,6 +283,9 @@ impl TreeKin {
             contact_radius: model.contacts.iter().map(|c| c.radius).collect(),
             phi_axes: [Vector3::x(), Vector3::y(), Vector3::z()],
             contact_body: model.contacts.iter().map(|c| c.body).collect(),
+            joints: model.joints.iter().map(JointConst::of).collect(),
+            body_com: model.bodies.iter().map(|b| b.com).collect(),
+            contact_local: model.contacts.iter().map(|c| c.position).collect(),
         }
     }
 
@@ -183,22 +331,33 @@ impl TreeKin {
         ];
         self.origin[0] = pose.position;
         self.rotation[0] = rot;
-        for (j, joint) in model.joints.iter().enumerate() {
-            let (p, c) = (joint.parent, joint.child);
-            let rp = self.rotation[p];
-            let fixed = rp * joint.origin.rotation.to_rotation_matrix().into_inner();
-            let turn = Rotation3::from_axis_angle(&joint.axis, q[BASE_DOF + j]).into_inner();
-            let o = self.origin[p] + rp * joint.origin.translation.vector;
-            self.rotation[c] = fixed * turn;
+        for ((jc, &theta), (axis, joint_origin)) in self
+            .joints
+            .iter()
+            .zip(&q[BASE_DOF..])
+            .zip(self.axis.iter_mut().zip(self.joint_origin.iter_mut()))
+        {
+            let (p, c) = (jc.parent, jc.child);
+            let rp = &self.rotation[p];
+            let o = self.origin[p] + rp * jc.translation;
+            let (rc, u) = jc.turn(&jc.rotation.apply(rp), theta);
+            self.rotation[c] = rc;
             self.origin[c] = o;
-            self.axis[j] = fixed * joint.axis.into_inner();
-            self.joint_origin[j] = o;
+            *axis = u;
+            *joint_origin = o;
         }
-        for (b, body) in model.bodies.iter().enumerate() {
-            self.com[b] = self.origin[b] + self.rotation[b] * body.com;
+        for (((com, local), o), r) in self
+            .com
+            .iter_mut()
+            .zip(&self.body_com)
+            .zip(&self.origin)
+            .zip(&self.rotation)
+        {
+            *com = o + r * local;
         }
-        for (k, c) in model.contacts.iter().enumerate() {
-            let centre = self.origin[c.body] + self.rotation[c.body] * c.position;
+        for (k, local) in self.contact_local.iter().enumerate() {
+            let b = self.contact_body[k];
+            let centre = self.origin[b] + self.rotation[b] * local;
             self.contact_center[k] = centre;
             self.contact[k] = Vector3::new(centre.x, centre.y - self.contact_radius[k], centre.z);
         }
@@ -308,6 +467,35 @@ impl<'a> Columns<'a> {
                     (BASE_DOF + j, kin.axis[j])
                 }
             },
+        }
+    }
+
+    /// Calls `f(q index, column)` for every column, in increasing `q`
+    /// index (as [`Self::iter`], without its per-column dispatch).
+    #[inline]
+    pub fn for_each(&self, mut f: impl FnMut(usize, Vector3<f64>)) {
+        let kin = self.kin;
+        match self.point {
+            Some(p) => {
+                f(0, Vector3::x());
+                f(1, Vector3::y());
+                f(2, Vector3::z());
+                let r = p - kin.origin[0];
+                for (k, a) in kin.phi_axes.iter().enumerate() {
+                    f(PHI + k, a.cross(&r));
+                }
+                for &j in self.joints {
+                    f(BASE_DOF + j, kin.axis[j].cross(&(p - kin.joint_origin[j])));
+                }
+            }
+            None => {
+                for (k, a) in kin.phi_axes.iter().enumerate() {
+                    f(PHI + k, *a);
+                }
+                for &j in self.joints {
+                    f(BASE_DOF + j, kin.axis[j]);
+                }
+            }
         }
     }
 

@@ -20,7 +20,7 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use fbd_dynamics::spatial::{eval, pattern};
+use fbd_dynamics::tree::assemble::{eval, pattern};
 use fbd_dynamics::{JacobianSink, NoJacobian};
 use fbd_scenario::Config;
 use fbd_sim::spatial::{SpatialData, SpatialModel, step};
@@ -60,7 +60,7 @@ fn bench(c: &mut Criterion) {
 
     // Assembly at a standing state (all feet sticking).
     let mut data = warmed(&stand, 500);
-    let n = stand.mech.layout().dim();
+    let n = stand.mech.dims().dim();
     let z = data.z.clone();
     // Two iterates, alternated, so that every evaluation computes the
     // kinematics (an evaluation at the same q reuses them).
@@ -150,7 +150,7 @@ fn bench(c: &mut Criterion) {
             let mut sys = fbd_sim::spatial::step::system_for_bench(model, &mut data);
             solver.load_jacobian(&mut sys, &z);
         }
-        println!("{name}: {} unknowns", model.mech.layout().dim());
+        println!("{name}: {} unknowns", model.mech.dims().dim());
         c.bench_function(&format!("spatial/numeric_lu_{name}"), |b| {
             b.iter(|| solver.factorize_loaded(None).expect("factorisation"))
         });
@@ -166,7 +166,13 @@ fn bench(c: &mut Criterion) {
     // The inertia limit of the walk's gains, (kp·Δt² + 2·kd·Δt)/4.
     let limit = 0.25 * (1000.0 * 1e-6 + 2.0 * 15.0 * 1e-3);
     c.bench_function("spatial/stability_check_walk", |b| {
-        b.iter(|| fbd_sim::spatial::modes_slower_than(black_box(&walk_params), &walk.mech, limit))
+        b.iter(|| {
+            fbd_sim::spatial::modes_slower_than(
+                black_box(&walk_params),
+                &fbd_sim::spatial::closed_form(&walk_params),
+                limit,
+            )
+        })
     });
 
     // One whole step, standing, walking, and landing (the passive drop:

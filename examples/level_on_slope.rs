@@ -29,7 +29,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     params.duration = 1.5;
     let mu = params.friction.mu_static;
     let model = SpatialModel::new(&params)?;
-    let legs = model.mech.legs.clone();
+    let legs = model.legs.clone();
     // γ of each leg (SPEC §1.2): the hip at (d·cos γ, 0, −d·sin γ) in
     // body axes, +x to the right.
     let gamma = [120.0f64, 60.0, 180.0, 0.0, 240.0, 300.0];

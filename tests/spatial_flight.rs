@@ -8,7 +8,7 @@ use fbd_contact::{Surface, Terrain};
 use fbd_dynamics::spatial::SpatialKin;
 use fbd_kinematics::JointLimits;
 use fbd_kinematics::nalgebra::Vector3;
-use fbd_sim::spatial::{SpatialModel, SpatialParams, run_collect, run_until};
+use fbd_sim::spatial::{SpatialModel, SpatialParams, closed_form, run_collect, run_until};
 use std::sync::atomic::AtomicBool;
 
 mod common;
@@ -37,13 +37,14 @@ fn tumbling(dt: f64, duration: f64, gravity: f64) -> SpatialParams {
     p
 }
 
+/// The centre of mass from the closed-form hexapod (an independent
+/// reference for the generic tree kinematics the model steps on).
 fn com(model: &SpatialModel, q: &[f64]) -> Vector3<f64> {
-    let mut kin = SpatialKin::new(&model.mech);
-    kin.eval(&model.mech, q);
-    let m = model.mech.total_mass();
-    model
-        .mech
-        .bodies
+    let mech = closed_form(&model.params);
+    let mut kin = SpatialKin::new(&mech);
+    kin.eval(&mech, q);
+    let m = mech.total_mass();
+    mech.bodies
         .iter()
         .zip(&kin.com)
         .map(|(b, c)| b.mass * c)

@@ -11,7 +11,7 @@ use common::spatial::stance;
 use fbd_contact::spatial::{clearance, frame};
 use fbd_contact::{Friction, Surface, Terrain};
 use fbd_dynamics::spatial::SpatialKin;
-use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_collect};
+use fbd_sim::spatial::{SpatialModel, SpatialRecord, closed_form, run_collect};
 
 /// Checks the law on every contact row; returns (sticking, sliding) rows.
 /// `(sticking rows, sliding rows, sliding rows aligned with their slip,
@@ -137,13 +137,9 @@ fn on_slope(mu: f64) -> (SpatialModel, Vec<SpatialRecord>) {
     // The body parallel to the slope (rolled about Z by the slope angle).
     p.q0[5] = 10f64.to_radians();
     // … until its lowest foot is 1 mm above the slope.
-    let probe = SpatialModel::new(&SpatialParams {
-        terrain: Surface::new(Terrain::None, 0.0),
-        ..p.clone()
-    })
-    .unwrap();
-    let mut kin = SpatialKin::new(&probe.mech);
-    kin.eval(&probe.mech, &p.q0);
+    let hexapod = closed_form(&p);
+    let mut kin = SpatialKin::new(&hexapod);
+    kin.eval(&hexapod, &p.q0);
     let lowest = kin
         .fk
         .legs

@@ -11,7 +11,7 @@ use common::spatial::stance;
 use fbd_contact::spatial::{clearance, frame};
 use fbd_contact::{Friction, FrictionPatch, HeightGrid, StateCode, Surface, Terrain, friction_at};
 use fbd_dynamics::spatial::SpatialKin;
-use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, run_collect};
+use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, closed_form, run_collect};
 
 /// A 4 m × 4 m height map of the plane `y = slope·x` (81 × 61 samples).
 fn plane_map(slope: f64) -> Surface {
@@ -33,13 +33,9 @@ fn on(
     p.terrain = surface;
     p.friction = friction;
     p.q0[5] = angle;
-    let probe = SpatialModel::new(&SpatialParams {
-        terrain: Surface::new(Terrain::None, 0.0),
-        ..p.clone()
-    })
-    .unwrap();
-    let mut kin = SpatialKin::new(&probe.mech);
-    kin.eval(&probe.mech, &p.q0);
+    let hexapod = closed_form(&p);
+    let mut kin = SpatialKin::new(&hexapod);
+    kin.eval(&hexapod, &p.q0);
     let lowest = kin
         .fk
         .legs
@@ -221,13 +217,9 @@ fn a_friction_patch_makes_the_stance_slide_where_it_lies() {
 fn a_fall_onto_a_bump_touches_down_at_the_free_fall_time() {
     let mut p = stance();
     p.duration = 0.3;
-    let probe = SpatialModel::new(&SpatialParams {
-        terrain: Surface::new(Terrain::None, 0.0),
-        ..p.clone()
-    })
-    .unwrap();
-    let mut kin = SpatialKin::new(&probe.mech);
-    kin.eval(&probe.mech, &p.q0);
+    let hexapod = closed_form(&p);
+    let mut kin = SpatialKin::new(&hexapod);
+    kin.eval(&hexapod, &p.q0);
     let foot1 = kin.fk.legs[0].tip;
     let (xf, zf) = (foot1.x, foot1.z);
     let bump = move |x: f64, z: f64| {

@@ -3,13 +3,10 @@
 //!
 //! * on the paper's hexapod, the mechanism built from the generic model
 //!   ([`fbd_scenario::robot::hexapod_robot`], the two-axis hip a compound
-//!   joint) has the spatial hexapod's layout of unknowns and equations, and
-//!   its residual and analytic Jacobian equal the hexapod-specific
-//!   [`fbd_dynamics::spatial`] assembly's (1e-10 relative) at random
-//!   states: tumbling base, random joint angles, iterates and forces, every
-//!   contact state (free, sticking at an anchor, sliding; fixed-state and
-//!   complementarity rows), stops free and at an end, the first step and a
-//!   later one;
+//!   joint; the model the 3D simulator steps) has the closed-form
+//!   hexapod's bodies, reactions, contact points and stops in the layout
+//!   of its output columns (its analytic Jacobian against central
+//!   differences: `crates/fbd/tests/hexapod_jacobian.rs`);
 //! * on the lab hexapod URDF (no compound joint: every joint a reaction of
 //!   3 forces and 2 constraint moments), the analytic Jacobian against
 //!   central differences of the residual through the shared checker
@@ -25,14 +22,14 @@ use std::path::Path;
 
 use fbd_contact::spatial::frame;
 use fbd_contact::{SpatialState, Surface, Terrain};
-use fbd_dynamics::spatial::{self, SpatialContactEquation, SpatialFbdData, SpatialMechanism};
+use fbd_dynamics::spatial::{SpatialContactEquation, SpatialMechanism};
 use fbd_dynamics::tree::assemble as tree;
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism, contacts_by_kind};
 use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
 use fbd_kinematics::LimitSide;
 use fbd_kinematics::fd::{FdTolerance, check_jacobian};
 use fbd_robot::{ContactChoice, RobotModel, Up};
-use fbd_sim::spatial::{SpatialModel, SpatialParams};
+use fbd_sim::spatial::SpatialParams;
 
 struct Dense<'a> {
     n: usize,
@@ -61,28 +58,10 @@ impl Rng {
 /// parameters, and the tree mechanism of the same parameters' robot model.
 fn both() -> (SpatialMechanism, TreeMechanism) {
     let params = SpatialParams::default();
-    let spatial = SpatialModel::new(&params).expect("default parameters").mech;
+    let spatial = fbd_sim::spatial::closed_form(&params);
     let model = fbd_scenario::robot::hexapod_robot(&params);
     let tree = TreeMechanism::with_contacts(&model, params.gravity, &contacts_by_kind(&model));
     (spatial, tree)
-}
-
-/// A random configuration near the standing pose: base tilted and
-/// turned, every joint different.
-fn random_q(rng: &mut Rng, legs: usize) -> Vec<f64> {
-    let mut q = vec![0.0; 6 + 3 * legs];
-    q[0] = 0.2 * rng.next();
-    q[1] = 0.4 + 0.1 * rng.next();
-    q[2] = 0.2 * rng.next();
-    for v in &mut q[3..6] {
-        *v = 0.5 * rng.next();
-    }
-    for s in 0..legs {
-        q[6 + 3 * s] = 0.6 * rng.next();
-        q[7 + 3 * s] = -0.3 + 0.5 * rng.next();
-        q[8 + 3 * s] = 4.3 + 0.4 * rng.next();
-    }
-    q
 }
 
 /// `q` moved a little (a step's worth) at random.
@@ -124,201 +103,9 @@ fn contact_equation(
     }
 }
 
-/// Entry by entry within `tol` of the row's scale.
-fn assert_close(what: &str, a: &[f64], b: &[f64], scale: &[f64], tol: f64) {
-    assert_eq!(a.len(), b.len());
-    let mut worst = (0.0, 0);
-    for i in 0..a.len() {
-        let e = (a[i] - b[i]).abs() / scale[i].max(1e-300);
-        if e > worst.0 {
-            worst = (e, i);
-        }
-    }
-    let i = worst.1;
-    assert!(
-        worst.0 <= tol,
-        "{what}: entry {i}: {} vs {} (relative {:e})",
-        a[i],
-        b[i],
-        worst.0
-    );
-}
-
-/// One random state driven through both assemblies with the same calls.
-fn compare_once(seed: u64, surface: &Surface, first_step: bool, complementarity: bool) {
-    let (sm, tm) = both();
-    let lay = sm.layout();
-    let n = lay.dim();
-    let legs = sm.legs.len();
-    let mut rng = Rng(seed);
-    let mut sd = SpatialFbdData::new(&sm);
-    let mut td = TreeFbdData::new(&tm);
-    let q_k = random_q(&mut rng, legs);
-    let q_prev = near(&mut rng, &q_k, 0.01);
-    let q_next = near(&mut rng, &q_k, 0.01);
-    spatial::set_previous(&sm, &mut sd, &q_prev);
-    tree::set_previous(&tm, &mut td, &q_prev);
-    spatial::set_configuration(&sm, &mut sd, &q_k);
-    tree::set_configuration(&tm, &mut td, &q_k);
-    let qdot: Vec<f64> = (0..lay.nq).map(|_| 2.0 * rng.next()).collect();
-    let history = || {
-        if first_step {
-            History::Initial { qdot: &qdot }
-        } else {
-            History::Previous
-        }
-    };
-    let dt = 0.002;
-    spatial::prepare_step(&sm, &mut sd, history(), dt);
-    tree::prepare_step(&tm, &mut td, history(), dt);
-    for s in 0..legs {
-        for j in 0..3 {
-            let t = 5.0 * rng.next();
-            sd.torque[s][j] = t;
-            td.torque[3 * s + j] = t;
-        }
-    }
-    for c in 0..lay.contacts {
-        let eq = contact_equation(&mut rng, surface, c, complementarity);
-        sd.contact[c] = eq;
-        td.contact[c] = eq;
-    }
-    for l in 0..lay.limits {
-        let eq = if l % 3 == 1 {
-            LimitEquation::default()
-        } else {
-            LimitEquation {
-                state: LimitState::At {
-                    side: if l % 2 == 0 {
-                        LimitSide::Lower
-                    } else {
-                        LimitSide::Upper
-                    },
-                    angle: q_k[tm.limits[l].q_index] + 0.01 * rng.next(),
-                },
-                regularization: 1e-3,
-                complementarity,
-            }
-        };
-        sd.limit[l] = eq;
-        td.limit[l] = eq;
-    }
-    let mut z: Vec<f64> = (0..n).map(|_| 50.0 * rng.next()).collect();
-    z[..lay.nq].copy_from_slice(&q_next);
-    if complementarity {
-        for c in (0..lay.contacts).step_by(2) {
-            z[lay.contact_force(c, 1)] = 2e6 * (1.0 + rng.next().abs());
-        }
-    }
-    let (mut rs, mut rt) = (vec![0.0; n], vec![0.0; n]);
-    let (mut js, mut jt) = (vec![0.0; n * n], vec![0.0; n * n]);
-    spatial::eval(
-        &sm,
-        surface,
-        &mut sd,
-        &z,
-        &mut rs,
-        &mut Dense { n, m: &mut js },
-    );
-    tree::eval(
-        &tm,
-        surface,
-        &mut td,
-        &z,
-        &mut rt,
-        &mut Dense { n, m: &mut jt },
-    );
-    // Row scales: the size of the terms each row is a sum of.
-    let mut r_scale = vec![0.0; n];
-    for i in 0..n {
-        r_scale[i] = rs[i].abs() + (0..n).map(|j| (js[i * n + j] * z[j]).abs()).sum::<f64>();
-    }
-    let what = format!("seed {seed}, first {first_step}, complementarity {complementarity}");
-    assert_close(&format!("residual ({what})"), &rt, &rs, &r_scale, 1e-10);
-    let mut j_scale = vec![0.0; n * n];
-    for i in 0..n {
-        let m = (0..n).map(|j| js[i * n + j].abs()).fold(0.0, f64::max);
-        j_scale[i * n..(i + 1) * n].fill(m.max(1e-12));
-    }
-    assert_close(&format!("Jacobian ({what})"), &jt, &js, &j_scale, 1e-10);
-    // The same branches of the complementarity rows (their numbers agree
-    // to round-off, checked through the rows above).
-    let flags = |b: &[fbd_dynamics::rows::Branch]| -> Vec<(bool, bool)> {
-        b.iter().map(|b| (b.unloaded, b.sliding)).collect()
-    };
-    assert_eq!(
-        flags(&sd.branch),
-        flags(&td.branch),
-        "complementarity branches ({what})"
-    );
-    assert_eq!(sd.limit_unloaded, td.limit_unloaded, "stops ({what})");
-    assert_eq!(spatial::pattern_key(&sd), tree::pattern_key(&td));
-    let (mut ps, mut pt) = (Vec::new(), Vec::new());
-    spatial::pattern(&sm, &sd, &mut ps);
-    tree::pattern(&tm, &td, &mut pt);
-    ps.sort_unstable();
-    ps.dedup();
-    pt.sort_unstable();
-    pt.dedup();
-    assert_eq!(ps, pt, "sparsity patterns ({what})");
-    // Residual-only evaluations agree as well.
-    spatial::eval(&sm, surface, &mut sd, &z, &mut rs, &mut NoJacobian);
-    tree::eval(&tm, surface, &mut td, &z, &mut rt, &mut NoJacobian);
-    assert_close(
-        &format!("residual only ({what})"),
-        &rt,
-        &rs,
-        &r_scale,
-        1e-10,
-    );
-
-    // Accept the iterate and take the next step: the carried state agrees.
-    spatial::evaluate_next(&sm, &mut sd, &q_next);
-    tree::evaluate_next(&tm, &mut td, &q_next);
-    spatial::advance(&mut sd);
-    tree::advance(&mut td);
-    spatial::prepare_step(&sm, &mut sd, History::Previous, dt);
-    tree::prepare_step(&tm, &mut td, History::Previous, dt);
-    z[..lay.nq].copy_from_slice(&near(&mut rng, &q_next, 0.01));
-    js.fill(0.0);
-    jt.fill(0.0);
-    spatial::eval(
-        &sm,
-        surface,
-        &mut sd,
-        &z,
-        &mut rs,
-        &mut Dense { n, m: &mut js },
-    );
-    tree::eval(
-        &tm,
-        surface,
-        &mut td,
-        &z,
-        &mut rt,
-        &mut Dense { n, m: &mut jt },
-    );
-    for i in 0..n {
-        r_scale[i] = rs[i].abs() + (0..n).map(|j| (js[i * n + j] * z[j]).abs()).sum::<f64>();
-        let m = (0..n).map(|j| js[i * n + j].abs()).fold(0.0, f64::max);
-        j_scale[i * n..(i + 1) * n].fill(m.max(1e-12));
-    }
-    assert_close(
-        &format!("next residual ({what})"),
-        &rt,
-        &rs,
-        &r_scale,
-        1e-10,
-    );
-    assert_close(
-        &format!("next Jacobian ({what})"),
-        &jt,
-        &js,
-        &j_scale,
-        1e-10,
-    );
-}
-
+/// The mechanism the 3D simulator steps (the D-H instance) has the closed-
+/// form hexapod's bodies, masses, reactions, contact points (in the order
+/// of the output columns) and stops, and the `q` layout of SPEC §1.2.
 #[test]
 fn hexapod_layout_is_the_spatial_models() {
     let (sm, tm) = both();
@@ -350,23 +137,6 @@ fn hexapod_layout_is_the_spatial_models() {
     let sq: Vec<usize> = sm.limits.iter().map(|l| l.q_index).collect();
     assert_eq!(lq, sq);
     assert!((tm.length_scale() - sm.length_scale()).abs() < 1e-14);
-}
-
-#[test]
-fn hexapod_equations_equal_the_spatial_models_at_random_states() {
-    let slope = Surface::new(
-        Terrain::Slope {
-            slope: 0.2,
-            height: 0.05,
-        },
-        0.6,
-    );
-    for seed in 1..=4 {
-        for (surface, first) in [(&Surface::default(), false), (&slope, true)] {
-            compare_once(seed, surface, first, false);
-            compare_once(seed + 100, surface, !first, true);
-        }
-    }
 }
 
 fn lab() -> RobotModel {
@@ -565,7 +335,7 @@ fn momenta(
         let v = body.mass * (c1 - c0) / dt;
         p += v;
         h += c0.cross(&v)
-            + spatial::half_momentum_value(
+            + fbd_dynamics::spatial::half_momentum_value(
                 &data.kin.rotation[b],
                 &data.kin_next.rotation[b],
                 &body.inertia,

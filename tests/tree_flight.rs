@@ -2,9 +2,11 @@
 //!
 //! * on the paper's hexapod built as a generic robot model
 //!   ([`fbd_scenario::robot::hexapod_robot`]), a passive tumbling flight
-//!   reproduces the spatial hexapod engine's ([`fbd_sim::spatial`]) step by
-//!   step: every coordinate and every hip and knee reaction force (matched
-//!   by joint name) agree to the solver's tolerance;
+//!   of the generic robot run reproduces the hexapod's run
+//!   ([`fbd_sim::spatial`]: the same equations, with the hexapod's own
+//!   parameters, controller and record around them) step by step: every
+//!   coordinate and every hip and knee reaction force (matched by joint
+//!   name) agree to the solver's tolerance;
 //! * the lab hexapod URDF in passive flight keeps the discrete momentum
 //!   laws (linear momentum changes by exactly `−M·g·Δt` a step, the
 //!   angular momentum about the centre of mass is conserved), its centre

@@ -1,6 +1,6 @@
 //! Fixtures of the spatial (3D) tests.
 
-use fbd_dynamics::spatial::SpatialKin;
+use fbd_dynamics::tree::kin::TreeKin;
 use fbd_sim::spatial::{SpatialControl, SpatialModel, SpatialParams};
 
 /// A PD-held stance with the feet on the ground at t = 0.
@@ -25,9 +25,10 @@ pub fn stance() -> SpatialParams {
         ..p.clone()
     })
     .unwrap();
-    let mut kin = SpatialKin::new(&model.mech);
-    kin.eval(&model.mech, &p.q0);
-    let tip_y = kin.fk.legs[0].tip.y;
+    let mut kin = TreeKin::new(&model.mech.model);
+    kin.eval(&model.mech.model, &p.q0);
+    // Contact 0 is leg 1's tip.
+    let tip_y = kin.contact[model.mech.contacts[0].model_contact].y;
     p.q0[1] = -tip_y;
     p
 }

@@ -16,7 +16,7 @@
 //! **Slip direction.** Friction opposes the point's slip over the step,
 //! `s = (p[k+1] − p[k])·(t1, t2)`: the equations take `Ft = −μD·N·ŝ`
 //! with `ŝ = s/|s|` an implicit function of the step's unknowns (see
-//! `fbd_dynamics::spatial::assemble::slip_direction`), so a slide may turn
+//! `fbd_dynamics::spatial::slip_direction`), so a slide may turn
 //! freely. The state keeps a reference direction `û`: on ST2 → ST3 the
 //! opposite of the tangential force sticking needed (`û = −Ft/|Ft|`:
 //! friction keeps the force's direction, as in the plane), afterwards the

@@ -40,19 +40,22 @@
 //! ## One assembly, two models
 //! The residual and its Jacobian are written once, in [`assembly`], over a
 //! [`space::Space`] (the plane or space) and a model ([`assembly::FbdModel`]):
-//! the planar mechanism ([`assemble`]) and the spatial hexapod ([`spatial`])
+//! the planar mechanism ([`assemble`]) and any robot in space ([`tree`])
 //! supply their kinematics, joint reactions and rotation rows; loads,
 //! Newton–Euler rows, contact and stop rows ([`rows`]) and every force
 //! column of the Jacobian are shared.
 //!
-//! ## Any robot
-//! [`tree`] writes the same per-body balances for any
-//! [`fbd_robot::RobotModel`] (an imported URDF/MJCF robot or a D-H
-//! instance): inverse dynamics body by body, every joint's force, moment and
+//! ## Any robot in space
+//! [`tree`] writes the per-body balances of any [`fbd_robot::RobotModel`]:
+//! an imported URDF/MJCF robot, or a D-H instance such as the paper's
+//! 24-DOF hexapod (`fbd_robot::dh::hexapod`, the model the 3D simulator
+//! steps): inverse dynamics body by body, every joint's force, moment and
 //! torque explicit ([`tree::inverse`]); the kinematics with analytic
-//! Jacobians ([`tree::kin`]); and the step's residual and Jacobian as one
-//! more [`assembly::FbdModel`] ([`tree::mechanism`], [`tree::assemble`]),
-//! equal to the 3D hexapod's for the hexapod built from its D-H rows.
+//! Jacobians ([`tree::kin`]); and the step's residual and Jacobian as an
+//! [`assembly::FbdModel`] ([`tree::mechanism`], [`tree::assemble`]).
+//! [`spatial`] holds the pieces of the 3D equations (the rotation scheme,
+//! the slip direction) and the hexapod in closed form, an independent
+//! reference for the tests and the controller's stability check.
 
 pub mod assemble;
 pub mod assembly;

@@ -303,7 +303,7 @@ fn coordinate_names(plant: &Plant) -> Vec<String> {
             let mut v: Vec<String> = ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"]
                 .map(String::from)
                 .to_vec();
-            for leg in &m.mech.legs {
+            for leg in &m.legs {
                 for j in 1..=3 {
                     v.push(format!("theta{j}_{leg}"));
                 }

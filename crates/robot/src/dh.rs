@@ -126,6 +126,8 @@ pub struct HexapodLayout {
     pub legs: Vec<usize>,
     /// Limits of `(θ1, θ2, θ3)` (`None`: continuous). Default none.
     pub limits: [Option<JointLimits>; 3],
+    /// Tips (feet) are contact points. Default true.
+    pub tips: bool,
     /// Knees are contact points. Default true.
     pub knees: bool,
     /// Hips are contact points. Default true.
@@ -137,6 +139,7 @@ impl Default for HexapodLayout {
         Self {
             legs: (1..=6).collect(),
             limits: [None; 3],
+            tips: true,
             knees: true,
             hips: true,
         }
@@ -254,9 +257,11 @@ pub fn hexapod(
             position,
             radius: 0.0,
         };
-        model
-            .contacts
-            .push(point(format!("tip{n}"), bodies[2], end.translation.vector));
+        if layout.tips {
+            model
+                .contacts
+                .push(point(format!("tip{n}"), bodies[2], end.translation.vector));
+        }
         if layout.knees {
             model
                 .contacts

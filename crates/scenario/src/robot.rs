@@ -1218,36 +1218,7 @@ impl LoadedRobot {
 /// parameters ([`fbd_robot::dh::hexapod`]): the same geometry, masses,
 /// inertias, legs, joint limits and contact points.
 pub fn hexapod_robot(p: &fbd_sim::spatial::SpatialParams) -> RobotModel {
-    use fbd_robot::JointLimits;
-    use fbd_robot::dh::{HexapodLayout, HexapodMasses, hexapod};
-    let geometry = fbd_kinematics::hexapod::HexapodModel::new(
-        p.side,
-        fbd_kinematics::leg::LegGeometry {
-            a: p.upper_length,
-            c: p.lower_length,
-        },
-        p.upper_com,
-        p.lower_com,
-    );
-    let masses = HexapodMasses {
-        body_mass: p.body_mass,
-        body_inertia: p.body_inertia,
-        upper_mass: p.upper_mass,
-        upper_radius: p.upper_radius,
-        upper_inertia: p.upper_inertia,
-        lower_mass: p.lower_mass,
-        lower_radius: p.lower_radius,
-        lower_inertia: p.lower_inertia,
-    };
-    let l = &p.joint_limits;
-    let limit = |[lower, upper]: [f64; 2]| Some(JointLimits { lower, upper });
-    let layout = HexapodLayout {
-        legs: p.legs.clone(),
-        limits: [limit(l.theta1), limit(l.theta2), limit(l.theta3)],
-        knees: p.contact_points.knees,
-        hips: p.contact_points.hips,
-    };
-    hexapod(&geometry, &masses, &layout)
+    p.robot_model()
 }
 
 /// A recorded motion of an imported robot (`fbd inverse --motion`): times,

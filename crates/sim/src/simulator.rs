@@ -478,12 +478,12 @@ impl Plant for SpatialModel {
         RunData::<SpatialModel>::new(self)
     }
     fn joint_indices(&self) -> Vec<usize> {
-        (0..self.mech.legs.len())
+        (0..self.legs.len())
             .flat_map(|s| (0..3).map(move |j| fbd_dynamics::spatial::q_joint(s, j)))
             .collect()
     }
     fn set_torques(&self, data: &mut RunData<Self>, tau: &[f64]) {
-        let legs = self.mech.legs.len();
+        let legs = self.legs.len();
         let t = data
             .external_torque
             .get_or_insert_with(|| vec![[0.0; 3]; legs]);
@@ -495,14 +495,17 @@ impl Plant for SpatialModel {
         let dt = SpatialModel::dt(self);
         let moved = data.k > 0;
         let (kin, prev) = (&data.fbd.kin, &data.fbd.kin_prev);
-        out.bodies.resize(kin.com.len(), BodyReadout::default());
-        for (b, body) in out.bodies.iter_mut().enumerate() {
-            let r = kin.rot[b];
+        out.bodies
+            .resize(self.mech.bodies.len(), BodyReadout::default());
+        for (body, spec) in out.bodies.iter_mut().zip(&self.mech.bodies) {
+            let b = spec.model_body;
+            let r = kin.rotation[b];
             body.position = [kin.com[b].x, kin.com[b].y, kin.com[b].z];
             body.rotation = std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]));
             if moved {
                 let v = (kin.com[b] - prev.com[b]) / dt;
-                let w = r * fbd_dynamics::spatial::so3::log(&(prev.rot[b].transpose() * r)) / dt;
+                let w =
+                    r * fbd_dynamics::spatial::so3::log(&(prev.rotation[b].transpose() * r)) / dt;
                 body.velocity = [v.x, v.y, v.z];
                 body.angular_velocity = [w.x, w.y, w.z];
             } else {
@@ -525,13 +528,14 @@ impl Plant for SpatialModel {
             };
         }
         out.contacts
-            .resize(self.mech.contacts.len(), ContactReadout::default());
-        for (c, spec) in self.mech.contacts.iter().enumerate() {
-            let p = kin.point(&self.mech, spec.point / 3, spec.kind);
+            .resize(self.contacts.len(), ContactReadout::default());
+        for (c, spec) in self.contacts.iter().enumerate() {
+            let mc = self.mech.contacts[c].model_contact;
+            let p = kin.contact[mc];
             let p = [p.x, p.y, p.z];
             let normal = self.params.terrain.normal(p[0], p[2]);
             let before = moved.then(|| {
-                let q = prev.point(&self.mech, spec.point / 3, spec.kind);
+                let q = prev.contact[mc];
                 [q.x, q.y, q.z]
             });
             let row = &rec.contacts[c];

@@ -1,5 +1,12 @@
 //! # The spatial (3D) FBD equations of the hexapod
 //!
+//! The equations are assembled for every robot by [`crate::tree`] (the
+//! hexapod is its D-H instance, `fbd_robot::dh::hexapod`); this module
+//! holds their 3D pieces ([`equations`], [`so3`]) and the hexapod in closed
+//! form ([`mechanism`], [`kin`]: the bodies of the paper's legs on the leg
+//! kinematics of `fbd_kinematics::hexapod`), an independent reference for
+//! the tests and the joint controller's stability check.
+//!
 //! The paper's method, extended from its planar two-leg model to the
 //! 24-DOF hexapod: every rigid body is isolated and its six Newton–Euler
 //! equations are written in the inertial frame with every force explicit.
@@ -56,18 +63,17 @@
 //! `K·(p − a) + β·F = 0` (3 rows, inertial); ST3 `Ft1 + μD·ŝ1·N = 0`,
 //! `K·(p_y − ϱ(p_x, p_z)) + β·N = 0`, `Ft2 + μD·ŝ2·N = 0` with `ŝ` the
 //! unit direction of the point's slip over the step, an implicit function
-//! of `q[k+1]` ([`assemble::slip_direction`]). Joint limits as in the planar model, the stop
+//! of `q[k+1]` ([`equations::slip_direction`]). Joint limits as in the planar model, the stop
 //! moment along the joint's axis.
 
-pub mod assemble;
+pub mod equations;
 pub mod kin;
 pub mod mechanism;
 pub mod so3;
 
-pub use assemble::{
-    BodyStep3, STOP_SPEED, SpatialContactEquation, SpatialFbdData, advance, eval, evaluate_next,
-    half_momentum, half_momentum_and_rotation, half_momentum_value, momentum, pattern, pattern_key,
-    prepare_step, set_configuration, set_previous, slip_direction,
+pub use equations::{
+    BodyStep3, SLIP_BIAS, STOP_SPEED, SpatialContactEquation, half_momentum,
+    half_momentum_and_rotation, half_momentum_value, slip_direction,
 };
 pub use kin::{Columns, SpatialKin};
 pub use mechanism::{

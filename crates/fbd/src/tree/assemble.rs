@@ -8,9 +8,9 @@
 //! [`slip_direction`]), the Lie-group discretisation of Euler's equations
 //! and the implicit slip direction of a sliding point.
 //!
-//! The stepping entry points mirror [`crate::spatial::assemble`]'s:
-//! [`set_configuration`], [`set_previous`], [`prepare_step`], [`eval`],
-//! [`pattern_key`], [`pattern`], [`evaluate_next`], [`advance`].
+//! The stepping entry points: [`set_configuration`], [`set_previous`],
+//! [`prepare_step`], [`eval`], [`pattern_key`], [`pattern`],
+//! [`evaluate_next`], [`advance`].
 
 use super::kin::{Columns, TreeKin};
 use super::mechanism::TreeMechanism;
@@ -19,17 +19,15 @@ use crate::assembly::{self, At, ContactView, Dims, FbdModel, Reaction, RowState,
 use crate::body::Wrench;
 use crate::rows;
 use crate::space::Space3;
-use crate::spatial::assemble::{
-    BodyStep3, STOP_SPEED, SpatialContactEquation, half_momentum, half_momentum_value,
-    slip_direction,
+use crate::spatial::equations::{
+    BodyStep3, STOP_SPEED, SpatialContactEquation, half_momentum_and_rotation,
+    half_momentum_derivative_and_rotation, half_momentum_value, slip_direction,
 };
 use fbd_contact::spatial::clearance;
 use fbd_contact::{SpatialState, Surface};
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
 
-/// Mutable workspace of a [`TreeMechanism`]'s assembly (allocated once);
-/// the fields the stepping loop sets are those of
-/// [`crate::spatial::SpatialFbdData`].
+/// Mutable workspace of a [`TreeMechanism`]'s assembly (allocated once).
 #[derive(Clone, Debug)]
 pub struct TreeFbdData {
     /// Kinematics at `q[k−1]`.
@@ -58,12 +56,18 @@ pub struct TreeFbdData {
     pub moment_dir: Vec<[Vector3<f64>; 2]>,
     /// Per FBD body, `L[k+½]` at the last evaluated iterate.
     pub l_next: Vec<Vector3<f64>>,
+    /// Per FBD body, the rotation `ψ[k+½]` of `l_next`.
+    psi_next: Vec<Vector3<f64>>,
+    /// Per FBD body, whether `l_next` and `psi_next` are those of the
+    /// evaluated `kin_next` over this step's `dt` ([`step_momentum`]).
+    l_next_fresh: Vec<bool>,
     /// Per FBD body, the sum of applied forces and moments (about its CoM)
     /// at k of the last evaluation (N, N·m).
     pub wrench: Vec<Wrench<Space3>>,
     /// `L[k+½]` of every body at the accepted `q[k+1]` over a step of
-    /// `l_carry_dt`, the next step's `L[k−½]` when `l_carry_valid`
-    /// (as [`crate::spatial::SpatialFbdData::l_carry`]).
+    /// `l_carry_dt`, the next step's `L[k−½]` when `l_carry_valid`: a
+    /// step accepted whole carries its momenta over, so that the next
+    /// step's history is bit-for-bit the one it was solved with.
     pub l_carry: Vec<Vector3<f64>>,
     /// The step length of `l_carry`.
     pub l_carry_dt: f64,
@@ -120,6 +124,8 @@ impl TreeFbdData {
             limit_gain: 0.0,
             moment_dir: vec![[Vector3::zeros(); 2]; mech.reactions.len()],
             l_next: vec![Vector3::zeros(); nb],
+            psi_next: vec![Vector3::zeros(); nb],
+            l_next_fresh: vec![false; nb],
             wrench: vec![Wrench::default(); nb],
             l_carry: vec![Vector3::zeros(); nb],
             l_carry_dt: 0.0,
@@ -196,6 +202,7 @@ fn moment_directions(mech: &TreeMechanism, kin: &TreeKin, i: usize) -> [Vector3<
 /// directions of this step, given `q[k]` (and `q[k−1]`) already set.
 pub fn prepare_step(mech: &TreeMechanism, data: &mut TreeFbdData, history: History<'_>, dt: f64) {
     data.dt = dt;
+    data.l_next_fresh.fill(false);
     data.slip_bias = STOP_SPEED * dt;
     let carried = data.l_carry_valid;
     data.l_carry_valid = false;
@@ -245,6 +252,7 @@ pub fn evaluate_next(mech: &TreeMechanism, data: &mut TreeFbdData, q_next: &[f64
     if data.kin_next_q != q_next {
         data.kin_next.eval(&mech.model, q_next);
         data.kin_next_q.copy_from_slice(q_next);
+        data.l_next_fresh.fill(false);
     }
     data.next_is_candidate = true;
 }
@@ -262,7 +270,18 @@ pub fn advance(data: &mut TreeFbdData) {
     std::mem::swap(&mut data.kin_prev, &mut data.kin);
     std::mem::swap(&mut data.kin, &mut data.kin_next);
     data.kin_next_q.fill(f64::NAN);
+    data.l_next_fresh.fill(false);
     data.next_is_candidate = false;
+}
+
+/// `L[k+½]` of FBD body `b` ([`crate::spatial::half_momentum_and_rotation`])
+/// and the rotation `ψ[k+½]` it is made of, over this step at the
+/// evaluated `q[k+1]` (after [`evaluate_next`]), when the last evaluation
+/// of the residual computed them there; `None` otherwise. Bit for bit the
+/// values [`crate::spatial::half_momentum_and_rotation`] gives.
+#[inline]
+pub fn step_momentum(data: &TreeFbdData, b: usize) -> Option<(Vector3<f64>, Vector3<f64>)> {
+    data.l_next_fresh[b].then(|| (data.l_next[b], data.psi_next[b]))
 }
 
 /// The sparsity key: contact state codes in base 4 (one code for a
@@ -336,6 +355,7 @@ impl FbdModel for TreeMechanism {
         if data.kin_next_q[..] != q[..] {
             data.kin_next.eval(&self.model, q);
             data.kin_next_q.copy_from_slice(q);
+            data.l_next_fresh.fill(false);
         }
         data.next_is_candidate = false;
     }
@@ -355,7 +375,7 @@ impl FbdModel for TreeMechanism {
         data.kin_next.com[self.bodies[b].model_body].into()
     }
 
-    /// `(c·L[k+½] − L[k−½])/Δt` ([`half_momentum`]); with `jacobian`, its
+    /// `(c·L[k+½] − L[k−½])/Δt` ([`crate::spatial::half_momentum`]); with `jacobian`, its
     /// derivative for [`FbdModel::rotation_entries`].
     fn angular_rate(&self, data: &mut TreeFbdData, b: usize, jacobian: bool) -> [f64; 3] {
         let bs = data.body[b];
@@ -363,14 +383,16 @@ impl FbdModel for TreeMechanism {
         let mb = body.model_body;
         let (dt, inertia) = (data.dt, &body.inertia);
         let (r_k, r_next) = (&data.kin.rotation[mb], &data.kin_next.rotation[mb]);
-        let l_next = if jacobian {
-            let (l, d) = half_momentum(r_k, r_next, inertia, dt);
+        let (l_next, psi) = if jacobian {
+            let (l, d, psi) = half_momentum_derivative_and_rotation(r_k, r_next, inertia, dt);
             data.rot_d[b] = d * (bs.c_next / dt);
-            l
+            (l, psi)
         } else {
-            half_momentum_value(r_k, r_next, inertia, dt)
+            half_momentum_and_rotation(r_k, r_next, inertia, dt)
         };
         data.l_next[b] = l_next;
+        data.psi_next[b] = psi;
+        data.l_next_fresh[b] = true;
         ((bs.c_next * l_next - Vector3::from(bs.ang)) / dt).into()
     }
 

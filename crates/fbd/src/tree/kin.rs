@@ -195,7 +195,11 @@ impl JointConst {
                 // T turns column a towards column b, (a, b, k) cyclic; the
                 // columns are named, not indexed, so that the result stays
                 // in registers.
-                let [f0, f1, f2] = [0, 1, 2].map(|i| f.column(i).into_owned());
+                let (f0, f1, f2) = (
+                    f.column(0).into_owned(),
+                    f.column(1).into_owned(),
+                    f.column(2).into_owned(),
+                );
                 let turn = |fa: Vector3<f64>, fb: Vector3<f64>| (c * fa + s * fb, c * fb - s * fa);
                 let (cols, axis) = match k {
                     0 => {

@@ -31,6 +31,7 @@ pub mod run;
 pub mod search;
 pub mod step;
 pub mod surface;
+pub mod tree_record;
 
 pub use data::RunData;
 

@@ -1,8 +1,7 @@
 //! The contact machinery of every model that stands on a 3D surface: the
-//! paper's hexapod ([`crate::spatial::SpatialModel`], on its own assembly
-//! [`fbd_dynamics::spatial`]) and any imported robot
-//! ([`crate::robot::RobotSim`], on the generic tree assembly
-//! [`fbd_dynamics::tree`]). One source for both:
+//! paper's hexapod ([`crate::spatial::SpatialModel`]) and any imported
+//! robot ([`crate::robot::RobotSim`]), both on the generic tree assembly
+//! [`fbd_dynamics::tree`]. One source for both:
 //!
 //! * the step's Newton system ([`SurfaceSystem`]) and its rows for the
 //!   trial states ([`prepare_rows`]: contact frames and friction of the
@@ -15,8 +14,8 @@
 //!   [`newton_fallback`], [`refine_directions`]);
 //! * the slide directions carried to the next step ([`advance_states`]).
 //!
-//! What the models differ in — their assembly, kinematics, controller and
-//! record — stays theirs ([`SurfaceEngine`]).
+//! What the models differ in — their controller and record — stays
+//! theirs ([`SurfaceEngine`]).
 //!
 //! Two things only a 3D slide needs:
 //!
@@ -45,7 +44,7 @@ use fbd_contact::{StateCode, Surface};
 use fbd_dynamics::assembly::{self, At, FbdModel};
 use fbd_dynamics::rows::{self, Branch, Frozen};
 use fbd_dynamics::space::Space3;
-use fbd_dynamics::spatial::{SpatialContactEquation, SpatialFbdData};
+use fbd_dynamics::spatial::SpatialContactEquation;
 use fbd_dynamics::tree::TreeFbdData;
 use fbd_dynamics::{LimitEquation, LimitState, NoJacobian};
 use fbd_solver::{NewtonSolver, NewtonSystem};
@@ -73,9 +72,8 @@ pub struct Search<'a> {
     pub released_direction: &'a mut [bool],
 }
 
-/// Access to a 3D assembly workspace's contact fields: the spatial
-/// hexapod's [`SpatialFbdData`] and the generic [`TreeFbdData`] hold the
-/// same ones under the same names.
+/// Access to a 3D assembly workspace's contact fields (the generic
+/// [`TreeFbdData`] of every robot, the paper's hexapod included).
 pub trait SearchFields {
     /// The contact fields, borrowed together.
     fn search(&mut self) -> Search<'_>;
@@ -103,61 +101,54 @@ pub trait SearchFields {
     fn set_carry_valid(&mut self);
 }
 
-macro_rules! search_fields {
-    ($t:ty) => {
-        impl SearchFields for $t {
-            fn search(&mut self) -> Search<'_> {
-                Search {
-                    contact: &mut self.contact,
-                    limit: &mut self.limit,
-                    branch: &self.branch,
-                    frozen: &mut self.frozen,
-                    first_frozen: &mut self.first_frozen,
-                    refrozen: &mut self.refrozen,
-                    fixed_states: &mut self.fixed_states,
-                    fixed_direction: &mut self.fixed_direction,
-                    released_direction: &mut self.released_direction,
-                }
-            }
-            fn contact_equations(&self) -> &[SpatialContactEquation] {
-                &self.contact
-            }
-            fn limit_equations(&self) -> &[LimitEquation] {
-                &self.limit
-            }
-            fn fixed_states(&self) -> bool {
-                self.fixed_states
-            }
-            fn branches(&self) -> &[Branch] {
-                &self.branch
-            }
-            fn slip_hat(&self) -> &[[f64; 2]] {
-                &self.slip_hat
-            }
-            fn slip_len(&self) -> &[f64] {
-                &self.slip_len
-            }
-            fn limit_unloaded(&self) -> &[bool] {
-                &self.limit_unloaded
-            }
-            fn step_length(&self) -> f64 {
-                self.dt
-            }
-            fn position_gain(&self) -> f64 {
-                self.position_gain
-            }
-            fn limit_gain(&self) -> f64 {
-                self.limit_gain
-            }
-            fn set_carry_valid(&mut self) {
-                self.l_carry_valid = true;
-            }
+impl SearchFields for TreeFbdData {
+    fn search(&mut self) -> Search<'_> {
+        Search {
+            contact: &mut self.contact,
+            limit: &mut self.limit,
+            branch: &self.branch,
+            frozen: &mut self.frozen,
+            first_frozen: &mut self.first_frozen,
+            refrozen: &mut self.refrozen,
+            fixed_states: &mut self.fixed_states,
+            fixed_direction: &mut self.fixed_direction,
+            released_direction: &mut self.released_direction,
         }
-    };
+    }
+    fn contact_equations(&self) -> &[SpatialContactEquation] {
+        &self.contact
+    }
+    fn limit_equations(&self) -> &[LimitEquation] {
+        &self.limit
+    }
+    fn fixed_states(&self) -> bool {
+        self.fixed_states
+    }
+    fn branches(&self) -> &[Branch] {
+        &self.branch
+    }
+    fn slip_hat(&self) -> &[[f64; 2]] {
+        &self.slip_hat
+    }
+    fn slip_len(&self) -> &[f64] {
+        &self.slip_len
+    }
+    fn limit_unloaded(&self) -> &[bool] {
+        &self.limit_unloaded
+    }
+    fn step_length(&self) -> f64 {
+        self.dt
+    }
+    fn position_gain(&self) -> f64 {
+        self.position_gain
+    }
+    fn limit_gain(&self) -> f64 {
+        self.limit_gain
+    }
+    fn set_carry_valid(&mut self) {
+        self.l_carry_valid = true;
+    }
 }
-
-search_fields!(SpatialFbdData);
-search_fields!(TreeFbdData);
 
 /// A model on a 3D surface: what the shared contact machinery needs
 /// beyond [`Engine`].
@@ -179,10 +170,10 @@ pub trait SurfaceEngine:
 
 /// The [`Engine`] stages every model on a surface shares, written once:
 /// expanded inside `impl Engine for …` of a [`SurfaceEngine`] whose
-/// assembly module is `$asm` (`fbd_dynamics::spatial` or
-/// `fbd_dynamics::tree::assemble`: `prepare_step`, `evaluate_next`,
-/// `set_configuration`, `set_previous`, `advance`) and whose model holds it
-/// in `self.mech`, its record `newton_iterations` and `state_trials`.
+/// assembly module is `$asm` (`fbd_dynamics::tree::assemble`:
+/// `prepare_step`, `evaluate_next`, `set_configuration`, `set_previous`,
+/// `advance`) and whose model holds it in `self.mech`, its record
+/// `newton_iterations` and `state_trials`.
 macro_rules! surface_stages {
     ($asm:path) => {
         fn kinematics(

@@ -11,10 +11,10 @@ use super::model::RobotSim;
 use super::record::RobotRecord;
 use crate::SimError;
 use crate::engine::surface::{self, SurfaceEngine};
+use crate::engine::tree_record;
 use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::LimitCode;
 use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
-use fbd_dynamics::spatial::half_momentum_and_rotation;
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism};
 use fbd_kinematics::Joint;
 use fbd_kinematics::nalgebra::Vector3;
@@ -104,7 +104,7 @@ impl Engine for RobotSim {
         make_record(self, data, iterations, trials, h);
     }
     fn skip_record(&self, data: &mut RobotData, h: f64) {
-        carry_momenta(self, data, h);
+        tree_record::carry_momenta(&self.mech, &mut data.fbd, h);
     }
 }
 
@@ -126,33 +126,14 @@ fn make_record(
     rec.q.copy_from_slice(&data.q);
     rec.newton_iterations = newton_iterations;
     rec.state_trials = state_trials;
-    for (c, tc) in mech.contacts.iter().enumerate() {
-        let p = fbd.kin.contact[tc.model_contact];
-        let eq = &fbd.contact[c];
-        let fl = [
-            z[dims.contact_force(c, 0)],
-            z[dims.contact_force(c, 1)],
-            z[dims.contact_force(c, 2)],
-        ];
-        let [t1, n, t2] = eq.frame;
-        let row = &mut rec.contacts[c];
-        row.point = [p.x, p.y, p.z];
+    for (c, row) in rec.contacts.iter_mut().enumerate() {
+        (row.point, row.force, row.normal) = tree_record::contact_force(mech, fbd, z, c);
         row.state = data.trial[c].code();
-        row.force = std::array::from_fn(|i| fl[0] * t1[i] + fl[1] * n[i] + fl[2] * t2[i]);
-        row.normal = fl[1];
     }
     rec.torque.copy_from_slice(&fbd.torque);
-    let v3 = |i: usize| Vector3::new(z[i], z[i + 1], z[i + 2]);
-    for (i, re) in mech.reactions.iter().enumerate() {
-        let [d1, d2] = fbd.moment_dir[i];
-        let mut m = z[mech.reaction_moment(i, 0)] * d1;
-        if !re.compound {
-            m += z[mech.reaction_moment(i, 1)] * d2;
-        }
-        for &j in re.joint_list() {
-            m += fbd.torque[j] * fbd.kin.axis[j];
-        }
-        rec.reaction_force[i] = v3(mech.reaction_force(i, 0)).into();
+    for i in 0..mech.reactions.len() {
+        let (f, m) = tree_record::reaction_wrench(mech, fbd, z, i);
+        rec.reaction_force[i] = f.into();
         rec.reaction_moment[i] = m.into();
     }
     rec.limit.fill(LimitCode::Free);
@@ -168,52 +149,11 @@ fn make_record(
         let r = joint_rates(model, data, j);
         data.record.rate[j] = r;
     }
-    // Energies and momenta over the step k → k+1 (the scheme's own); the
-    // momenta are the next step's L[k−½] when this step is accepted whole.
-    let fbd = &mut data.fbd;
-    let g = mech.gravity;
-    let (mut kinetic, mut potential) = (0.0, 0.0);
-    let (mut p, mut hm, mut c) = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
-    for (b, body) in mech.bodies.iter().enumerate() {
-        let mb = body.model_body;
-        let (c0, c1) = (fbd.kin.com[mb], fbd.kin_next.com[mb]);
-        let v = (c1 - c0) / h;
-        let (l, psi) = half_momentum_and_rotation(
-            &fbd.kin.rotation[mb],
-            &fbd.kin_next.rotation[mb],
-            &body.inertia,
-            h,
-        );
-        fbd.l_carry[b] = l;
-        kinetic +=
-            0.5 * body.mass * v.norm_squared() + 0.5 * psi.dot(&(body.inertia * psi)) / (h * h);
-        potential += body.mass * g * 0.5 * (c0.y + c1.y);
-        p += body.mass * v;
-        hm += body.mass * c0.cross(&v) + l;
-        c += body.mass * c0;
-    }
-    fbd.l_carry_dt = h;
+    let m = tree_record::momenta(mech, &mut data.fbd, h);
     let rec = &mut data.record;
-    rec.kinetic = kinetic;
-    rec.potential = potential;
-    rec.momentum = p.into();
-    rec.angular_momentum = hm.into();
-    rec.com = (c / mech.total_mass()).into();
-}
-
-/// The bodies' momenta `L[k+½]` over the step, kept for the next step's
-/// `L[k−½]` (as [`make_record`] keeps them), for a step without a record.
-fn carry_momenta(model: &RobotSim, data: &mut RobotData, h: f64) {
-    let fbd = &mut data.fbd;
-    for (b, body) in model.mech.bodies.iter().enumerate() {
-        let mb = body.model_body;
-        let (l, _) = half_momentum_and_rotation(
-            &fbd.kin.rotation[mb],
-            &fbd.kin_next.rotation[mb],
-            &body.inertia,
-            h,
-        );
-        fbd.l_carry[b] = l;
-    }
-    fbd.l_carry_dt = h;
+    rec.kinetic = m.kinetic;
+    rec.potential = m.potential;
+    rec.momentum = m.momentum;
+    rec.angular_momentum = m.angular_momentum;
+    rec.com = m.com;
 }

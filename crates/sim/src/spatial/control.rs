@@ -31,18 +31,20 @@ pub fn joint_rates(model: &SpatialModel, data: &SpatialData, s: usize) -> [f64; 
 pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimError> {
     if let Some(tau) = &data.external_torque {
         assert_eq!(
-            tau.len(),
+            3 * tau.len(),
             data.fbd.torque.len(),
             "one torque triple per leg"
         );
-        data.fbd.torque.copy_from_slice(tau);
+        for (t, v) in data.fbd.torque.iter_mut().zip(tau.iter().flatten()) {
+            *t = *v;
+        }
         return Ok(());
     }
     let dt = model.dt();
     let t = data.k as f64 * dt;
     let (kp, kd, limit) = match &model.params.control {
         SpatialControl::None => {
-            data.fbd.torque.fill([0.0; 3]);
+            data.fbd.torque.fill(0.0);
             return Ok(());
         }
         SpatialControl::Pd {
@@ -73,7 +75,7 @@ pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(),
             message: e.to_string(),
         })?;
     }
-    for s in 0..model.mech.legs.len() {
+    for s in 0..model.legs.len() {
         let rate = joint_rates(model, data, s);
         let (target, target_rate) = match &model.params.control {
             SpatialControl::Pd { target, .. } => (target[s], [0.0; 3]),
@@ -87,14 +89,14 @@ pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(),
             }
             SpatialControl::Gait { .. } => {
                 let g = data.control.as_ref().expect("gait workspace");
-                let leg = &g.legs[model.mech.legs[s] - 1];
+                let leg = &g.legs[model.legs[s] - 1];
                 (leg.theta, leg.rate)
             }
             SpatialControl::None => unreachable!("handled above"),
         };
         for j in 0..3 {
             let theta = data.q[q_joint(s, j)];
-            data.fbd.torque[s][j] =
+            data.fbd.torque[3 * s + j] =
                 crate::control::pd_torque(kp, kd, limit, target[j], target_rate[j], theta, rate[j]);
         }
     }

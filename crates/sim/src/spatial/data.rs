@@ -9,7 +9,8 @@ use crate::engine::data::Parts;
 use crate::gait::GaitData;
 use crate::spatial::params::SpatialControl;
 use fbd_contact::StateCode;
-use fbd_dynamics::spatial::{SpatialFbdData, set_configuration};
+use fbd_dynamics::tree::TreeFbdData;
+use fbd_dynamics::tree::assemble::set_configuration;
 use fbd_solver::NewtonSolver;
 
 /// Everything that changes during a spatial run (see [`RunData`]); every
@@ -20,15 +21,14 @@ impl RunData<SpatialModel> {
     /// A fresh workspace at the model's initial state.
     pub fn new(model: &SpatialModel) -> Self {
         let mech = &model.mech;
-        let lay = mech.layout();
         let q0 = &model.params.q0;
-        let mut fbd = SpatialFbdData::new(mech);
+        let mut fbd = TreeFbdData::new(mech);
         set_configuration(mech, &mut fbd, q0);
         let record = SpatialRecord {
             step: 0,
             t: 0.0,
             q: q0.clone(),
-            contacts: mech
+            contacts: model
                 .contacts
                 .iter()
                 .map(|c| ContactRow {
@@ -40,7 +40,7 @@ impl RunData<SpatialModel> {
                     normal: 0.0,
                 })
                 .collect(),
-            legs: mech
+            legs: model
                 .legs
                 .iter()
                 .map(|&leg| LegRow {
@@ -61,8 +61,8 @@ impl RunData<SpatialModel> {
         };
         RunData::build(Parts {
             q0: q0.clone(),
-            dim: lay.dim(),
-            limits: lay.limits,
+            dim: mech.dims().dim(),
+            limits: mech.limits.len(),
             initial_states: model.initial_states.clone(),
             fbd,
             solver: NewtonSolver::new(model.newton),

@@ -20,7 +20,7 @@ mod run;
 pub mod step;
 
 pub use data::SpatialData;
-pub use model::{SpatialModel, fastest_mode_over_poses, modes_slower_than};
+pub use model::{LegLimit, SpatialModel, closed_form, fastest_mode_over_poses, modes_slower_than};
 pub use params::{LegTrajectory3, SpatialControl, SpatialParams, default_q0, hexagon_inertia};
 pub use record::{ContactRow, LegRow, SpatialRecord};
 pub use run::{run_collect, run_until};

@@ -7,18 +7,44 @@ use crate::joint_inertia::{
 };
 use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
-use fbd_dynamics::PointKind;
 use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism, q_joint};
+use fbd_dynamics::tree::{TreeMechanism, contacts_by_kind};
+use fbd_dynamics::{ContactSpec, PointKind};
+use fbd_kinematics::Joint;
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
 use fbd_solver::NewtonParams;
+
+/// A joint stop of the hexapod: which leg slot and which joint of it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LegLimit {
+    /// Position of the leg in [`SpatialModel::legs`].
+    pub slot: usize,
+    /// Which joint of the leg.
+    pub joint: Joint,
+    /// Its angle's index in `q` (`6 + 3·slot + j`).
+    pub q_index: usize,
+}
 
 /// Everything fixed during a spatial run.
 #[derive(Clone, Debug)]
 pub struct SpatialModel {
     /// The parameters it was built from.
     pub params: SpatialParams,
-    /// Bodies, joints, contact points and limits.
-    pub mech: SpatialMechanism,
+    /// The FBD mechanism of the hexapod's generic robot model
+    /// ([`SpatialParams::robot_model`], the D-H instance): 13 bodies for
+    /// six legs, a two-axis hip and a knee reaction per leg, the contact
+    /// points (every tip, then every knee, then every hip:
+    /// [`contacts_by_kind`]) and the stops. The same equations as every
+    /// imported robot's (`fbd_dynamics::tree`).
+    pub mech: TreeMechanism,
+    /// Leg numbers (1–6) of the model's legs, in slot order
+    /// (`SpatialParams::legs`).
+    pub legs: Vec<usize>,
+    /// Each contact point's hexapod identity (leg, tip/knee/hip), in the
+    /// order of `mech.contacts`.
+    pub contacts: Vec<ContactSpec>,
+    /// Each stop's leg and joint, in the order of `mech.limits`.
+    pub limits: Vec<LegLimit>,
     /// Newton tolerances.
     pub newton: NewtonParams,
     /// Steps to solve: `round(duration/dt) + 1`.
@@ -198,57 +224,74 @@ impl SpatialModel {
     pub fn new(params: &SpatialParams) -> Result<Self, SimError> {
         let p = params;
         p.validate()?;
-        let geometry = p.kinematic_model();
-        let inertia = SpatialInertia {
-            body_mass: p.body_mass,
-            body_inertia: inertia_matrix(&p.body_inertia),
-            upper_mass: p.upper_mass,
-            upper_axial: 0.5 * p.upper_mass * p.upper_radius * p.upper_radius,
-            upper_transverse: p.upper_inertia,
-            lower_mass: p.lower_mass,
-            lower_axial: 0.5 * p.lower_mass * p.lower_radius * p.lower_radius,
-            lower_transverse: p.lower_inertia,
-        };
-        let mech = SpatialMechanism::new(
-            geometry,
-            &p.legs,
-            &inertia,
-            p.gravity,
-            p.contact_points,
-            &p.joint_limits,
-        );
+        let robot = p.robot_model();
+        let mech = TreeMechanism::with_contacts(&robot, p.gravity, &contacts_by_kind(&robot));
         let start = std::time::Instant::now();
-        pd_stability(p, &mech)?;
+        pd_stability(p, &closed_form(p))?;
         let stability_check_seconds = start.elapsed().as_secs_f64();
-        for lim in &mech.limits {
+        let legs = p.legs.clone();
+        // Model joint 3·slot + j is θ(j+1) of leg `legs[slot]`.
+        let joints = [Joint::Theta1, Joint::Theta2, Joint::Theta3];
+        let limits: Vec<LegLimit> = mech
+            .limits
+            .iter()
+            .map(|l| LegLimit {
+                slot: l.joint / 3,
+                joint: joints[l.joint % 3],
+                q_index: l.q_index,
+            })
+            .collect();
+        for lim in &limits {
             if let Err(e) = p.joint_limits.check(lim.joint, p.q0[lim.q_index]) {
                 check(
                     false,
-                    &format!("initial.leg{}.theta_deg", mech.legs[lim.slot]),
+                    &format!("initial.leg{}.theta_deg", legs[lim.slot]),
                     "outside the joint limits",
                     e,
                     &format!("angles inside [leg] {}_deg", lim.joint.name()),
                 )?;
             }
         }
-        let contact = p.contact;
-        let contact_bumper = mech
+        let contacts: Vec<ContactSpec> = mech
             .contacts
+            .iter()
+            .map(|c| {
+                let stem = c.name.trim_end_matches(|ch: char| ch.is_ascii_digit());
+                let leg: usize = c.name[stem.len()..].parse().expect("a hexapod point's leg");
+                let slot = legs
+                    .iter()
+                    .position(|&n| n == leg)
+                    .expect("a leg of the model");
+                let kind = [PointKind::Tip, PointKind::Knee, PointKind::Hip]
+                    .into_iter()
+                    .find(|k| k.as_str() == stem)
+                    .expect("tip, knee or hip");
+                ContactSpec {
+                    name: c.name.clone(),
+                    leg,
+                    kind,
+                    body: c.body,
+                    point: fbd_dynamics::spatial::point_id(slot, kind),
+                }
+            })
+            .collect();
+        let contact = p.contact;
+        let contact_bumper = contacts
             .iter()
             .map(|c| match c.kind {
                 PointKind::Tip => 0.0,
                 PointKind::Knee | PointKind::Hip => contact.bumper_regularization,
             })
             .collect();
-        let mut kin = SpatialKin::new(&mech);
-        kin.eval(&mech, &p.q0);
-        let mut initial_states = Vec::with_capacity(mech.contacts.len());
-        for c in &mech.contacts {
-            let pt = kin.point(&mech, c.point / 3, c.kind);
+        let mut kin = fbd_dynamics::tree::kin::TreeKin::new(&mech.model);
+        kin.eval(&mech.model, &p.q0);
+        let mut initial_states = Vec::with_capacity(contacts.len());
+        for (c, spec) in mech.contacts.iter().zip(&contacts) {
+            let pt = kin.contact[c.model_contact];
             let state = SpatialState::initial([pt.x, pt.y, pt.z], &p.terrain, contact.initial_tol)
                 .map_err(|depth| SimError::InitialPenetration {
-                    leg: format!("leg{}", c.leg),
-                    point: c.name.clone(),
+                    leg: format!("leg{}", spec.leg),
+                    point: spec.name.clone(),
                     depth,
                 })?;
             initial_states.push(state);
@@ -281,6 +324,9 @@ impl SpatialModel {
             stability_check_seconds,
             complementarity: true,
             mech,
+            legs,
+            contacts,
+            limits,
         };
         Ok(model)
     }
@@ -292,13 +338,39 @@ impl SpatialModel {
 
     /// Generalised coordinates.
     pub fn nq(&self) -> usize {
-        self.mech.layout().nq
+        self.mech.nq()
     }
 
     /// Gravity vector (m/s²).
     pub fn gravity(&self) -> Vector3<f64> {
         Vector3::new(0.0, -self.params.gravity, 0.0)
     }
+}
+
+/// The hexapod of `p` in closed form ([`fbd_dynamics::spatial`]): its
+/// bodies' masses and inertias on the leg kinematics of
+/// `fbd_kinematics::hexapod`, on which [`pd_stability`] decides the joint
+/// controller's stability leg by leg, and the tests have an independent
+/// reference for the positions the generic tree kinematics computes.
+pub fn closed_form(p: &SpatialParams) -> SpatialMechanism {
+    let inertia = SpatialInertia {
+        body_mass: p.body_mass,
+        body_inertia: inertia_matrix(&p.body_inertia),
+        upper_mass: p.upper_mass,
+        upper_axial: 0.5 * p.upper_mass * p.upper_radius * p.upper_radius,
+        upper_transverse: p.upper_inertia,
+        lower_mass: p.lower_mass,
+        lower_axial: 0.5 * p.lower_mass * p.lower_radius * p.lower_radius,
+        lower_transverse: p.lower_inertia,
+    };
+    SpatialMechanism::new(
+        p.kinematic_model(),
+        &p.legs,
+        &inertia,
+        p.gravity,
+        p.contact_points,
+        &p.joint_limits,
+    )
 }
 
 /// Most gait steps at which [`pd_stability`] evaluates the effective

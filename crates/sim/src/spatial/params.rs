@@ -197,6 +197,39 @@ impl SpatialParams {
         )
     }
 
+    /// The hexapod of these parameters as a generic [`fbd_robot::RobotModel`],
+    /// built from its D-H parameters ([`fbd_robot::dh::hexapod`]): the same
+    /// geometry, masses, inertias, legs, joint limits and contact points.
+    /// [`super::SpatialModel`] steps it on the generic FBD equations of
+    /// `fbd_dynamics::tree`, as every imported robot.
+    pub fn robot_model(&self) -> fbd_robot::RobotModel {
+        use fbd_robot::JointLimits as Range;
+        use fbd_robot::dh::{HexapodLayout, HexapodMasses, hexapod};
+        let masses = HexapodMasses {
+            body_mass: self.body_mass,
+            body_inertia: self.body_inertia,
+            upper_mass: self.upper_mass,
+            upper_radius: self.upper_radius,
+            upper_inertia: self.upper_inertia,
+            lower_mass: self.lower_mass,
+            lower_radius: self.lower_radius,
+            lower_inertia: self.lower_inertia,
+        };
+        let l = &self.joint_limits;
+        // An open range is a continuous joint (no stop).
+        let limit = |[lower, upper]: [f64; 2]| {
+            (lower.is_finite() || upper.is_finite()).then_some(Range { lower, upper })
+        };
+        let layout = HexapodLayout {
+            legs: self.legs.clone(),
+            limits: [limit(l.theta1), limit(l.theta2), limit(l.theta3)],
+            tips: self.contact_points.tips,
+            knees: self.contact_points.knees,
+            hips: self.contact_points.hips,
+        };
+        hexapod(&self.kinematic_model(), &masses, &layout)
+    }
+
     /// The spatial twin of a planar run: legs 3 and 4 only, θ1 = 0, the
     /// planar initial state in the X–Y plane, the same masses (the body's
     /// inertia isotropic with the planar value about Z, each link's

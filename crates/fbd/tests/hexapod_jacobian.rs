@@ -1,6 +1,8 @@
-//! The analytic Jacobian of the spatial (3D) FBD residual against central
-//! differences, through the shared checker: six legs, generic (tumbling,
-//! tilted) configurations, every contact state (free, sticking, sliding in
+//! The analytic Jacobian of the paper's hexapod's 3D FBD residual (the
+//! generic tree assembly on its D-H instance, as the 3D simulator steps
+//! it) against central differences, through the shared checker: six legs,
+//! a body inertia with products of inertia, generic (tumbling, tilted)
+//! configurations, every contact state (free, sticking, sliding in
 //! a generic direction) on flat and tilted, rotated terrain, joint limits
 //! free and at a stop, at the first step (history from the initial
 //! velocities) and at a later one. The pattern declared by `pattern`
@@ -8,16 +10,14 @@
 
 use fbd_contact::spatial::frame;
 use fbd_contact::{SpatialState, Surface, Terrain};
-use fbd_dynamics::mechanism::ContactPoints;
-use fbd_dynamics::spatial::{
-    SpatialContactEquation, SpatialFbdData, SpatialInertia, SpatialMechanism, eval, pattern,
-    prepare_step, set_configuration, set_previous,
-};
+use fbd_dynamics::spatial::SpatialContactEquation;
+use fbd_dynamics::tree::assemble::{eval, pattern, prepare_step, set_configuration, set_previous};
+use fbd_dynamics::tree::{TreeFbdData, TreeMechanism, contacts_by_kind};
 use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
 use fbd_kinematics::fd::{FdTolerance, check_jacobian};
 use fbd_kinematics::hexapod::HexapodModel;
-use fbd_kinematics::nalgebra::Matrix3;
-use fbd_kinematics::{JointLimits, LimitSide};
+use fbd_kinematics::{Joint, JointLimits, LimitSide};
+use fbd_robot::dh::{HexapodLayout, HexapodMasses, hexapod};
 
 struct Dense<'a> {
     n: usize,
@@ -30,38 +30,43 @@ impl JacobianSink for Dense<'_> {
     }
 }
 
-fn mechanism(legs: &[usize]) -> SpatialMechanism {
-    let inertia = SpatialInertia {
+/// The hexapod of `legs` with every contact point (tips, knees, hips, in
+/// the simulator's order) and the default joint limits.
+fn mechanism(legs: &[usize]) -> TreeMechanism {
+    let masses = HexapodMasses {
         body_mass: 10.0,
-        body_inertia: Matrix3::new(0.2, 0.01, -0.02, 0.01, 0.39, 0.015, -0.02, 0.015, 0.21),
+        body_inertia: [0.2, 0.39, 0.21, 0.01, -0.02, 0.015],
         upper_mass: 0.3,
-        upper_axial: 6e-5,
-        upper_transverse: 1.0e-3,
+        upper_radius: 0.02,
+        upper_inertia: 1.0e-3,
         lower_mass: 1.1,
-        lower_axial: 1.2e-4,
-        lower_transverse: 1.6e-2,
+        lower_radius: 0.015,
+        lower_inertia: 1.6e-2,
     };
-    let all = ContactPoints {
-        tips: true,
-        knees: true,
-        hips: true,
+    let l = JointLimits::default();
+    let range = |j| {
+        let [lower, upper] = l.range(j);
+        Some(fbd_robot::JointLimits { lower, upper })
     };
-    SpatialMechanism::new(
-        HexapodModel::default(),
-        legs,
-        &inertia,
-        9.81,
-        all,
-        &JointLimits::default(),
-    )
+    let layout = HexapodLayout {
+        legs: legs.to_vec(),
+        limits: [
+            range(Joint::Theta1),
+            range(Joint::Theta2),
+            range(Joint::Theta3),
+        ],
+        ..HexapodLayout::default()
+    };
+    let robot = hexapod(&HexapodModel::default(), &masses, &layout);
+    TreeMechanism::with_contacts(&robot, 9.81, &contacts_by_kind(&robot))
 }
 
 /// A generic configuration: tilted, turned body; every leg different.
-fn q_at(mech: &SpatialMechanism, shift: f64) -> Vec<f64> {
-    let nq = mech.layout().nq;
+fn q_at(mech: &TreeMechanism, shift: f64) -> Vec<f64> {
+    let nq = mech.nq();
     let mut q = vec![0.0; nq];
     q[..6].copy_from_slice(&[0.1, 0.45, -0.05, 0.2, -0.4, 0.3]);
-    for s in 0..mech.legs.len() {
+    for s in 0..(nq - 6) / 3 {
         let f = s as f64;
         q[6 + 3 * s] = 0.1 * f - 0.2;
         q[7 + 3 * s] = -0.3 + 0.1 * f;
@@ -82,22 +87,23 @@ fn check(surface: &Surface, first_step: bool, limits_at: bool) {
 /// slide; a negative `N` unloads).
 fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementarity: bool) {
     let mech = mechanism(&[1, 2, 3, 4, 5, 6]);
-    let lay = mech.layout();
+    let lay = mech.dims();
     let n = lay.dim();
-    let mut data = SpatialFbdData::new(&mech);
+    let mut data = TreeFbdData::new(&mech);
     let q_prev = q_at(&mech, -0.004);
     let q_k = q_at(&mech, 0.0);
     set_previous(&mech, &mut data, &q_prev);
     set_configuration(&mech, &mut data, &q_k);
-    let qdot: Vec<f64> = (0..lay.nq).map(|i| 0.3 - 0.05 * i as f64).collect();
+    let nq = mech.nq();
+    let qdot: Vec<f64> = (0..nq).map(|i| 0.3 - 0.05 * i as f64).collect();
     let history = if first_step {
         History::Initial { qdot: &qdot }
     } else {
         History::Previous
     };
     prepare_step(&mech, &mut data, history, 0.002);
-    for (s, t) in data.torque.iter_mut().enumerate() {
-        *t = [1.0 + s as f64, -2.0, 0.5];
+    for (j, t) in data.torque.iter_mut().enumerate() {
+        *t = [1.0 + (j / 3) as f64, -2.0, 0.5][j % 3];
     }
     for (c, eq) in data.contact.iter_mut().enumerate() {
         let state = match c % 4 {
@@ -142,7 +148,7 @@ fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementar
     }
     // A generic iterate.
     let mut z: Vec<f64> = (0..n).map(|i| 3.0 * ((i as f64) * 0.37).sin()).collect();
-    z[..lay.nq].copy_from_slice(&q_at(&mech, 0.003));
+    z[..nq].copy_from_slice(&q_at(&mech, 0.003));
     if complementarity {
         // Large normal forces on every other point: held on the surface.
         for c in (0..data.contact.len()).step_by(2) {

@@ -168,21 +168,59 @@ pub trait SurfaceEngine:
     fn total_mass(&self) -> f64;
 }
 
-/// The [`Engine`] stages every model on a surface shares, written once:
-/// expanded inside `impl Engine for …` of a [`SurfaceEngine`] whose
-/// assembly module is `$asm` (`fbd_dynamics::tree::assemble`:
-/// `prepare_step`, `evaluate_next`, `set_configuration`, `set_previous`,
-/// `advance`) and whose model holds it in `self.mech`, its record
-/// `newton_iterations` and `state_trials`.
+/// `impl SurfaceEngine for $model` of a model on the generic tree
+/// equations, which holds its mechanism in `mech`, its complementarity
+/// choice in `complementarity` and its points' bumpers in
+/// `contact_bumper`.
+macro_rules! tree_surface_engine {
+    ($model:ty) => {
+        impl $crate::engine::surface::SurfaceEngine for $model {
+            type Mech = fbd_dynamics::tree::TreeMechanism;
+            fn mech(&self) -> &fbd_dynamics::tree::TreeMechanism {
+                &self.mech
+            }
+            fn complementarity_rows(&self) -> bool {
+                self.complementarity
+            }
+            fn bumper(&self, c: usize) -> f64 {
+                self.contact_bumper[c]
+            }
+            fn total_mass(&self) -> f64 {
+                self.mech.total_mass()
+            }
+        }
+    };
+}
+pub(crate) use tree_surface_engine;
+
+/// The [`Engine`] items every model on a surface shares, written once:
+/// expanded inside `impl Engine for …` of a [`SurfaceEngine`] on the
+/// generic tree equations (`fbd_dynamics::tree`: its state, trial, ground
+/// and workspace types; the stages `prepare_step`, `evaluate_next`,
+/// `set_configuration`, `set_previous`, `advance` of
+/// `fbd_dynamics::tree::assemble`; the stop rows' unknowns; the momenta
+/// carried by a step without a record) whose model holds its mechanism in
+/// `self.mech`, its record `newton_iterations` and `state_trials`.
 macro_rules! surface_stages {
-    ($asm:path) => {
+    () => {
+        type State = fbd_contact::SpatialState;
+        type Trial = fbd_contact::SpatialTrial;
+        type Ground = fbd_contact::Surface;
+        type Fbd = fbd_dynamics::tree::TreeFbdData;
+
+        fn limit_moment_index(&self, l: usize) -> usize {
+            self.mech.dims().limit_moment(l)
+        }
+        fn skip_record(&self, data: &mut $crate::engine::RunData<Self>, h: f64) {
+            $crate::engine::tree_record::carry_momenta(&self.mech, &mut data.fbd, h);
+        }
         fn kinematics(
             &self,
             data: &mut $crate::engine::RunData<Self>,
             history: fbd_dynamics::History<'_>,
             h: f64,
         ) {
-            use $asm as asm;
+            use fbd_dynamics::tree::assemble as asm;
             asm::prepare_step(&self.mech, &mut data.fbd, history, h);
             $crate::engine::surface::reset_search(&mut data.fbd);
         }
@@ -194,7 +232,7 @@ macro_rules! surface_stages {
             solver.solve(&mut sys, z)
         }
         fn evaluate_next(&self, data: &mut $crate::engine::RunData<Self>) {
-            use $asm as asm;
+            use fbd_dynamics::tree::assemble as asm;
             let nq = $crate::engine::Engine::nq(self);
             asm::evaluate_next(&self.mech, &mut data.fbd, &data.z[..nq]);
         }
@@ -238,11 +276,11 @@ macro_rules! surface_stages {
             $crate::engine::surface::refine_directions(self, data)
         }
         fn set_previous(&self, data: &mut $crate::engine::RunData<Self>) {
-            use $asm as asm;
+            use fbd_dynamics::tree::assemble as asm;
             asm::set_previous(&self.mech, &mut data.fbd, &data.q_prev);
         }
         fn reset_kinematics(&self, data: &mut $crate::engine::RunData<Self>) {
-            use $asm as asm;
+            use fbd_dynamics::tree::assemble as asm;
             asm::set_configuration(&self.mech, &mut data.fbd, &data.grid_q);
             asm::set_previous(&self.mech, &mut data.fbd, &data.grid_q_prev);
         }
@@ -251,7 +289,7 @@ macro_rules! surface_stages {
             record.state_trials += trials;
         }
         fn advance(&self, data: &mut $crate::engine::RunData<Self>) {
-            use $asm as asm;
+            use fbd_dynamics::tree::assemble as asm;
             $crate::engine::surface::advance_states(data);
             asm::advance(&mut data.fbd);
         }

@@ -42,6 +42,9 @@ pub struct RobotSim {
     /// Whether the contact points in contact solve stick/slip and lift-off
     /// as a complementarity problem (default `true`, as the hexapod).
     pub complementarity: bool,
+    /// Regularisation added to each contact point's position rows: 0
+    /// (every point of an imported robot is a foot or a sphere).
+    pub contact_bumper: Vec<f64>,
     /// The (unused) ground of a run in flight.
     pub(crate) no_ground: fbd_contact::Surface,
 }
@@ -169,7 +172,7 @@ impl RobotSim {
             Vec::new()
         };
         let mech = TreeMechanism::with_contacts(robot, p.gravity, &contacts);
-        let contact_specs = mech
+        let contact_specs: Vec<ContactSpec> = mech
             .contacts
             .iter()
             .enumerate()
@@ -201,6 +204,7 @@ impl RobotSim {
         Ok(Self {
             params: p.clone(),
             effort: robot.joints.iter().map(|j| j.effort).collect(),
+            contact_bumper: vec![0.0; contact_specs.len()],
             contact_specs,
             newton: NewtonParams {
                 chord_steps: 6,

@@ -10,12 +10,11 @@ use super::data::RobotData;
 use super::model::RobotSim;
 use super::record::RobotRecord;
 use crate::SimError;
-use crate::engine::surface::{self, SurfaceEngine};
+use crate::engine::surface;
 use crate::engine::tree_record;
 use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::LimitCode;
-use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
-use fbd_dynamics::tree::{TreeFbdData, TreeMechanism};
+use fbd_contact::{Friction, Surface};
 use fbd_kinematics::Joint;
 use fbd_kinematics::nalgebra::Vector3;
 
@@ -29,27 +28,9 @@ pub fn step(model: &RobotSim, data: &mut RobotData) -> Result<(), SimError> {
     crate::engine::step::step(model, data)
 }
 
-impl SurfaceEngine for RobotSim {
-    type Mech = TreeMechanism;
-    fn mech(&self) -> &TreeMechanism {
-        &self.mech
-    }
-    fn complementarity_rows(&self) -> bool {
-        self.complementarity
-    }
-    fn bumper(&self, _c: usize) -> f64 {
-        0.0
-    }
-    fn total_mass(&self) -> f64 {
-        self.mech.total_mass()
-    }
-}
+crate::engine::surface::tree_surface_engine!(RobotSim);
 
 impl Engine for RobotSim {
-    type State = SpatialState;
-    type Trial = SpatialTrial;
-    type Ground = Surface;
-    type Fbd = TreeFbdData;
     type Record = RobotRecord;
     type Torques = Vec<f64>;
     type ControlData = Option<Box<super::control::GaitWork>>;
@@ -86,11 +67,7 @@ impl Engine for RobotSim {
             .name
             .clone()
     }
-    fn limit_moment_index(&self, l: usize) -> usize {
-        self.mech.dims().limit_moment(l)
-    }
-
-    crate::engine::surface::surface_stages!(fbd_dynamics::tree::assemble);
+    crate::engine::surface::surface_stages!();
     fn torques(&self, data: &mut RobotData) -> Result<(), SimError> {
         joint_torques(self, data)
     }
@@ -102,9 +79,6 @@ impl Engine for RobotSim {
     }
     fn make_record(&self, data: &mut RobotData, iterations: usize, trials: usize, h: f64) {
         make_record(self, data, iterations, trials, h);
-    }
-    fn skip_record(&self, data: &mut RobotData, h: f64) {
-        tree_record::carry_momenta(&self.mech, &mut data.fbd, h);
     }
 }
 

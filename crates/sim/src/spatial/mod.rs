@@ -2,7 +2,11 @@
 //! (the central body, and per leg the upper and the lower link), each with
 //! its six Newton–Euler equations in the inertial frame, every joint
 //! reaction and contact force an explicit unknown; see
-//! `fbd_dynamics::spatial` for the equations and the rotation scheme.
+//! `fbd_dynamics::spatial` for the equations and the rotation scheme. The
+//! model is the hexapod's D-H instance of the generic robot model
+//! ([`SpatialParams::robot_model`]) on the FBD equations of every robot
+//! (`fbd_dynamics::tree`); the hexapod's parameters, controllers, record
+//! and output columns are its own.
 //!
 //! * [`SpatialParams`] → [`SpatialModel`] (immutable) and [`SpatialData`]
 //!   (the workspace);

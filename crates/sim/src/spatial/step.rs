@@ -14,12 +14,12 @@ use super::control::{joint_rates, joint_torques};
 use super::data::SpatialData;
 use super::model::SpatialModel;
 use crate::SimError;
-use crate::engine::surface::{self, SurfaceEngine, SurfaceSystem};
+use crate::engine::surface::{self, SurfaceSystem};
 use crate::engine::tree_record;
 use crate::engine::{Engine, LimitInfo, Settings};
 use crate::record::LimitCode;
-use fbd_contact::{Friction, SpatialState, SpatialTrial, Surface};
-use fbd_dynamics::tree::{TreeFbdData, TreeMechanism};
+use fbd_contact::{Friction, Surface};
+use fbd_dynamics::tree::TreeMechanism;
 
 pub use crate::engine::surface::{LIMIT_RELEASE_ANGLE, SLIP_RESOLUTION, UNLOADED_STICK_DRIFT};
 
@@ -36,27 +36,9 @@ pub fn step(model: &SpatialModel, data: &mut SpatialData) -> Result<(), SimError
     crate::engine::step::step(model, data)
 }
 
-impl SurfaceEngine for SpatialModel {
-    type Mech = TreeMechanism;
-    fn mech(&self) -> &TreeMechanism {
-        &self.mech
-    }
-    fn complementarity_rows(&self) -> bool {
-        self.complementarity
-    }
-    fn bumper(&self, c: usize) -> f64 {
-        self.contact_bumper[c]
-    }
-    fn total_mass(&self) -> f64 {
-        self.mech.total_mass()
-    }
-}
+crate::engine::surface::tree_surface_engine!(SpatialModel);
 
 impl Engine for SpatialModel {
-    type State = SpatialState;
-    type Trial = SpatialTrial;
-    type Ground = Surface;
-    type Fbd = TreeFbdData;
     type Record = super::record::SpatialRecord;
     type Torques = Vec<[f64; 3]>;
     type ControlData = Option<Box<crate::gait::GaitData>>;
@@ -92,11 +74,7 @@ impl Engine for SpatialModel {
         let lim = &self.limits[l];
         format!("theta{}_{}", lim.joint.index() + 1, self.legs[lim.slot])
     }
-    fn limit_moment_index(&self, l: usize) -> usize {
-        self.mech.dims().limit_moment(l)
-    }
-
-    crate::engine::surface::surface_stages!(fbd_dynamics::tree::assemble);
+    crate::engine::surface::surface_stages!();
     fn torques(&self, data: &mut SpatialData) -> Result<(), SimError> {
         joint_torques(self, data)
     }
@@ -105,9 +83,6 @@ impl Engine for SpatialModel {
     }
     fn make_record(&self, data: &mut SpatialData, iterations: usize, trials: usize, h: f64) {
         make_record(self, data, iterations, trials, h);
-    }
-    fn skip_record(&self, data: &mut SpatialData, h: f64) {
-        tree_record::carry_momenta(&self.mech, &mut data.fbd, h);
     }
 }
 

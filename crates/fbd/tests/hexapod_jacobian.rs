@@ -14,7 +14,7 @@ use fbd_dynamics::spatial::SpatialContactEquation;
 use fbd_dynamics::tree::assemble::{eval, pattern, prepare_step, set_configuration, set_previous};
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism, contacts_by_kind};
 use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
-use fbd_kinematics::fd::{FdTolerance, check_jacobian};
+use fbd_kinematics::fd::{FdTolerance, check_jacobian, check_pattern};
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::{Joint, JointLimits, LimitSide};
 use fbd_robot::dh::{HexapodLayout, HexapodMasses, hexapod};
@@ -191,19 +191,7 @@ fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementar
     // The declared pattern covers every non-zero entry.
     let mut entries = Vec::new();
     pattern(&mech, &data, &mut entries);
-    let mut declared = vec![false; n * n];
-    for (i, j) in entries {
-        declared[i * n + j] = true;
-    }
-    for i in 0..n {
-        for j in 0..n {
-            assert!(
-                declared[i * n + j] || jac[i * n + j] == 0.0,
-                "entry ({i}, {j}) = {} is not in the pattern",
-                jac[i * n + j]
-            );
-        }
-    }
+    check_pattern(n, n, &entries, |i, j| jac[i * n + j]).unwrap_or_else(|e| panic!("{e}"));
     let mut work = data.clone();
     check_jacobian(
         &z,

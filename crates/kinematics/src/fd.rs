@@ -111,6 +111,32 @@ pub fn check_jacobian(
     Ok(())
 }
 
+/// Checks that a sparse Jacobian's declared structure covers every entry
+/// it writes: `jac(i, j)` (an `m × n` matrix) is zero wherever `(i, j)` is
+/// not among `entries` (the structural pattern, repeats allowed). Returns
+/// the first non-zero entry outside it, row-major, as
+/// `"entry (i, j) = v is not in the pattern"`.
+pub fn check_pattern(
+    m: usize,
+    n: usize,
+    entries: &[(usize, usize)],
+    jac: impl Fn(usize, usize) -> f64,
+) -> Result<(), String> {
+    let mut declared = vec![false; m * n];
+    for &(i, j) in entries {
+        declared[i * n + j] = true;
+    }
+    for i in 0..m {
+        for j in 0..n {
+            let v = jac(i, j);
+            if !declared[i * n + j] && v != 0.0 {
+                return Err(format!("entry ({i}, {j}) = {v} is not in the pattern"));
+            }
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -148,5 +174,13 @@ mod tests {
         let e = check_jacobian(&x, 2, f, j, FdTolerance::default()).unwrap_err();
         assert_eq!((e.i, e.j), (1, 1));
         assert!(e.to_string().contains("(1, 1)"));
+    }
+
+    #[test]
+    fn reports_an_entry_outside_the_pattern() {
+        let jac = |i: usize, j: usize| if (i, j) == (1, 0) { 2.5 } else { 0.0 };
+        assert!(check_pattern(2, 2, &[(1, 0), (0, 1)], jac).is_ok());
+        let e = check_pattern(2, 2, &[(0, 0), (0, 1)], jac).unwrap_err();
+        assert_eq!(e, "entry (1, 0) = 2.5 is not in the pattern");
     }
 }

@@ -3,11 +3,13 @@
 //! * every analytic Jacobian (centres of mass, contact points, points fixed
 //!   anywhere on a body, angular velocities) against central differences
 //!   of `eval` through the workspace's one checker
-//!   ([`fbd_kinematics::fd::check_jacobian`]), on the lab hexapod URDF and
-//!   on the paper's hexapod built from D-H rows, at random configurations;
+//!   ([`fbd_kinematics::fd::check_jacobian`]), on the lab hexapod URDF,
+//!   on the same robot with oblique and negative joint axes (the general
+//!   rotation of the kinematics and its coordinate-axis shortcuts), and on
+//!   the paper's hexapod built from D-H rows, at random configurations;
 //! * the frames, axes and contact points against [`fbd_robot::forward`]
 //!   with the same base pose ([`fbd_robot::forward::base_frame`]);
-//! * on the D-H hexapod, equality (1e-12) with the hexapod-specific
+//! * on the D-H hexapod, equality (1e-12) with the closed-form
 //!   spatial kinematics ([`fbd_dynamics::spatial::SpatialKin`]): centres of
 //!   mass, tips, knees, hips, joint axes and every dense Jacobian, which
 //!   share the `q` layout;
@@ -35,6 +37,23 @@ use proptest::prelude::*;
 fn lab() -> RobotModel {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/robots/lab_hexapod.urdf");
     fbd_robot::urdf::load(&path, Up::Z, &ContactChoice::CollisionSpheres).unwrap()
+}
+
+/// The lab hexapod with every joint's axis changed: an oblique axis (the
+/// kinematics' general rotation), a negative coordinate axis, and the
+/// description's own, leg joint by leg joint.
+fn oblique() -> RobotModel {
+    let mut model = lab();
+    for (j, joint) in model.joints.iter_mut().enumerate() {
+        match j % 3 {
+            0 => {
+                joint.axis = fbd_robot::nalgebra::Unit::new_normalize(Vector3::new(1.0, 2.0, -2.0))
+            }
+            1 => joint.axis = -Vector3::y_axis(),
+            _ => {}
+        }
+    }
+    model
 }
 
 fn dh_hexapod(legs: &[usize]) -> RobotModel {
@@ -370,7 +389,13 @@ proptest! {
     #[test]
     fn eval_matches_forward(q in q_strategy(18)) {
         check_forward(&lab(), &q)?;
+        check_forward(&oblique(), &q)?;
         check_forward(&dh_hexapod(&[1, 2, 3, 4, 5, 6]), &q)?;
+    }
+
+    #[test]
+    fn oblique_axes_jacobians_match_central_differences(q in q_strategy(LAB_JOINTS)) {
+        check_fd(&oblique(), &q)?;
     }
 
     #[test]

@@ -53,9 +53,9 @@ fn spatial(rel: &str, duration: Option<f64>, q_tol: f64, force_tol: f64) {
             assert_eq!(ca.state, cb.state, "{rel}: step {}", ra.step);
             df = df.max(worst(ca.force.iter(), cb.force.iter()));
         }
-        for (la, lb) in ra.legs.iter().zip(&rb.legs) {
-            df = df.max(worst(la.hip_force.iter(), lb.hip_force.iter()));
-            df = df.max(worst(la.knee_force.iter(), lb.knee_force.iter()));
+        // Every joint reaction (the hips' and knees').
+        for (fa, fb) in ra.reaction_force.iter().zip(&rb.reaction_force) {
+            df = df.max(worst(fa.iter(), fb.iter()));
         }
     }
     println!("{rel}: |Δq| ≤ {dq:.2e}, |ΔF| ≤ {df:.2e} N");

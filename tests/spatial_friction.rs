@@ -11,12 +11,13 @@ use common::spatial::stance;
 use fbd_contact::spatial::{clearance, frame};
 use fbd_contact::{Friction, Surface, Terrain};
 use fbd_dynamics::spatial::SpatialKin;
-use fbd_sim::spatial::{SpatialModel, SpatialRecord, closed_form, run_collect};
+use fbd_sim::robot::RobotRecord;
+use fbd_sim::spatial::{SpatialModel, closed_form, run_collect};
 
 /// Checks the law on every contact row; returns (sticking, sliding) rows.
 /// `(sticking rows, sliding rows, sliding rows aligned with their slip,
 /// sliding rows checked)`.
-fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize, usize, usize) {
+fn check_law(model: &SpatialModel, rows: &[RobotRecord]) -> (usize, usize, usize, usize) {
     let p = &model.params;
     let (mu_s, mu_d) = (p.friction.mu_static, p.friction.mu_dynamic);
     let (mut sticking, mut sliding) = (0, 0);
@@ -72,8 +73,8 @@ fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize, usi
                                 touchdown || cos < -0.99,
                                 "t = {} leg {} {}: friction not against the slip (cos {cos})",
                                 r.t,
-                                c.leg,
-                                c.kind.as_str()
+                                model.contacts[j].leg,
+                                model.contacts[j].kind.as_str()
                             );
                         }
                     }
@@ -125,7 +126,7 @@ fn a_spinning_landing_obeys_coulomb_on_every_row() {
     );
 }
 
-fn on_slope(mu: f64) -> (SpatialModel, Vec<SpatialRecord>) {
+fn on_slope(mu: f64) -> (SpatialModel, Vec<RobotRecord>) {
     let mut p = stance();
     p.duration = 1.0;
     let slope = 10f64.to_radians().tan();

@@ -31,10 +31,10 @@ fn at_rest_the_forces_and_torques_are_the_static_ones() {
         (normal - weight).abs() < 1e-6 * weight,
         "Σ N = {normal}, weight {weight}"
     );
-    for c in &last.contacts {
+    for (c, spec) in last.contacts.iter().zip(&model.contacts) {
         assert_eq!(
             c.state.as_str(),
-            if c.kind.as_str() == "tip" {
+            if spec.kind.as_str() == "tip" {
                 "ST2"
             } else {
                 "ST1"
@@ -45,11 +45,13 @@ fn at_rest_the_forces_and_torques_are_the_static_ones() {
     kin.eval(mech, &last.q);
     let g = Vector3::new(0.0, -p.gravity, 0.0);
     let mut worst: f64 = 0.0;
-    for (s, leg) in last.legs.iter().enumerate() {
-        let foot = last
+    for s in 0..model.legs.len() {
+        let leg = model.leg_row(last, s);
+        let foot = model
             .contacts
             .iter()
-            .find(|c| c.leg == leg.leg && c.kind.as_str() == "tip")
+            .position(|c| c.leg == leg.leg && c.kind.as_str() == "tip")
+            .map(|c| &last.contacts[c])
             .unwrap();
         let f = Vector3::from(foot.force);
         let l = &kin.fk.legs[leg.leg - 1];

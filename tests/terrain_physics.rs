@@ -11,7 +11,8 @@ use common::spatial::stance;
 use fbd_contact::spatial::{clearance, frame};
 use fbd_contact::{Friction, FrictionPatch, HeightGrid, StateCode, Surface, Terrain, friction_at};
 use fbd_dynamics::spatial::SpatialKin;
-use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord, closed_form, run_collect};
+use fbd_sim::robot::RobotRecord;
+use fbd_sim::spatial::{SpatialModel, SpatialParams, closed_form, run_collect};
 
 /// A 4 m × 4 m height map of the plane `y = slope·x` (81 × 61 samples).
 fn plane_map(slope: f64) -> Surface {
@@ -27,7 +28,7 @@ fn on(
     angle: f64,
     friction: Friction,
     duration: f64,
-) -> (SpatialModel, Vec<SpatialRecord>) {
+) -> (SpatialModel, Vec<RobotRecord>) {
     let mut p = stance();
     p.duration = duration;
     p.terrain = surface;
@@ -58,7 +59,7 @@ fn weight(p: &SpatialParams) -> f64 {
 
 /// Coulomb's law on every contact row, with the friction of the patch
 /// under the point: returns (sticking, sliding) rows.
-fn check_law(model: &SpatialModel, rows: &[SpatialRecord]) -> (usize, usize) {
+fn check_law(model: &SpatialModel, rows: &[RobotRecord]) -> (usize, usize) {
     let p = &model.params;
     let (mut stick, mut slide) = (0, 0);
     for r in rows {
@@ -244,7 +245,12 @@ fn a_fall_onto_a_bump_touches_down_at_the_free_fall_time() {
     println!("touchdown step starts {} s, free fall {t_free} s", first.t);
     assert!(first.t < t_free && t_free <= first.t + p.dt + 1e-12);
     let row = &rows[first.step + 1];
-    let c = row.contacts.iter().find(|c| c.leg == 1).unwrap();
+    let c = model
+        .contacts
+        .iter()
+        .position(|c| c.leg == 1)
+        .map(|c| &row.contacts[c])
+        .unwrap();
     assert!(
         clearance(&p.terrain, c.point).abs() < 1e-9,
         "on the surface"

@@ -142,7 +142,7 @@ fn the_hexapod_flies_as_the_spatial_engine_flies_it() {
             dq = dq.max((a - b).abs());
         }
         for (s, &(hip, knee)) in legs.iter().enumerate() {
-            let leg = &row.legs[s];
+            let leg = model.leg_row(row, s);
             df = df
                 .max(diff(&rec.reaction_force[hip], &leg.hip_force))
                 .max(diff(&rec.reaction_force[knee], &leg.knee_force));

@@ -58,7 +58,7 @@ pub struct LawReport {
 #[allow(dead_code)]
 pub fn check_contact_laws(
     model: &SpatialModel,
-    rows: &[fbd_sim::spatial::SpatialRecord],
+    rows: &[fbd_sim::robot::RobotRecord],
     retried: &[usize],
 ) -> LawReport {
     let p = &model.params;
@@ -72,14 +72,14 @@ pub fn check_contact_laws(
     };
     for (i, r) in rows.iter().enumerate() {
         let next = rows.get(i + 1).filter(|n| n.step == r.step + 1);
-        for (j, c) in r.contacts.iter().enumerate() {
+        for (j, (c, spec)) in r.contacts.iter().zip(&model.contacts).enumerate() {
             let f = c.force;
             let at = |law: &str| {
                 format!(
                     "t = {:.4} leg {} {} {}: {law}",
                     r.t,
-                    c.leg,
-                    c.kind.as_str(),
+                    spec.leg,
+                    spec.kind.as_str(),
                     c.state.as_str()
                 )
             };

@@ -18,7 +18,8 @@ use fbd_contact::spatial::frame;
 use fbd_contact::{StateCode, friction_at};
 use fbd_dynamics::PointKind;
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, NQ, forward};
-use fbd_sim::spatial::{SpatialParams, SpatialRecord};
+use fbd_sim::robot::RobotRecord;
+use fbd_sim::spatial::SpatialParams;
 
 /// The plane the test files sample.
 fn plane(x: f64, z: f64) -> f64 {
@@ -228,7 +229,7 @@ fn bad_heightfield_files_get_one_clear_error_naming_the_file_and_key() {
 }
 
 /// Runs an example in-process; returns its parameters, rows and summary.
-fn run_example(name: &str) -> (SpatialParams, Vec<SpatialRecord>, fbd_sim::RunSummary) {
+fn run_example(name: &str) -> (SpatialParams, Vec<RobotRecord>, fbd_sim::RunSummary) {
     let path = examples().join(name);
     let Config::Hexapod(c) = fbd_cli::config::load(&path).unwrap() else {
         panic!("hexapod")
@@ -250,7 +251,7 @@ type Centres = ([f64; 3], Vec<[[f64; 3]; 2]>);
 /// Newton's second law of every body on every interior row but those of the
 /// steps in `substepped` (solved in substeps: their recorded forces are the
 /// first substep's, over Δt/n, not a whole step's; `events.csv` names them).
-fn check_rows(p: &SpatialParams, rows: &[SpatialRecord], substepped: &[usize]) -> f64 {
+fn check_rows(p: &SpatialParams, rows: &[RobotRecord], substepped: &[usize]) -> f64 {
     let model = p.kinematic_model();
     let coms: Vec<Centres> = rows
         .iter()
@@ -273,9 +274,10 @@ fn check_rows(p: &SpatialParams, rows: &[SpatialRecord], substepped: &[usize]) -
         .collect();
     let g = [0.0, -p.gravity, 0.0];
     let dt = p.dt;
+    let index = p.record_index();
     let mut worst = 0.0f64;
     for (k, r) in rows.iter().enumerate() {
-        for c in &r.contacts {
+        for (c, &(leg, _)) in r.contacts.iter().zip(&index.contacts) {
             let f = c.force;
             let fnorm = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
             let tol = 1e-6 * (1.0 + fnorm);
@@ -290,15 +292,13 @@ fn check_rows(p: &SpatialParams, rows: &[SpatialRecord], substepped: &[usize]) -
                 StateCode::St1 => assert!(fnorm < 1e-9, "t = {}: a free point pushed", r.t),
                 StateCode::St2 => assert!(
                     n > -tol && ftn <= mu.mu_static * n + tol,
-                    "t = {} leg {}: sticking outside the cone",
+                    "t = {} leg {leg}: sticking outside the cone",
                     r.t,
-                    c.leg
                 ),
                 StateCode::St3 => assert!(
                     n > -tol && (ftn - mu.mu_dynamic * n).abs() < tol,
-                    "t = {} leg {}: sliding |Ft| {ftn} ≠ μD·N",
+                    "t = {} leg {leg}: sliding |Ft| {ftn} ≠ μD·N",
                     r.t,
-                    c.leg
                 ),
             }
         }
@@ -324,12 +324,16 @@ fn check_rows(p: &SpatialParams, rows: &[SpatialRecord], substepped: &[usize]) -
             }
         };
         let mut on_body = Vec::new();
-        for (i, leg) in r.legs.iter().enumerate() {
+        for (i, li) in index.legs.iter().enumerate() {
+            let leg = li.row(r);
             let ground = |kind: PointKind| {
                 r.contacts
                     .iter()
-                    .filter(|c| c.leg == leg.leg && c.kind == kind)
-                    .fold([0.0; 3], |s, c| std::array::from_fn(|a| s[a] + c.force[a]))
+                    .zip(&index.contacts)
+                    .filter(|(_, id)| **id == (leg.leg, kind))
+                    .fold([0.0; 3], |s, (c, _)| {
+                        std::array::from_fn(|a| s[a] + c.force[a])
+                    })
             };
             check(
                 &format!("lower link {}", leg.leg),
@@ -384,10 +388,12 @@ fn the_rough_walk_covers_its_metre_obeying_coulomb_and_newton_on_every_row() {
     let heights: Vec<f64> = touchdowns
         .iter()
         .map(|e| {
-            let c = rows[e.step + 1]
+            let c = p
+                .record_index()
                 .contacts
                 .iter()
-                .find(|c| c.leg == e.leg && c.kind == PointKind::Tip)
+                .position(|id| *id == (e.leg, PointKind::Tip))
+                .map(|c| &rows[e.step + 1].contacts[c])
                 .unwrap();
             assert!(
                 (c.point[1] - p.terrain.height(c.point[0], c.point[2])).abs() < 1e-9,
@@ -403,13 +409,15 @@ fn the_rough_walk_covers_its_metre_obeying_coulomb_and_newton_on_every_row() {
 
 #[test]
 fn the_stairs_example_climbs_three_steps() {
-    let (_, rows, _) = run_example("hexapod_stairs.toml");
+    let (p, rows, _) = run_example("hexapod_stairs.toml");
     let (first, last) = (&rows[0], rows.last().unwrap());
-    for c in last.contacts.iter().filter(|c| c.kind == PointKind::Tip) {
+    for (c, &(leg, kind)) in last.contacts.iter().zip(&p.record_index().contacts) {
+        if kind != PointKind::Tip {
+            continue;
+        }
         assert!(
             (c.point[1] - 0.15).abs() < 1e-6,
-            "leg {} ends at y = {}, not on the top step",
-            c.leg,
+            "leg {leg} ends at y = {}, not on the top step",
             c.point[1]
         );
     }

@@ -31,13 +31,9 @@ impl Stepper<fbd_sim::StepRecord> for fbd_sim::Model {
     }
 }
 
-impl Stepper<fbd_sim::spatial::SpatialRecord> for fbd_sim::spatial::SpatialModel {
+impl Stepper<fbd_sim::robot::RobotRecord> for fbd_sim::spatial::SpatialModel {
     type Run = fbd_sim::RunSummary;
-    fn step(
-        &self,
-        stop: &AtomicBool,
-        each: impl FnMut(&fbd_sim::spatial::SpatialRecord),
-    ) -> Self::Run {
+    fn step(&self, stop: &AtomicBool, each: impl FnMut(&fbd_sim::robot::RobotRecord)) -> Self::Run {
         fbd_sim::spatial::run_until(self, stop, each)
     }
 }

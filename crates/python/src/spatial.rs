@@ -9,7 +9,7 @@ use std::path::Path;
 use fbd_output::spatial::csv::{Slots, row_values};
 use fbd_output::spatial::{Feet, Layout, columns, simulate};
 use fbd_scenario::{Config, HexapodConfig};
-use fbd_sim::spatial::SpatialRecord;
+use fbd_sim::robot::RobotRecord;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -45,16 +45,15 @@ pub fn run<'py>(
             .min(1 << 16);
         let mut cols = Columns::named(columns(&layout), dt, rows);
         let mut feet = Feet::new(&params);
-        let mut slots: Option<Slots> = None;
+        let slots = Slots::of(&layout, &params.record_index());
         simulate(
             &params,
             &config.to_toml(),
             source,
             out,
             stop,
-            &mut |r: &SpatialRecord| {
-                let s = slots.get_or_insert_with(|| Slots::of(&layout, r));
-                row_values(&layout, s, &mut feet, r, &mut cols.sink());
+            &mut |r: &RobotRecord| {
+                row_values(&layout, &slots, &mut feet, r, &mut cols.sink());
                 watch.row(stop);
             },
         )

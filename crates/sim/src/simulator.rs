@@ -492,33 +492,16 @@ impl Plant for SpatialModel {
         }
     }
     fn read(&self, data: &RunData<Self>, out: &mut Readout) {
-        let dt = SpatialModel::dt(self);
-        let moved = data.k > 0;
-        let (kin, prev) = (&data.fbd.kin, &data.fbd.kin_prev);
-        out.bodies
-            .resize(self.mech.bodies.len(), BodyReadout::default());
-        for (body, spec) in out.bodies.iter_mut().zip(&self.mech.bodies) {
-            let b = spec.model_body;
-            let r = kin.rotation[b];
-            body.position = [kin.com[b].x, kin.com[b].y, kin.com[b].z];
-            body.rotation = std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]));
-            if moved {
-                let v = (kin.com[b] - prev.com[b]) / dt;
-                let w =
-                    r * fbd_dynamics::spatial::so3::log(&(prev.rotation[b].transpose() * r)) / dt;
-                body.velocity = [v.x, v.y, v.z];
-                body.angular_velocity = [w.x, w.y, w.z];
-            } else {
-                body.velocity = [0.0; 3];
-                body.angular_velocity = [0.0; 3];
-            }
-        }
-        let rec = &data.record;
-        for (j, joint) in out.joints.iter_mut().enumerate() {
-            joint.torque = rec.legs[j / 3].torque[j % 3];
-        }
-        out.legs.resize(rec.legs.len(), LegReadout::default());
-        for (l, leg) in out.legs.iter_mut().zip(&rec.legs) {
+        read_tree(
+            self,
+            data,
+            self.mech.bodies.iter().map(|b| b.model_body),
+            out,
+        );
+        out.reactions.clear();
+        out.legs.resize(self.legs.len(), LegReadout::default());
+        for (s, l) in out.legs.iter_mut().enumerate() {
+            let leg = self.leg_row(&data.record, s);
             *l = LegReadout {
                 leg: leg.leg,
                 hip_force: leg.hip_force,
@@ -527,35 +510,79 @@ impl Plant for SpatialModel {
                 knee_moment: leg.knee_moment,
             };
         }
-        out.contacts
-            .resize(self.contacts.len(), ContactReadout::default());
-        for (c, spec) in self.contacts.iter().enumerate() {
-            let mc = self.mech.contacts[c].model_contact;
-            let p = kin.contact[mc];
-            let p = [p.x, p.y, p.z];
-            let normal = self.params.terrain.normal(p[0], p[2]);
-            let before = moved.then(|| {
-                let q = prev.contact[mc];
-                [q.x, q.y, q.z]
-            });
-            let row = &rec.contacts[c];
-            let state = if moved {
-                row.state
-            } else {
-                data.states[c].code()
-            };
-            out.contacts[c] = contact_readout(
-                spec,
-                [p, normal],
-                before,
-                dt,
-                state,
-                (row.force, row.normal),
-            );
-        }
-        out.kinetic = rec.kinetic;
-        out.potential = rec.potential;
     }
+}
+
+/// The readout every model on the tree equations shares (the hexapod's
+/// and every imported robot's): the model bodies `bodies` (position,
+/// rotation and velocities from `q[k−1]` → `q[k]`), the joints' torques,
+/// every contact point and the energies, from the one record
+/// ([`crate::robot::RobotRecord`]).
+pub(crate) fn read_tree<M>(
+    model: &M,
+    data: &RunData<M>,
+    bodies: impl ExactSizeIterator<Item = usize>,
+    out: &mut Readout,
+) where
+    M: crate::engine::surface::SurfaceEngine<
+            Mech = fbd_dynamics::tree::TreeMechanism,
+            Fbd = fbd_dynamics::tree::TreeFbdData,
+            Record = crate::robot::RobotRecord,
+        >,
+{
+    let mech = model.mech();
+    let dt = model.dt();
+    let moved = data.k > 0;
+    let (kin, prev) = (&data.fbd.kin, &data.fbd.kin_prev);
+    out.bodies.resize(bodies.len(), BodyReadout::default());
+    for (body, b) in out.bodies.iter_mut().zip(bodies) {
+        let r = kin.rotation[b];
+        let c = kin.com[b];
+        body.position = [c.x, c.y, c.z];
+        body.rotation = std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)]));
+        if moved {
+            let v = (c - prev.com[b]) / dt;
+            let w = r * fbd_dynamics::spatial::so3::log(&(prev.rotation[b].transpose() * r)) / dt;
+            body.velocity = [v.x, v.y, v.z];
+            body.angular_velocity = [w.x, w.y, w.z];
+        } else {
+            body.velocity = [0.0; 3];
+            body.angular_velocity = [0.0; 3];
+        }
+    }
+    let rec = &data.record;
+    for (joint, &tau) in out.joints.iter_mut().zip(&rec.torque) {
+        joint.torque = tau;
+    }
+    let specs = model.settings().contacts;
+    let ground = model.ground();
+    out.contacts
+        .resize(mech.contacts.len(), ContactReadout::default());
+    for (c, tc) in mech.contacts.iter().enumerate() {
+        let p = kin.contact[tc.model_contact];
+        let p = [p.x, p.y, p.z];
+        let normal = ground.normal(p[0], p[2]);
+        let before = moved.then(|| {
+            let q = prev.contact[tc.model_contact];
+            [q.x, q.y, q.z]
+        });
+        let row = &rec.contacts[c];
+        let state = if moved {
+            row.state
+        } else {
+            data.states[c].code()
+        };
+        out.contacts[c] = contact_readout(
+            &specs[c],
+            [p, normal],
+            before,
+            dt,
+            state,
+            (row.force, row.normal),
+        );
+    }
+    out.kinetic = rec.kinetic;
+    out.potential = rec.potential;
 }
 
 impl Plant for Model {
@@ -800,10 +827,10 @@ mod tests {
             );
         }
         for (j, joint) in r.joints.iter().enumerate() {
-            assert_eq!(joint.torque, row.legs[j / 3].torque[j % 3]);
+            assert_eq!(joint.torque, row.torque[j]);
         }
         assert_eq!((r.kinetic, r.potential), (row.kinetic, row.potential));
-        assert_eq!(r.legs[2].knee_force, row.legs[2].knee_force);
+        assert_eq!(r.legs[2].knee_force, sim.model().leg_row(row, 2).knee_force);
     }
 
     /// The same for the planar model's `Control::Pd`.

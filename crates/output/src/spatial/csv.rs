@@ -7,7 +7,8 @@ use std::path::{Path, PathBuf};
 use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
 use fbd_scenario::OutputFormat;
-use fbd_sim::spatial::{SpatialParams, SpatialRecord};
+use fbd_sim::robot::RobotRecord;
+use fbd_sim::spatial::{LegIndex, RecordIndex, SpatialParams};
 
 use super::Layout;
 use crate::OutputError;
@@ -79,31 +80,31 @@ pub fn columns(layout: &Layout) -> Vec<String> {
     c
 }
 
-/// Where each column group of a row is found in a [`SpatialRecord`],
-/// matched by `{leg, kind}` on the first record.
+/// Where each column group of a row is found in a hexapod's
+/// [`RobotRecord`] (the one record of every robot), by `{leg, kind}`.
 #[derive(Clone, Debug, Default)]
 pub struct Slots {
-    /// Per leg of the layout: its row in `record.legs`.
-    pub legs: Vec<Option<usize>>,
+    /// Per leg of the layout: where its values are.
+    pub legs: Vec<Option<LegIndex>>,
     /// Per leg of the layout: its foot's row in `record.contacts`.
     pub tips: Vec<Option<usize>>,
     /// Per extra point of the layout: its row in `record.contacts`.
     pub extras: Vec<Option<usize>>,
+    /// Per row of `record.contacts`: its leg number and kind.
+    pub contacts: Vec<(usize, PointKind)>,
 }
 
 impl Slots {
-    /// The rows of `r` for `layout`.
-    pub fn of(layout: &Layout, r: &SpatialRecord) -> Self {
-        let contact = |leg: usize, kind: PointKind| {
-            r.contacts
-                .iter()
-                .position(|c| c.leg == leg && c.kind == kind)
-        };
+    /// The rows of `layout` in the records of a model whose values are
+    /// where `index` says ([`SpatialParams::record_index`]).
+    pub fn of(layout: &Layout, index: &RecordIndex) -> Self {
+        let contact =
+            |leg: usize, kind: PointKind| index.contacts.iter().position(|&c| c == (leg, kind));
         Self {
             legs: layout
                 .legs
                 .iter()
-                .map(|&n| r.legs.iter().position(|l| l.leg == n))
+                .map(|&n| index.legs.iter().find(|l| l.leg == n).copied())
                 .collect(),
             tips: layout
                 .legs
@@ -115,7 +116,14 @@ impl Slots {
                 .iter()
                 .map(|&(n, kind)| contact(n, kind))
                 .collect(),
+            contacts: index.contacts.clone(),
         }
+    }
+
+    /// The values of the `i`-th leg of the layout in `r`, if it is a leg
+    /// of the model.
+    pub fn leg(&self, r: &RobotRecord, i: usize) -> Option<fbd_sim::spatial::LegRow> {
+        self.legs[i].map(|l| l.row(r))
     }
 }
 
@@ -130,7 +138,7 @@ pub fn row_values(
     layout: &Layout,
     slots: &Slots,
     feet: &mut super::Feet,
-    r: &SpatialRecord,
+    r: &RobotRecord,
     sink: &mut dyn RowSink,
 ) {
     sink.time(r.step, r.t);
@@ -154,7 +162,7 @@ pub fn row_values(
             sink.num(x);
         }
         sink.num(n);
-        let leg = slots.legs[i].map(|l| &r.legs[l]);
+        let leg = slots.leg(r, i);
         for v in [
             leg.map_or(zero, |l| l.hip_force),
             leg.map_or(zero, |l| l.hip_moment),
@@ -191,7 +199,7 @@ pub fn row_values(
 pub struct TrajectoryWriter {
     table: output::Table,
     layout: Layout,
-    slots: Option<Slots>,
+    slots: Slots,
     feet: super::Feet,
     rows: usize,
 }
@@ -212,8 +220,8 @@ impl TrajectoryWriter {
         Ok(Self {
             table: output::Table::create(dir, format, columns(&layout), params.dt)?,
             feet: super::Feet::new(params),
+            slots: Slots::of(&layout, &params.record_index()),
             layout,
-            slots: None,
             rows: 0,
         })
     }
@@ -225,9 +233,8 @@ impl TrajectoryWriter {
 
     /// Appends the row of `r`. An I/O error is kept and reported by
     /// [`TrajectoryWriter::finish`]; later rows are skipped.
-    pub fn write(&mut self, r: &SpatialRecord) {
-        let slots = self.slots.get_or_insert_with(|| Slots::of(&self.layout, r));
-        let (layout, feet) = (&self.layout, &mut self.feet);
+    pub fn write(&mut self, r: &RobotRecord) {
+        let (layout, slots, feet) = (&self.layout, &self.slots, &mut self.feet);
         self.table
             .row(|sink| row_values(layout, slots, feet, r, sink));
         if !self.table.failed() {

@@ -16,7 +16,8 @@ use fbd_dynamics::PointKind;
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, NQ, forward};
 use fbd_scenario::OutputConfig;
 use fbd_sim::RunSummary;
-use fbd_sim::spatial::{SpatialModel, SpatialParams, SpatialRecord};
+use fbd_sim::robot::RobotRecord;
+use fbd_sim::spatial::{SpatialModel, SpatialParams};
 
 use crate::OutputError;
 use crate::config::ConfigError;
@@ -154,7 +155,7 @@ impl Feet {
 }
 
 /// The viewer frame of a record.
-fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &SpatialRecord) -> HexFrame {
+fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &RobotRecord) -> HexFrame {
     feet.update(&r.q);
     let mut d = HexDynamics::default();
     for (i, &n) in layout.legs.iter().enumerate() {
@@ -173,8 +174,7 @@ fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &SpatialRecord
                 d.points[n - 1][k] = (r.contacts[c].state, r.contacts[c].force);
             }
         }
-        if let Some(l) = slots.legs[i] {
-            let l = &r.legs[l];
+        if let Some(l) = slots.leg(r, i) {
             d.hip_force[n - 1] = l.hip_force;
             d.knee_force[n - 1] = l.knee_force;
             d.torque[n - 1] = l.torque;
@@ -205,7 +205,7 @@ pub struct Outputs {
     view: Option<HexapodScene>,
     collect: Option<summary::Collector>,
     feet: Feet,
-    slots: Option<csv::Slots>,
+    slots: csv::Slots,
     /// The model's start-up stability check (s), for `summary.json`.
     pub stability_check_seconds: f64,
 }
@@ -267,47 +267,38 @@ impl Outputs {
             params: params.clone(),
             traj,
             output: output.clone(),
+            slots: csv::Slots::of(&layout, &params.record_index()),
             layout,
             steps,
-            slots: None,
         };
         Ok(Recording::new(files, stride, out_dir))
-    }
-
-    fn slots(&mut self, r: &SpatialRecord) -> &csv::Slots {
-        self.slots
-            .get_or_insert_with(|| csv::Slots::of(&self.layout, r))
     }
 }
 
 impl RunFiles for Outputs {
-    type Record = SpatialRecord;
+    type Record = RobotRecord;
     type Run = RunSummary;
     type Summary = SpatialSummary;
 
-    fn step_of(r: &SpatialRecord) -> usize {
+    fn step_of(r: &RobotRecord) -> usize {
         r.step
     }
 
-    fn row(&mut self, r: &SpatialRecord) {
-        self.slots(r);
-        let s = self.slots.as_ref().expect("set");
+    fn row(&mut self, r: &RobotRecord) {
         if let Some(t) = self.traj.as_mut() {
             t.write(r);
         }
         if let Some(v) = self.view.as_mut() {
-            v.push(&frame(&mut self.feet, &self.layout, s, r));
+            v.push(&frame(&mut self.feet, &self.layout, &self.slots, r));
         }
     }
 
-    fn observe(&mut self, r: &SpatialRecord) {
-        self.slots(r);
-        let s = self.slots.as_ref().expect("set");
+    fn observe(&mut self, r: &RobotRecord) {
         if let Some(c) = self.collect.as_mut() {
-            c.push(r, s);
+            c.push(r, &self.slots);
         }
         if let Some(p) = self.plot.as_mut() {
-            p.push(r, s);
+            p.push(r, &self.slots);
         }
     }
 
@@ -376,7 +367,7 @@ pub fn simulate(
     source: &str,
     out_dir: Option<&Path>,
     stop: &AtomicBool,
-    on_row: &mut dyn FnMut(&SpatialRecord),
+    on_row: &mut dyn FnMut(&RobotRecord),
 ) -> Result<SpatialRun, OutputError> {
     // The plots and peaks want every step: stride is applied by Outputs.
     let mut every_step = params.clone();
@@ -448,61 +439,41 @@ pub fn run_command(
 mod tests {
     use super::*;
     use fbd_contact::StateCode;
+    use fbd_dynamics::tree::{TreeMechanism, contacts_by_kind};
     use fbd_sim::Event;
-    use fbd_sim::spatial::{ContactRow, LegRow};
+    use fbd_sim::robot::RobotContactRow;
 
     /// A made-up step `k` of `params`: the robot falling rigidly, foot 4
     /// on the ground (ST2) from step 5.
-    fn record(p: &SpatialParams, k: usize) -> SpatialRecord {
+    fn record(p: &SpatialParams, k: usize) -> RobotRecord {
         let t = k as f64 * p.dt;
         let mut q = p.q0.clone();
         q[1] -= 0.5 * p.gravity * t * t;
-        let layout = Layout::of(p);
-        let mut contacts = Vec::new();
-        for &n in &layout.legs {
-            let cp = p.contact_points;
-            for (on, kind) in [
-                (cp.tips, PointKind::Tip),
-                (cp.knees, PointKind::Knee),
-                (cp.hips, PointKind::Hip),
-            ] {
-                if !on {
-                    continue;
-                }
-                let down = n == 4 && kind == PointKind::Tip && k >= 5;
-                contacts.push(ContactRow {
-                    leg: n,
-                    kind,
-                    point: [n as f64, 0.0, 0.0],
-                    state: if down { StateCode::St2 } else { StateCode::St1 },
-                    force: if down { [1.0, 50.0, 0.0] } else { [0.0; 3] },
-                    normal: if down { 50.0 } else { 0.0 },
-                });
-            }
+        let robot = p.robot_model();
+        let mech = TreeMechanism::with_contacts(&robot, p.gravity, &contacts_by_kind(&robot));
+        let mut r = RobotRecord::new(&mech, &q);
+        let index = p.record_index();
+        for (c, &(n, kind)) in index.contacts.iter().enumerate() {
+            let down = n == 4 && kind == PointKind::Tip && k >= 5;
+            r.contacts[c] = RobotContactRow {
+                point: [n as f64, 0.0, 0.0],
+                state: if down { StateCode::St2 } else { StateCode::St1 },
+                force: if down { [1.0, 50.0, 0.0] } else { [0.0; 3] },
+                normal: if down { 50.0 } else { 0.0 },
+            };
         }
-        let legs = layout
-            .legs
-            .iter()
-            .map(|&n| LegRow {
-                leg: n,
-                torque: [0.1 * n as f64, -2.0, 3.0],
-                rate: [1.0, 2.0, -1.0],
-                ..LegRow::default()
-            })
-            .collect();
-        SpatialRecord {
-            step: k,
-            t,
-            q,
-            contacts,
-            legs,
-            kinetic: 1.0,
-            potential: 2.0,
-            momentum: [0.0; 3],
-            angular_momentum: [0.0; 3],
-            newton_iterations: 2 + k % 3,
-            state_trials: 1,
+        for l in &index.legs {
+            let j = l.joint;
+            r.torque[j..j + 3].copy_from_slice(&[0.1 * l.leg as f64, -2.0, 3.0]);
+            r.rate[j..j + 3].copy_from_slice(&[1.0, 2.0, -1.0]);
         }
+        r.step = k;
+        r.t = t;
+        r.kinetic = 1.0;
+        r.potential = 2.0;
+        r.newton_iterations = 2 + k % 3;
+        r.state_trials = 1;
+        r
     }
 
     #[test]

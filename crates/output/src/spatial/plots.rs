@@ -13,7 +13,7 @@
 
 use fbd_contact::Surface;
 use fbd_sim::RunSummary;
-use fbd_sim::spatial::SpatialRecord;
+use fbd_sim::robot::RobotRecord;
 use plotters::style::RGBColor;
 
 use super::Layout;
@@ -83,7 +83,7 @@ impl Recorder {
     ///
     /// Runs for every step: the step's time column is found once for all
     /// the curves ([`Columns::of`]).
-    pub fn push(&mut self, r: &SpatialRecord, s: &Slots) {
+    pub fn push(&mut self, r: &RobotRecord, s: &Slots) {
         let t = r.t;
         let col = self.columns.of(t);
         for (i, m) in self.normal.iter_mut().enumerate() {
@@ -99,7 +99,10 @@ impl Recorder {
             }
         }
         for (i, ms) in self.torque.iter_mut().enumerate() {
-            let tau = s.legs[i].map_or([0.0; 3], |l| r.legs[l].torque);
+            let tau = s.legs[i].map_or([0.0; 3], |l| {
+                let j = l.joint;
+                [r.torque[j], r.torque[j + 1], r.torque[j + 2]]
+            });
             for (m, v) in ms.iter_mut().zip(tau) {
                 m.push_at(col, t, v);
             }

@@ -6,7 +6,8 @@ use std::collections::BTreeMap;
 
 use fbd_contact::{StateCode, Surface};
 use fbd_dynamics::PointKind;
-use fbd_sim::spatial::{SpatialControl, SpatialParams, SpatialRecord};
+use fbd_sim::robot::RobotRecord;
+use fbd_sim::spatial::{SpatialControl, SpatialParams};
 use fbd_sim::{Event, RunSummary};
 use serde::Serialize;
 
@@ -136,10 +137,10 @@ impl Collector {
     }
 
     /// Adds one step; `s` matches the record's rows to the layout.
-    pub fn push(&mut self, r: &SpatialRecord, s: &Slots) {
+    pub fn push(&mut self, r: &RobotRecord, s: &Slots) {
         self.iter_max = self.iter_max.max(r.newton_iterations);
-        for (i, slot) in s.legs.iter().enumerate() {
-            let Some(l) = slot.map(|l| &r.legs[l]) else {
+        for i in 0..s.legs.len() {
+            let Some(l) = s.leg(r, i) else {
                 continue;
             };
             for j in 0..3 {
@@ -150,10 +151,10 @@ impl Collector {
             self.joint_force[i][1] = self.joint_force[i][1].max(norm(l.knee_force));
         }
         if self.contact.is_empty() {
-            self.contact = r
+            self.contact = s
                 .contacts
                 .iter()
-                .map(|c| (c.leg, c.kind, PeakForce::default()))
+                .map(|&(leg, kind)| (leg, kind, PeakForce::default()))
                 .collect();
         }
         for (p, c) in self.contact.iter_mut().zip(&r.contacts) {

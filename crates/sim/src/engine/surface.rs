@@ -198,15 +198,17 @@ pub(crate) use tree_surface_engine;
 /// generic tree equations (`fbd_dynamics::tree`: its state, trial, ground
 /// and workspace types; the stages `prepare_step`, `evaluate_next`,
 /// `set_configuration`, `set_previous`, `advance` of
-/// `fbd_dynamics::tree::assemble`; the stop rows' unknowns; the momenta
+/// `fbd_dynamics::tree::assemble`; the stop rows' unknowns; the one record
+/// of every robot, [`super::tree_record::RobotRecord`], and the momenta
 /// carried by a step without a record) whose model holds its mechanism in
-/// `self.mech`, its record `newton_iterations` and `state_trials`.
+/// `self.mech`.
 macro_rules! surface_stages {
     () => {
         type State = fbd_contact::SpatialState;
         type Trial = fbd_contact::SpatialTrial;
         type Ground = fbd_contact::Surface;
         type Fbd = fbd_dynamics::tree::TreeFbdData;
+        type Record = $crate::engine::tree_record::RobotRecord;
 
         fn limit_moment_index(&self, l: usize) -> usize {
             self.mech.dims().limit_moment(l)
@@ -283,6 +285,15 @@ macro_rules! surface_stages {
             use fbd_dynamics::tree::assemble as asm;
             asm::set_configuration(&self.mech, &mut data.fbd, &data.grid_q);
             asm::set_previous(&self.mech, &mut data.fbd, &data.grid_q_prev);
+        }
+        fn make_record(
+            &self,
+            data: &mut $crate::engine::RunData<Self>,
+            iterations: usize,
+            trials: usize,
+            h: f64,
+        ) {
+            $crate::engine::tree_record::make_record(self, data, iterations, trials, h);
         }
         fn add_to_record(record: &mut Self::Record, iterations: usize, trials: usize) {
             record.newton_iterations += iterations;

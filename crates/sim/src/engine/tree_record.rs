@@ -1,13 +1,187 @@
-//! What a step of any model on the generic tree equations
-//! ([`fbd_dynamics::tree`]: the paper's hexapod and every imported robot)
-//! records from its solution, written once: each contact point's force,
-//! each joint reaction's force and moment, and the step's energies and
-//! momenta (the scheme's own, over the step k → k+1).
+//! The one record of every model on the generic tree equations
+//! ([`fbd_dynamics::tree`]: the paper's hexapod and every imported robot),
+//! [`RobotRecord`], and what a step records from its solution, written
+//! once ([`make_record`]): each contact point's force, each joint
+//! reaction's force and moment, each joint's torque, rate and stop, and
+//! the step's energies and momenta (the scheme's own, over the step
+//! k → k+1). A model's own view of it (the hexapod's legs,
+//! [`crate::spatial::LegRow`]) is read from it, not recorded apart.
 
+use super::RunData;
+use super::surface::SurfaceEngine;
+use crate::record::LimitCode;
+use fbd_contact::StateCode;
 use fbd_dynamics::spatial::half_momentum_and_rotation;
 use fbd_dynamics::tree::assemble::step_momentum;
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism};
 use fbd_kinematics::nalgebra::Vector3;
+
+/// One contact point's row values.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RobotContactRow {
+    /// Where it touches the ground at `q[k]` (a sphere's lowest point)
+    /// (m, inertial).
+    pub point: [f64; 3],
+    /// State the point was solved in at step k.
+    pub state: StateCode,
+    /// Force of the ground on the point, inertial frame (N).
+    pub force: [f64; 3],
+    /// Normal component of that force (N, along the terrain normal).
+    pub normal: f64,
+}
+
+/// Everything known about step `k` of a robot once it is solved: row `k`
+/// of `trajectory.csv`. Sized from the model (allocated once, refilled
+/// every step).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotRecord {
+    /// Step index k.
+    pub step: usize,
+    /// Time k·Δt (s).
+    pub t: f64,
+    /// `q[k]`: the root's `(Rx, Ry, Rz, φx, φy, φz)`, then every joint's
+    /// angle (m, rad).
+    pub q: Vec<f64>,
+    /// Per contact point of the mechanism (model order).
+    pub contacts: Vec<RobotContactRow>,
+    /// Per reaction (`TreeMechanism::reactions`), the force at its first
+    /// joint's origin on the child body (N, inertial; the parent gets its
+    /// opposite).
+    pub reaction_force: Vec<[f64; 3]>,
+    /// Per reaction, the moment on the child body about that point:
+    /// constraint moments, actuator torques and stop moments (N·m,
+    /// inertial).
+    pub reaction_moment: Vec<[f64; 3]>,
+    /// Per model joint, its actuator torque at k (N·m).
+    pub torque: Vec<f64>,
+    /// Per model joint, its rate at k (rad/s, backward difference; the
+    /// initial rate at k = 0).
+    pub rate: Vec<f64>,
+    /// Per model joint, its stop's state at k (free for joints without
+    /// limits).
+    pub limit: Vec<LimitCode>,
+    /// Per model joint, its stop moment at k (N·m, along the joint axis on
+    /// the child).
+    pub stop: Vec<f64>,
+    /// Kinetic energy over the step (J, the scheme's).
+    pub kinetic: f64,
+    /// Gravitational potential energy, mean of k and k+1 (J).
+    pub potential: f64,
+    /// Total linear momentum over the step k → k+1 (kg·m/s).
+    pub momentum: [f64; 3],
+    /// Total angular momentum about the origin over the step (kg·m²/s).
+    pub angular_momentum: [f64; 3],
+    /// Centre of mass of the whole robot at `q[k]` (m).
+    pub com: [f64; 3],
+    /// Newton iterations of this step (every state trial and substep).
+    pub newton_iterations: usize,
+    /// State combinations solved in this step.
+    pub state_trials: usize,
+}
+
+impl RobotRecord {
+    /// A record sized for `mech` at `q0` (every value zero).
+    pub fn new(mech: &TreeMechanism, q0: &[f64]) -> Self {
+        let nj = mech.model.joints.len();
+        let nr = mech.reactions.len();
+        Self {
+            step: 0,
+            t: 0.0,
+            q: q0.to_vec(),
+            contacts: vec![
+                RobotContactRow {
+                    point: [0.0; 3],
+                    state: StateCode::St1,
+                    force: [0.0; 3],
+                    normal: 0.0,
+                };
+                mech.contacts.len()
+            ],
+            reaction_force: vec![[0.0; 3]; nr],
+            reaction_moment: vec![[0.0; 3]; nr],
+            torque: vec![0.0; nj],
+            rate: vec![0.0; nj],
+            limit: vec![LimitCode::Free; nj],
+            stop: vec![0.0; nj],
+            kinetic: 0.0,
+            potential: 0.0,
+            momentum: [0.0; 3],
+            angular_momentum: [0.0; 3],
+            com: [0.0; 3],
+            newton_iterations: 0,
+            state_trials: 0,
+        }
+    }
+}
+
+/// The rate `q̇_i[k]` of coordinate `i`: the backward difference
+/// `(q_i[k] − q_i[k−1])/Δt`, the initial rate `q̇_i(0)` at k = 0 (the
+/// joint controllers' rates and the record's, one rule).
+#[inline]
+pub fn coordinate_rate<M: super::Engine>(model: &M, data: &RunData<M>, i: usize) -> f64 {
+    if data.k == 0 {
+        model.qdot0()[i]
+    } else {
+        (data.q[i] - data.q_prev[i]) / model.dt()
+    }
+}
+
+/// The number of root coordinates before the joint angles in `q`.
+const ROOT_DOF: usize = 6;
+
+/// Fills `data.record` for the solved (sub)step of length `h` of a model
+/// on the tree equations: every model's, written once.
+pub fn make_record<M>(
+    model: &M,
+    data: &mut RunData<M>,
+    newton_iterations: usize,
+    state_trials: usize,
+    h: f64,
+) where
+    M: SurfaceEngine<Mech = TreeMechanism, Fbd = TreeFbdData, Record = RobotRecord>,
+{
+    let mech = model.mech();
+    let dims = mech.dims();
+    let dt = model.dt();
+    let fbd = &data.fbd;
+    let z = &data.z;
+    let rec = &mut data.record;
+    rec.step = data.k;
+    rec.t = data.k as f64 * dt;
+    rec.q.copy_from_slice(&data.q);
+    rec.newton_iterations = newton_iterations;
+    rec.state_trials = state_trials;
+    for (c, row) in rec.contacts.iter_mut().enumerate() {
+        (row.point, row.force, row.normal) = contact_force(mech, fbd, z, c);
+        row.state = data.trial[c].code();
+    }
+    rec.torque.copy_from_slice(&fbd.torque);
+    for i in 0..mech.reactions.len() {
+        let (f, m) = reaction_wrench(mech, fbd, z, i);
+        rec.reaction_force[i] = f.into();
+        rec.reaction_moment[i] = m.into();
+    }
+    rec.limit.fill(LimitCode::Free);
+    rec.stop.fill(0.0);
+    for (l, lim) in mech.limits.iter().enumerate() {
+        let stop = z[dims.limit_moment(l)];
+        let m = Vector3::from(rec.reaction_moment[lim.reaction]) + stop * fbd.kin.axis[lim.joint];
+        rec.reaction_moment[lim.reaction] = m.into();
+        rec.limit[lim.joint] = LimitCode::of(&data.limit_trial[l]);
+        rec.stop[lim.joint] = stop;
+    }
+    for j in 0..rec.rate.len() {
+        let r = coordinate_rate(model, data, ROOT_DOF + j);
+        data.record.rate[j] = r;
+    }
+    let m = momenta(mech, &mut data.fbd, h);
+    let rec = &mut data.record;
+    rec.kinetic = m.kinetic;
+    rec.potential = m.potential;
+    rec.momentum = m.momentum;
+    rec.angular_momentum = m.angular_momentum;
+    rec.com = m.com;
+}
 
 /// Contact point `c` at `q[k]` (where it touches the ground), and the
 /// ground's force on it (inertial) with its normal component, from the

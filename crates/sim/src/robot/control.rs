@@ -115,12 +115,7 @@ impl RobotControl {
 
 /// Joint `j`'s rate `θ̇[k]` (backward difference; `q̇0` at k = 0).
 pub fn joint_rates(model: &RobotSim, data: &RobotData, j: usize) -> f64 {
-    let i = BASE_DOF + j;
-    if data.k == 0 {
-        model.params.qdot0[i]
-    } else {
-        (data.q[i] - data.q_prev[i]) / model.params.dt
-    }
+    crate::engine::tree_record::coordinate_rate(model, data, BASE_DOF + j)
 }
 
 /// Fills `data.fbd.torque` for step `data.k`. No allocation.

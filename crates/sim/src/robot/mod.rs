@@ -24,12 +24,11 @@ mod data;
 mod model;
 mod params;
 mod plant;
-mod record;
 mod step;
 
+pub use crate::engine::tree_record::{RobotContactRow, RobotRecord};
 pub use control::{GaitWork, JointTrajectory, RobotControl, joint_rates};
 pub use data::RobotData;
 pub use model::{RobotSim, mass_matrix};
 pub use params::RobotParams;
-pub use record::{RobotContactRow, RobotRecord};
 pub use step::step;

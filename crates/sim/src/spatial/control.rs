@@ -10,18 +10,12 @@ use super::data::SpatialData;
 use super::model::SpatialModel;
 use super::params::SpatialControl;
 use crate::SimError;
+use crate::engine::tree_record::coordinate_rate;
 use fbd_dynamics::spatial::q_joint;
 
 /// The joint rates `θ̇[k]` of slot `s` (backward difference).
 pub fn joint_rates(model: &SpatialModel, data: &SpatialData, s: usize) -> [f64; 3] {
-    std::array::from_fn(|j| {
-        let i = q_joint(s, j);
-        if data.k == 0 {
-            model.params.qdot0[i]
-        } else {
-            (data.q[i] - data.q_prev[i]) / model.dt()
-        }
-    })
+    std::array::from_fn(|j| coordinate_rate(model, data, q_joint(s, j)))
 }
 
 /// Fills `data.fbd.torque` for step `data.k`. No allocation.

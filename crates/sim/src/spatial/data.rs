@@ -3,12 +3,11 @@
 //! spatial model.
 
 use super::model::SpatialModel;
-use super::record::{ContactRow, LegRow, SpatialRecord};
 use crate::engine::RunData;
 use crate::engine::data::Parts;
+use crate::engine::tree_record::RobotRecord;
 use crate::gait::GaitData;
 use crate::spatial::params::SpatialControl;
-use fbd_contact::StateCode;
 use fbd_dynamics::tree::TreeFbdData;
 use fbd_dynamics::tree::assemble::set_configuration;
 use fbd_solver::NewtonSolver;
@@ -24,37 +23,7 @@ impl RunData<SpatialModel> {
         let q0 = &model.params.q0;
         let mut fbd = TreeFbdData::new(mech);
         set_configuration(mech, &mut fbd, q0);
-        let record = SpatialRecord {
-            step: 0,
-            t: 0.0,
-            q: q0.clone(),
-            contacts: model
-                .contacts
-                .iter()
-                .map(|c| ContactRow {
-                    leg: c.leg,
-                    kind: c.kind,
-                    point: [0.0; 3],
-                    state: StateCode::St1,
-                    force: [0.0; 3],
-                    normal: 0.0,
-                })
-                .collect(),
-            legs: model
-                .legs
-                .iter()
-                .map(|&leg| LegRow {
-                    leg,
-                    ..LegRow::default()
-                })
-                .collect(),
-            kinetic: 0.0,
-            potential: 0.0,
-            momentum: [0.0; 3],
-            angular_momentum: [0.0; 3],
-            newton_iterations: 0,
-            state_trials: 0,
-        };
+        let record = RobotRecord::new(mech, q0);
         let gait = match &model.params.control {
             SpatialControl::Gait { gait, .. } => Some(Box::new(GaitData::new(gait))),
             _ => None,

@@ -5,15 +5,18 @@
 //! `fbd_dynamics::spatial` for the equations and the rotation scheme. The
 //! model is the hexapod's D-H instance of the generic robot model
 //! ([`SpatialParams::robot_model`]) on the FBD equations of every robot
-//! (`fbd_dynamics::tree`); the hexapod's parameters, controllers, record
-//! and output columns are its own.
+//! (`fbd_dynamics::tree`), and records every robot's record
+//! ([`crate::robot::RobotRecord`]); the hexapod's parameters, controllers,
+//! leg-by-leg view of the record ([`LegRow`]) and output columns are its
+//! own.
 //!
 //! * [`SpatialParams`] → [`SpatialModel`] (immutable) and [`SpatialData`]
 //!   (the workspace);
 //! * [`step()`] — one staged step (kinematics at k → torques → predictor →
 //!   solve → contact and limit check → accept);
-//! * [`run_until`] / [`run_collect`] — the loop, one [`SpatialRecord`] per
-//!   written step, and a [`crate::RunSummary`].
+//! * [`run_until`] / [`run_collect`] — the loop, one
+//!   [`crate::robot::RobotRecord`] per written step, and a
+//!   [`crate::RunSummary`].
 
 pub mod control;
 mod data;
@@ -26,6 +29,6 @@ pub mod step;
 pub use data::SpatialData;
 pub use model::{LegLimit, SpatialModel, closed_form, fastest_mode_over_poses, modes_slower_than};
 pub use params::{LegTrajectory3, SpatialControl, SpatialParams, default_q0, hexagon_inertia};
-pub use record::{ContactRow, LegRow, SpatialRecord};
+pub use record::{LegIndex, LegRow, RecordIndex};
 pub use run::{run_collect, run_until};
 pub use step::step;

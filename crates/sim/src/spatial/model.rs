@@ -252,29 +252,7 @@ impl SpatialModel {
                 )?;
             }
         }
-        let contacts: Vec<ContactSpec> = mech
-            .contacts
-            .iter()
-            .map(|c| {
-                let stem = c.name.trim_end_matches(|ch: char| ch.is_ascii_digit());
-                let leg: usize = c.name[stem.len()..].parse().expect("a hexapod point's leg");
-                let slot = legs
-                    .iter()
-                    .position(|&n| n == leg)
-                    .expect("a leg of the model");
-                let kind = [PointKind::Tip, PointKind::Knee, PointKind::Hip]
-                    .into_iter()
-                    .find(|k| k.as_str() == stem)
-                    .expect("tip, knee or hip");
-                ContactSpec {
-                    name: c.name.clone(),
-                    leg,
-                    kind,
-                    body: c.body,
-                    point: fbd_dynamics::spatial::point_id(slot, kind),
-                }
-            })
-            .collect();
+        let contacts = hexapod_contacts(&mech, &legs);
         let contact = p.contact;
         let contact_bumper = contacts
             .iter()
@@ -345,6 +323,35 @@ impl SpatialModel {
     pub fn gravity(&self) -> Vector3<f64> {
         Vector3::new(0.0, -self.params.gravity, 0.0)
     }
+}
+
+/// Each contact point's hexapod identity (leg, tip/knee/hip), in the
+/// order of `mech.contacts` (named `tip3`, `knee3`, `hip3`, … by
+/// [`SpatialParams::robot_model`]); `legs` are the model's leg numbers in
+/// slot order.
+pub(crate) fn hexapod_contacts(mech: &TreeMechanism, legs: &[usize]) -> Vec<ContactSpec> {
+    mech.contacts
+        .iter()
+        .map(|c| {
+            let stem = c.name.trim_end_matches(|ch: char| ch.is_ascii_digit());
+            let leg: usize = c.name[stem.len()..].parse().expect("a hexapod point's leg");
+            let slot = legs
+                .iter()
+                .position(|&n| n == leg)
+                .expect("a leg of the model");
+            let kind = [PointKind::Tip, PointKind::Knee, PointKind::Hip]
+                .into_iter()
+                .find(|k| k.as_str() == stem)
+                .expect("tip, knee or hip");
+            ContactSpec {
+                name: c.name.clone(),
+                leg,
+                kind,
+                body: c.body,
+                point: fbd_dynamics::spatial::point_id(slot, kind),
+            }
+        })
+        .collect()
 }
 
 /// The hexapod of `p` in closed form ([`fbd_dynamics::spatial`]): its

@@ -2,8 +2,8 @@
 
 use super::data::SpatialData;
 use super::model::SpatialModel;
-use super::record::SpatialRecord;
 use crate::RunSummary;
+use crate::engine::tree_record::RobotRecord;
 use std::sync::atomic::AtomicBool;
 
 /// Runs `model` to its last step (or the first error or `stop`), handing
@@ -12,13 +12,13 @@ use std::sync::atomic::AtomicBool;
 pub fn run_until(
     model: &SpatialModel,
     stop: &AtomicBool,
-    on_row: impl FnMut(&SpatialRecord),
+    on_row: impl FnMut(&RobotRecord),
 ) -> RunSummary {
     crate::engine::run::run_until(model, SpatialData::new(model), stop, on_row)
 }
 
 /// [`run_until`] keeping every written record in memory.
-pub fn run_collect(model: &SpatialModel) -> (Vec<SpatialRecord>, RunSummary) {
+pub fn run_collect(model: &SpatialModel) -> (Vec<RobotRecord>, RunSummary) {
     let mut rows = Vec::with_capacity(model.steps / model.params.stride.max(1) + 1);
     let summary = run_until(model, &AtomicBool::new(false), |r| rows.push(r.clone()));
     (rows, summary)

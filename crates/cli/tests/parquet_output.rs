@@ -1,7 +1,8 @@
 //! `[output] format = "parquet"`: `trajectory.parquet` holds the columns of
 //! `trajectory.csv`, with the same names, in the same order, with the same
 //! values (numbers bit for bit, states as strings, `newton_iterations` as
-//! integers), for the planar model, the kinematic gait and the 3D dynamics;
+//! integers), for the planar model, the kinematic gait, the 3D dynamics and
+//! an imported robot;
 //! and the run writes no `trajectory.csv` beside it.
 
 use std::fs::File;
@@ -140,4 +141,70 @@ fn kinematic_gait_parquet_equals_the_csv() {
     // Load once to check the example parses, then run its text.
     load_with_overrides(&path, &[]).unwrap();
     same_table(&std::fs::read_to_string(&path).unwrap(), "tripod gait");
+}
+
+#[test]
+fn robot_parquet_equals_the_csv() {
+    // An imported robot landing (contact states of every kind), through
+    // the writer of every model on the tree equations; the description by
+    // its absolute path, so that the text runs from elsewhere.
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/robots");
+    let text = std::fs::read_to_string(examples.join("lab_hexapod_drop.toml"))
+        .unwrap()
+        .replace(
+            "urdf = \"lab_hexapod.urdf\"",
+            &format!(
+                "urdf = \"{}\"",
+                examples
+                    .join("lab_hexapod.urdf")
+                    .canonicalize()
+                    .unwrap()
+                    .display()
+            ),
+        )
+        .replace("duration = 0.6", "duration = 0.3");
+    let tmp = tempfile::tempdir().unwrap();
+    let (c, p) = (tmp.path().join("csv"), tmp.path().join("parquet"));
+    for (dir, format) in [(&c, "csv"), (&p, "parquet")] {
+        std::fs::create_dir_all(dir).unwrap();
+        let path = dir.join("in.toml");
+        std::fs::write(
+            &path,
+            format!("{text}\n[output]\nformat = \"{format}\"\nviewer = false\n"),
+        )
+        .unwrap();
+        fbd_cli::run::run_command(Some(&path), dir, &mut std::io::sink()).unwrap();
+    }
+    assert!(
+        !p.join("trajectory.csv").exists(),
+        "a CSV beside the Parquet"
+    );
+    let (ch, crows) = csv_cells(&c.join("trajectory.csv"));
+    let (ph, prows) = parquet_cells(&p.join("trajectory.parquet"));
+    assert_eq!(ch, ph, "columns");
+    assert_eq!(crows, prows, "rows");
+    assert!(ch.iter().any(|h| h == "lf_foot_sphere_state"), "{ch:?}");
+    assert!(
+        crows
+            .iter()
+            .any(|r| r.contains(&Cell::Str("ST2".to_owned()))),
+        "a point sticks"
+    );
+    // The plots of every model on the tree equations, in the robot's names.
+    for f in ["feet.svg", "torques.svg", "body.svg", "energy.svg"] {
+        let svg = std::fs::read_to_string(p.join(f)).unwrap();
+        assert!(
+            svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"),
+            "{f}"
+        );
+    }
+    let torques = std::fs::read_to_string(p.join("torques.svg")).unwrap();
+    for d in 1..=3 {
+        assert!(torques.contains(&format!("Depth {d} from the root")), "{d}");
+    }
+    assert!(!torques.contains("Depth 4 from the root"));
+    assert!(torques.contains("lf_tibia_joint"));
+    let feet = std::fs::read_to_string(p.join("feet.svg")).unwrap();
+    assert!(feet.contains("rr_foot_sphere") && feet.contains("ground under"));
+    assert!(!p.join("viewer.html").exists());
 }

@@ -5,7 +5,8 @@
 //! `fbd run` drivers writing `trajectory.csv`, `events.csv`,
 //! `summary.json`, `config.toml` and the plots ([`run`], [`output`],
 //! [`plot`]; a kinematic hexapod run in [`hexapod`], a dynamic one in
-//! [`spatial`], an imported robot in [`robot_run`]), the Parquet output
+//! [`spatial`], an imported robot in [`robot_run`]; the trajectory of
+//! every model on the tree equations in [`tree`]), the Parquet output
 //! ([`columnar`]), the viewer page ([`viewer`]), sweeps ([`sweep`],
 //! [`sweep_plot`]) and the answers of `fbd kinematics` / `fbd inverse`
 //! ([`kinematics`]). Nothing here parses a command line; every failure is
@@ -27,6 +28,7 @@ pub mod spatial;
 pub mod steptime;
 pub mod sweep;
 pub mod sweep_plot;
+pub mod tree;
 pub mod viewer;
 
 pub use config::{Config, ConfigError, Override};

@@ -542,7 +542,7 @@ pub fn trajectory_columns(contacts: &[ContactSpec]) -> Vec<String> {
 /// Receives the values of one row of `trajectory.csv`, column by column
 /// in the order of the file's columns: the files' writers and the
 /// in-memory columns of the Python package share the row builders
-/// ([`row_values`], [`crate::spatial::csv::row_values`]), one source of
+/// ([`row_values`], [`crate::tree::Plan::row`]), one source of
 /// the values.
 pub trait RowSink {
     /// `t`: the time of step `step` (`t = step·Δt`; the file writes the

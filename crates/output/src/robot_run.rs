@@ -1,32 +1,46 @@
 //! `fbd run` of an imported robot (`model = "robot"`): the run itself is
 //! [`fbd_scenario::robot::LoadedRobot::run`] (the generic FBD model on its
 //! terrain, or in flight with `[terrain] kind = "none"`); this module
-//! writes `trajectory.csv` (streamed, every `[output] stride`-th step),
-//! `events.csv`, `summary.json`, `config.toml` and `viewer.html` (unless
-//! `[output] viewer = false`; [`crate::viewer::robot`]), each
-//! all-or-nothing, also after a simulation error or an interruption.
+//! writes `trajectory.csv` (or `trajectory.parquet` with `[output] format
+//! = "parquet"`; streamed, every `[output] stride`-th step: the columns of
+//! [`plan`] through the row writer of every model on the tree equations,
+//! [`crate::tree`]), `events.csv`, `summary.json`, `config.toml`, the
+//! plots `feet.svg`, `torques.svg`, `body.svg`, `energy.svg` (unless
+//! `[output] plots = false`; the hexapod's, [`crate::tree::plots`], in the
+//! robot's names: [`plot_plan`]) and `viewer.html` (unless `[output]
+//! viewer = false`; [`crate::viewer::robot`]), each all-or-nothing, also
+//! after a simulation error or an interruption.
 
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use fbd_sim::robot::RobotRecord;
+use fbd_sim::robot::{RobotRecord, RobotSim};
 
 use serde::Serialize;
 
 use crate::OutputError;
-use crate::config::robot::{ColumnKind, LoadedRobot, RobotRun};
+use crate::config::robot::{LoadedRobot, MOTION_BASE_COLUMNS, RobotRun};
 use crate::driver::{self, Recording, RunFiles, RunOutput, Stepper};
 use crate::output::{self, Ending, IterationsPerStep};
+use crate::plot::{EventMark, PALETTE};
 use crate::steptime::StepTimes;
+use crate::tree::plots::{self, Curve, PlotPlan};
+use crate::tree::{Plan, Source};
 
-/// The files of a robot's run, in the order they are written (the last
-/// only with `[output] viewer`).
-pub const FILES: [&str; 5] = [
+/// The files of a robot's run, in the order they are written (the plots
+/// only with `[output] plots`, the viewer only with `[output] viewer`;
+/// `trajectory.parquet` instead of `trajectory.csv` with `[output] format
+/// = "parquet"`).
+pub const FILES: [&str; 9] = [
     "trajectory.csv",
     "events.csv",
     "summary.json",
     "config.toml",
+    "feet.svg",
+    "torques.svg",
+    "body.svg",
+    "energy.svg",
     "viewer.html",
 ];
 
@@ -113,14 +127,6 @@ pub struct RobotSummary {
 /// the files written.
 pub type RobotRunOutput = RunOutput<RobotRun, RobotSummary>;
 
-fn write_number(w: &mut impl Write, x: f64, buf: &mut ryu::Buffer) -> std::io::Result<()> {
-    if x.is_finite() {
-        w.write_all(buf.format_finite(x).as_bytes())
-    } else {
-        write!(w, "{x}")
-    }
-}
-
 /// Every event of a robot's run in time order (contact events first at
 /// equal times), named for `events.csv`, with each one's step.
 pub fn robot_events(
@@ -169,11 +175,131 @@ pub fn robot_events(
     )
 }
 
-/// A robot's stepping: the engine on its simulator ([`LoadedRobot::run_sim`],
-/// which hands over every `[output] stride`-th step).
+/// The columns of a robot's `trajectory.csv` (run by `sim`): `t, rx, ry,
+/// rz, phi_x, phi_y, phi_z`, one per joint angle (rad, the joint's name);
+/// per reaction `<joint>_fx, _fy, _fz` (force of the parent on the child
+/// at the joint's origin, N, inertial) and `<joint>_mx, _my, _mz` (its
+/// moment on the child about that point: constraint moments, actuator
+/// torques and stops, N·m), named by the reaction's first joint;
+/// `tau_<joint>` per joint (N·m); per contact point `<c>`: `<c>_state`,
+/// `<c>_x, _y, _z` (where it touches, m), `<c>_fx, _fy, _fz` (the ground's
+/// force on it, N, inertial) and `<c>_n` (its normal component); then
+/// `com_x, com_y, com_z, kinetic, potential, newton_iterations`.
+pub fn plan(robot: &LoadedRobot, sim: &RobotSim) -> Plan {
+    let joints = &robot.model.joints;
+    let mut p = Plan::default();
+    p.push("t", Source::Time);
+    for (i, name) in MOTION_BASE_COLUMNS.iter().enumerate() {
+        p.push(*name, Source::Q(i));
+    }
+    for (j, joint) in joints.iter().enumerate() {
+        p.push(joint.name.clone(), Source::Q(MOTION_BASE_COLUMNS.len() + j));
+    }
+    for (i, r) in sim.mech.reactions.iter().enumerate() {
+        let prefix = format!("{}_", joints[r.joints[0]].name);
+        p.push_each(&prefix, ["fx", "fy", "fz"], |a| Source::ReactionForce(i, a));
+        p.push_each(&prefix, ["mx", "my", "mz"], |a| {
+            Source::ReactionMoment(i, a)
+        });
+    }
+    for (j, joint) in joints.iter().enumerate() {
+        p.push(format!("tau_{}", joint.name), Source::Torque(j));
+    }
+    for (c, point) in sim.mech.contacts.iter().enumerate() {
+        let prefix = format!("{}_", point.name);
+        p.push(format!("{prefix}state"), Source::ContactState(c));
+        p.push_each(&prefix, ["x", "y", "z"], |a| Source::ContactPoint(c, a));
+        p.push_each(&prefix, ["fx", "fy", "fz"], |a| Source::ContactForce(c, a));
+        p.push(format!("{prefix}n"), Source::ContactNormal(c));
+    }
+    p.push_each("com_", ["x", "y", "z"], Source::Com);
+    p.push("kinetic", Source::Kinetic);
+    p.push("potential", Source::Potential);
+    p.push("newton_iterations", Source::Iterations);
+    p
+}
+
+/// The curves of a robot's plots: every contact point a foot (its name,
+/// a colour each); the joints in one torque chart per depth from the root
+/// (the first joint of every limb, the second, …: a quadruped's hip
+/// abduction, hip flexion and knee), each joint in its limb's colour (the
+/// limbs: the subtrees of the root, in model order).
+pub fn plot_plan(robot: &LoadedRobot, sim: &RobotSim) -> PlotPlan {
+    let model = &robot.model;
+    let color = |k: usize| PALETTE[k % PALETTE.len()];
+    // Each joint's depth (1: on the root) and limb.
+    let mut depth = vec![0usize; model.joints.len()];
+    let mut limb = vec![0usize; model.joints.len()];
+    let mut limbs = 0;
+    for (j, joint) in model.joints.iter().enumerate() {
+        match model.bodies[joint.parent].joint {
+            Some(up) => {
+                depth[j] = depth[up] + 1;
+                limb[j] = limb[up];
+            }
+            None => {
+                depth[j] = 1;
+                limb[j] = limbs;
+                limbs += 1;
+            }
+        }
+    }
+    let deepest = depth.iter().copied().max().unwrap_or(0);
+    let torques = (1..=deepest)
+        .map(|d| {
+            let curves: Vec<Curve> = (0..model.joints.len())
+                .filter(|&j| depth[j] == d)
+                .map(|j| Curve {
+                    label: model.joints[j].name.clone(),
+                    short: model.joints[j].name.clone(),
+                    color: color(limb[j]),
+                    source: Some(j),
+                })
+                .collect();
+            let names: Vec<&str> = curves.iter().map(|c| c.label.as_str()).collect();
+            let listed = if names.len() > 4 {
+                format!("{}, … ({} joints)", names[..4].join(", "), names.len())
+            } else {
+                names.join(", ")
+            };
+            let title = format!("Depth {d} from the root: {listed}");
+            (title, curves)
+        })
+        .collect();
+    PlotPlan {
+        feet: sim
+            .mech
+            .contacts
+            .iter()
+            .enumerate()
+            .map(|(c, point)| Curve {
+                label: point.name.clone(),
+                short: point.name.clone(),
+                color: color(c),
+                source: Some(c),
+            })
+            .collect(),
+        torques,
+        torques_title: "Joint torques, by depth from the root".into(),
+    }
+}
+
+/// The event marks of a robot's plots: a contact point's name and its new
+/// state.
+fn event_marks(sim: &RobotSim, run: &fbd_sim::RunSummary) -> Vec<EventMark> {
+    run.events
+        .iter()
+        .map(|e| EventMark {
+            t: e.t,
+            label: format!("{} {}", sim.mech.contacts[e.contact].name, e.to.as_str()),
+        })
+        .collect()
+}
+
+/// A robot's stepping: the engine on its simulator ([`LoadedRobot::run_sim`]).
 struct RobotStepper<'a> {
     robot: &'a LoadedRobot,
-    sim: &'a fbd_sim::robot::RobotSim,
+    sim: &'a RobotSim,
 }
 
 impl Stepper<RobotRecord> for RobotStepper<'_> {
@@ -183,18 +309,15 @@ impl Stepper<RobotRecord> for RobotStepper<'_> {
     }
 }
 
-/// A robot's files ([`RunFiles`]): `trajectory.csv` streamed, the peaks,
-/// the viewer's frames.
+/// A robot's files ([`RunFiles`]): the trajectory streamed, the plots, the
+/// peaks, the viewer's frames.
 struct RobotFiles<'a> {
     robot: &'a LoadedRobot,
-    sim: &'a fbd_sim::robot::RobotSim,
-    dest: PathBuf,
-    w: Option<BufWriter<tempfile::NamedTempFile>>,
-    io: std::io::Result<()>,
+    sim: &'a RobotSim,
+    traj: Option<output::Table>,
+    plan: Plan,
     rows: usize,
-    row: Vec<f64>,
-    kinds: Vec<ColumnKind>,
-    buf: ryu::Buffer,
+    plot: Option<plots::Recorder>,
     frames: Option<crate::viewer::robot::RobotFrames>,
     states: Vec<u8>,
     forces: Vec<[f64; 3]>,
@@ -208,9 +331,8 @@ impl RunFiles for RobotFiles<'_> {
     type Run = RobotRun;
     type Summary = RobotSummary;
 
-    /// Every record is a row: the engine applies the stride.
-    fn step_of(_: &RobotRecord) -> usize {
-        0
+    fn step_of(r: &RobotRecord) -> usize {
+        r.step
     }
 
     fn row(&mut self, r: &RobotRecord) {
@@ -232,29 +354,20 @@ impl RunFiles for RobotFiles<'_> {
                 (contacts > 0).then_some((&self.states[..], &self.forces[..])),
             );
         }
-        if self.io.is_err() {
-            return;
-        }
-        LoadedRobot::row(r, &mut self.row);
-        self.rows += 1;
-        let last = self.kinds.len() - 1;
-        let (Some(w), buf) = (self.w.as_mut(), &mut self.buf) else {
-            return;
-        };
-        self.io = (|| {
-            for (i, (&x, kind)) in self.row.iter().zip(&self.kinds).enumerate() {
-                match kind {
-                    ColumnKind::Number => write_number(w, x, buf)?,
-                    ColumnKind::State => write!(w, "ST{}", x as u8)?,
-                    ColumnKind::Count => write!(w, "{}", x as usize)?,
-                }
-                w.write_all(if i == last { b"\n" } else { b"," })?;
+        if let Some(t) = self.traj.as_mut() {
+            let plan = &self.plan;
+            t.row(|sink| plan.row(r, None, sink));
+            if !t.failed() {
+                self.rows += 1;
             }
-            Ok(())
-        })();
+        }
     }
 
-    fn observe(&mut self, _: &RobotRecord) {}
+    fn observe(&mut self, r: &RobotRecord) {
+        if let Some(p) = self.plot.as_mut() {
+            p.push(r);
+        }
+    }
 
     /// The rows counted are those written before a failure.
     fn summary(&mut self, run: &RobotRun, _: usize) -> RobotSummary {
@@ -315,20 +428,7 @@ impl RunFiles for RobotFiles<'_> {
     }
 
     fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
-        let dest = self.dest.clone();
-        let io = std::mem::replace(&mut self.io, Ok(()));
-        let mut w = self.w.take()?;
-        Some(
-            io.and_then(|()| w.flush().map(|()| w))
-                .map_err(|e| OutputError::io(dest.display(), &e))
-                .and_then(|w| {
-                    let tmp = w
-                        .into_inner()
-                        .map_err(|e| OutputError::io(dest.display(), e.error()))?;
-                    output::persist(tmp, &dest)?;
-                    Ok(dest.clone())
-                }),
-        )
+        self.traj.take().map(output::Table::finish)
     }
 
     fn events_csv(&self, _: &RobotRun) -> String {
@@ -338,9 +438,22 @@ impl RunFiles for RobotFiles<'_> {
     fn write_extras(
         self,
         dir: &Path,
-        _: &RobotRun,
+        run: &RobotRun,
         keep: &mut output::FirstError,
     ) -> Vec<&'static str> {
+        if let Some(plot) = self.plot {
+            let plot = plot.finish(event_marks(self.sim, &run.summary));
+            driver::write_svgs(
+                dir,
+                [
+                    ("feet.svg", plots::feet_svg(&plot)),
+                    ("torques.svg", plots::torques_svg(&plot)),
+                    ("body.svg", plots::body_svg(&plot)),
+                    ("energy.svg", plots::energy_svg(&plot)),
+                ],
+                keep,
+            );
+        }
         if let Some(mut f) = self.frames {
             if !self.states.is_empty() {
                 f = f.with_surface(self.robot.config.terrain.surface());
@@ -348,43 +461,52 @@ impl RunFiles for RobotFiles<'_> {
             f.set_event_rows(self.events_csv.lines().count() - 1);
             keep.keep(f.write(dir));
         }
-        files(self.robot).to_vec()
+        files(self.robot)
     }
 }
 
 /// Simulates `robot` and writes its files in `out_dir` (created if
 /// needed; files of an earlier run that this one does not write are
-/// removed). The run stops before its next step once `stop` is set.
+/// removed), handing every written row's record to `on_row`. The run
+/// stops before its next step once `stop` is set.
 pub fn simulate(
     robot: &LoadedRobot,
     source: &str,
     out_dir: &Path,
     stop: &AtomicBool,
+    on_row: &mut dyn FnMut(&RobotRecord),
 ) -> Result<RobotRunOutput, OutputError> {
-    let sim = robot.sim().map_err(|e| crate::ConfigError::Semantic {
+    let mut sim = robot.sim().map_err(|e| crate::ConfigError::Semantic {
         file: source.to_owned(),
         message: e.to_string(),
     })?;
+    let output = &robot.config.output;
+    // The plots want every step: the stride is then applied by the
+    // recording (a record's step is a multiple of the stride either way).
+    if output.plots {
+        sim.params.stride = 1;
+    }
     output::prepare_dir(out_dir)?;
-    let columns = robot.columns(&sim);
-    let dest = out_dir.join("trajectory.csv");
-    let tmp = output::temp_in(out_dir, "trajectory.csv")?;
-    let mut w = BufWriter::new(tmp);
-    let io: std::io::Result<()> = w.write_all(format!("{}\n", columns.names.join(",")).as_bytes());
+    let plan = plan(robot, &sim);
+    let traj = output::Table::create(out_dir, output.format, plan.names.clone(), sim.params.dt)?;
     let contacts = sim.mech.contacts.len();
+    let t_end = (sim.steps.max(1) - 1) as f64 * sim.params.dt;
+    let surface = robot.config.terrain.surface();
     let files = RobotFiles {
         robot,
         sim: &sim,
-        dest,
-        w: Some(w),
-        io,
+        traj: Some(traj),
+        plan,
         rows: 0,
-        row: Vec::with_capacity(columns.names.len()),
-        kinds: columns.kinds,
-        buf: ryu::Buffer::new(),
-        frames: robot
-            .config
-            .output
+        plot: output.plots.then(|| {
+            let r = plots::Recorder::new(plot_plan(robot, &sim), t_end);
+            if contacts > 0 {
+                r.with_surface(&surface)
+            } else {
+                r
+            }
+        }),
+        frames: output
             .viewer
             .then(|| crate::viewer::robot::RobotFrames::new(&robot.model, contacts > 0)),
         states: vec![0u8; contacts],
@@ -396,21 +518,18 @@ pub fn simulate(
     let stepper = RobotStepper { robot, sim: &sim };
     Ok(driver::drive(
         &stepper,
-        Recording::new(files, 1, Some(out_dir)),
+        Recording::new(files, output.stride, Some(out_dir)),
         stop,
         &robot.config.to_toml(),
-        &mut |_| {},
+        on_row,
     ))
 }
 
-/// The files a run of `robot` writes ([`FILES`], `viewer.html` only with
-/// `[output] viewer`).
-pub fn files(robot: &LoadedRobot) -> &'static [&'static str] {
-    if robot.config.output.viewer {
-        &FILES
-    } else {
-        &FILES[..4]
-    }
+/// The files a run of `robot` writes ([`FILES`] as `[output]` selects
+/// them).
+pub fn files(robot: &LoadedRobot) -> Vec<&'static str> {
+    let output = &robot.config.output;
+    output::selected(output::files_as(&FILES, output.format), output)
 }
 
 /// `fbd run` of a `model = "robot"` configuration `text` read from `path`:
@@ -430,7 +549,13 @@ pub fn run_command(
         summary: _,
         io_error,
         files,
-    } = simulate(&robot, &source, out_dir, crate::interrupt::flag())?;
+    } = simulate(
+        &robot,
+        &source,
+        out_dir,
+        crate::interrupt::flag(),
+        &mut |_| {},
+    )?;
     let s = &run.summary;
     let text = output::solved_line(
         s.error.is_some() || s.interrupted,

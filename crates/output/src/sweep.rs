@@ -848,7 +848,10 @@ impl RunConfig {
                 output.viewer = viewer;
                 output.plots = plots;
             }
-            RunConfig::Robot(r) => r.config.output.viewer = viewer,
+            RunConfig::Robot(r) => {
+                r.config.output.viewer = viewer;
+                r.config.output.plots = plots;
+            }
         }
     }
 }
@@ -1055,9 +1058,9 @@ fn plan_robot(
         let stride = robot.config.output.stride.max(1);
         trajectories.push(crate::output::TrajectorySize {
             rows: sim.steps.div_ceil(stride),
-            columns: robot.columns(&sim).names.len(),
+            columns: crate::robot_run::plan(&robot, &sim).names.len(),
             stride,
-            format: fbd_scenario::OutputFormat::Csv,
+            format: robot.config.output.format,
             hexapod: true,
         });
         configs.push(RunConfig::Robot(Box::new(robot)));

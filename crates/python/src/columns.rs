@@ -1,7 +1,7 @@
 //! Every column of `trajectory.csv`, kept in memory: the same names
 //! ([`fbd_output::output::trajectory_columns`]) and the same values, from the
 //! same row builders ([`fbd_output::output::row_values`],
-//! [`fbd_output::spatial::csv::row_values`]), so that a run from Python equals
+//! [`fbd_output::tree::Plan::row`]), so that a run from Python equals
 //! the CLI's file bit for bit (the test suite compares them).
 
 use fbd_output::output::{ContactSlots, RowSink};
@@ -66,7 +66,7 @@ impl Columns {
     }
 
     /// The row being written, one value per call in column order (the 3D
-    /// run's [`fbd_output::spatial::csv::row_values`]).
+    /// run's [`fbd_output::tree::Plan::row`]).
     pub fn sink(&mut self) -> Sink<'_> {
         Sink {
             w: Writer {

@@ -1,91 +1,23 @@
 //! `run(config)` of an imported robot (`model = "robot"`): the CLI's own
 //! run ([`fbd_output::robot_run::simulate`]) into `out` or a temporary
-//! directory, every column of its `trajectory.csv` read back into memory
-//! (shortest round-trip numbers: the file's values, bit for bit; the
-//! names and kinds of [`LoadedRobot::columns`]), its events and summary.
+//! directory, every column of its `trajectory.csv` in memory from the
+//! same columns and row writer ([`fbd_output::robot_run::plan`],
+//! [`fbd_output::tree::Plan::row`]: the file's values, bit for bit), its
+//! events and summary.
 
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
-use fbd_output::config::robot::{ColumnKind, LoadedRobot, RobotColumns};
-use fbd_output::robot_run::{robot_events, simulate};
+use fbd_output::config::robot::LoadedRobot;
+use fbd_output::robot_run::{plan, robot_events, simulate};
 use fbd_output::steptime::StepTimes;
-use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+use crate::columns::Columns;
+
 use crate::errors::{cli_error, config_error};
 use crate::run::run_result;
-
-/// The values of one column of a robot's trajectory.
-enum Values {
-    /// Numbers.
-    Float(Vec<f64>),
-    /// Contact states `ST1`, `ST2`, `ST3`.
-    State(Vec<&'static str>),
-    /// Counts.
-    Int(Vec<i64>),
-}
-
-/// A robot's columns, filled row by row.
-struct RobotTable {
-    names: Vec<String>,
-    values: Vec<Values>,
-}
-
-impl RobotTable {
-    fn new(columns: &RobotColumns, rows: usize) -> Self {
-        let values = columns
-            .kinds
-            .iter()
-            .map(|k| match k {
-                ColumnKind::Number => Values::Float(Vec::with_capacity(rows)),
-                ColumnKind::State => Values::State(Vec::with_capacity(rows)),
-                ColumnKind::Count => Values::Int(Vec::with_capacity(rows)),
-            })
-            .collect();
-        Self {
-            names: columns.names.clone(),
-            values,
-        }
-    }
-
-    /// Appends the rows of a `trajectory.csv` written by the CLI (its
-    /// header skipped); `None` for a file that does not parse.
-    fn read_csv(&mut self, text: &str) -> Option<()> {
-        for line in text.lines().skip(1) {
-            let mut cells = line.split(',');
-            for v in &mut self.values {
-                let cell = cells.next()?;
-                match v {
-                    Values::Float(v) => v.push(cell.parse().ok()?),
-                    Values::State(v) => v.push(match cell {
-                        "ST1" => "ST1",
-                        "ST2" => "ST2",
-                        "ST3" => "ST3",
-                        _ => return None,
-                    }),
-                    Values::Int(v) => v.push(cell.parse().ok()?),
-                }
-            }
-        }
-        Some(())
-    }
-
-    fn into_py<'py>(self, py: Python<'py>, d: &Bound<'py, PyDict>) -> PyResult<()> {
-        let data = PyDict::new(py);
-        for (name, v) in self.names.iter().zip(self.values) {
-            match v {
-                Values::Float(v) => data.set_item(name, PyArray1::from_vec(py, v))?,
-                Values::Int(v) => data.set_item(name, PyArray1::from_vec(py, v))?,
-                Values::State(v) => data.set_item(name, PyList::new(py, v)?)?,
-            }
-        }
-        d.set_item("columns", PyList::new(py, &self.names)?)?;
-        d.set_item("data", data)?;
-        Ok(())
-    }
-}
 
 /// A robot's events as `events.csv` lists them: dicts `t`, `step`,
 /// `point` (a contact point's name, `<joint>_limit`, or `substeps`),
@@ -141,8 +73,9 @@ impl Drop for TempDir {
 /// `newton_iterations` int64), `events` ([`events`]), `summary` (JSON
 /// text, `summary.json`'s), `error`, `source`. The run is the CLI's own
 /// ([`simulate`]: the same files, the same summary), into `out` or, without
-/// it, a temporary directory (no `viewer.html`) removed afterwards; the
-/// columns are read back from its `trajectory.csv`. The GIL is released;
+/// it, a temporary directory (no `viewer.html`, no plots) removed
+/// afterwards; the columns are the file's, kept as the rows are written.
+/// The GIL is released;
 /// Ctrl-C (Python's signal handlers, looked at every 50 ms while the run
 /// goes on in a thread of its own) stops it.
 pub fn run<'py>(
@@ -162,9 +95,9 @@ pub fn run<'py>(
             from_text,
         )
     })?;
-    let columns = robot.columns(&sim);
+    let plan = plan(robot, &sim);
     let rows = sim.steps.div_ceil(sim.params.stride.max(1)).min(1 << 16);
-    let mut table = RobotTable::new(&columns, rows);
+    let mut cols = Columns::named(plan.names.clone(), sim.params.dt, rows);
     let (temp, dir, quiet);
     let robot = match out {
         Some(out) => {
@@ -182,6 +115,7 @@ pub fn run<'py>(
             dir = temp.0.clone();
             let mut r = robot.clone();
             r.config.output.viewer = false;
+            r.config.output.plots = false;
             quiet = r;
             &quiet
         }
@@ -190,7 +124,11 @@ pub fn run<'py>(
     let mut signal: Option<PyErr> = None;
     let output = py.detach(|| {
         std::thread::scope(|scope| {
-            let worker = scope.spawn(|| simulate(robot, source, &dir, &stop));
+            let worker = scope.spawn(|| {
+                simulate(robot, source, &dir, &stop, &mut |r| {
+                    plan.row(r, None, &mut cols.sink());
+                })
+            });
             while !worker.is_finished() {
                 std::thread::sleep(std::time::Duration::from_millis(50));
                 if signal.is_none()
@@ -214,21 +152,9 @@ pub fn run<'py>(
     let dt = sim.params.dt;
     let signal = crate::run::SignalWatch::caught(signal);
     run_result(py, output, signal, from_text, source, dt, |d, run| {
-        let path = dir.join("trajectory.csv");
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            cli_error(
-                py,
-                &fbd_output::OutputError::io(path.display(), &e),
-                from_text,
-            )
-        })?;
-        table.read_csv(&text).ok_or_else(|| {
-            pyo3::exceptions::PyRuntimeError::new_err(format!(
-                "{}: not a robot's trajectory.csv",
-                path.display()
-            ))
-        })?;
-        table.into_py(py, d)?;
+        let (names, data) = cols.into_py(py)?;
+        d.set_item("columns", names)?;
+        d.set_item("data", data)?;
         d.set_item("events", events(py, robot, &sim, &run.summary)?)
     })
 }

@@ -1,13 +1,13 @@
 //! `run(config)` of a dynamic hexapod configuration: the 3D FBD dynamics
 //! ([`fbd_output::spatial::simulate`]), every column of its `trajectory.csv`
-//! in memory from the CLI's own row builder
-//! ([`fbd_output::spatial::csv::row_values`]): the same names and values as
-//! the file.
+//! in memory from the CLI's own columns and row writer
+//! ([`fbd_output::spatial::csv::plan`], [`fbd_output::tree::Plan::row`]):
+//! the same names and values as the file.
 
 use std::path::Path;
 
-use fbd_output::spatial::csv::{Slots, row_values};
-use fbd_output::spatial::{Feet, Layout, columns, simulate};
+use fbd_output::spatial::csv::{Slots, plan};
+use fbd_output::spatial::{Feet, Layout, simulate};
 use fbd_scenario::{Config, HexapodConfig};
 use fbd_sim::robot::RobotRecord;
 use pyo3::prelude::*;
@@ -43,9 +43,9 @@ pub fn run<'py>(
         let rows = ((params.duration / dt).round().max(0.0) as usize + 1)
             .div_ceil(stride)
             .min(1 << 16);
-        let mut cols = Columns::named(columns(&layout), dt, rows);
+        let plan = plan(&layout, &Slots::of(&layout, &params.record_index()));
+        let mut cols = Columns::named(plan.names.clone(), dt, rows);
         let mut feet = Feet::new(&params);
-        let slots = Slots::of(&layout, &params.record_index());
         simulate(
             &params,
             &config.to_toml(),
@@ -53,7 +53,7 @@ pub fn run<'py>(
             out,
             stop,
             &mut |r: &RobotRecord| {
-                row_values(&layout, &slots, &mut feet, r, &mut cols.sink());
+                plan.row(r, Some(&mut feet), &mut cols.sink());
                 watch.row(stop);
             },
         )

@@ -15,13 +15,14 @@
 //! dt = 0.001                  # optional: the step (s)
 //! duration = 1.0              # optional (s)
 //! [terrain]
-//! kind = "none"               # only "none" (flight) so far
+//! kind = "flat"               # or "none" (flight), a height map, …
 //! [output]
 //! stride = 1                  # optional: every stride-th step is written
 //! ```
 //!
 //! `fbd kinematics`, `fbd inverse`, `fbd export mjcf` take such a
-//! configuration, and `fbd run` simulates it in flight ([`LoadedRobot::run_flight`]).
+//! configuration, and `fbd run` simulates it on its terrain or in flight
+//! ([`LoadedRobot::run`]).
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -270,35 +271,9 @@ pub struct RobotControlConfig {
     pub targets_deg: Vec<BTreeMap<String, f64>>,
 }
 
-/// `[output]` of an imported robot.
-#[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct RobotOutput {
-    /// Every `stride`-th step is written (≥ 1). Default 1.
-    #[serde(default = "default_stride")]
-    pub stride: usize,
-    /// Write `viewer.html` (default true; `fbd sweep` sets it false in its
-    /// runs unless `--viewer`).
-    #[serde(default = "default_viewer")]
-    pub viewer: bool,
-}
-
-fn default_viewer() -> bool {
-    true
-}
-
-fn default_stride() -> usize {
-    1
-}
-
-impl Default for RobotOutput {
-    fn default() -> Self {
-        Self {
-            stride: default_stride(),
-            viewer: default_viewer(),
-        }
-    }
-}
+/// `[output]` of an imported robot: every model's (`stride`, `format`,
+/// `viewer`, `plots`).
+pub type RobotOutput = crate::OutputConfig;
 
 /// A `model = "robot"` configuration file.
 #[derive(Clone, Debug, Deserialize, Serialize, PartialEq)]
@@ -1430,26 +1405,6 @@ impl LoadedRobot {
     }
 }
 
-/// A column of a robot's `trajectory.csv` ([`RobotColumns`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ColumnKind {
-    /// A number (f64, written shortest round-trip).
-    Number,
-    /// A contact state, written `ST1`, `ST2` or `ST3` (1, 2, 3 in the row).
-    State,
-    /// A count (written as an integer).
-    Count,
-}
-
-/// The columns of a robot's `trajectory.csv`: their names and kinds.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RobotColumns {
-    /// Column names, in order.
-    pub names: Vec<String>,
-    /// Each column's kind.
-    pub kinds: Vec<ColumnKind>,
-}
-
 /// How a run of an imported robot ended ([`LoadedRobot::run`]).
 #[derive(Clone, Debug)]
 pub struct RobotRun {
@@ -1509,75 +1464,6 @@ impl LoadedRobot {
     /// ground ([`fbd_sim::SimError`], naming the key or point).
     pub fn sim(&self) -> Result<fbd_sim::robot::RobotSim, fbd_sim::SimError> {
         fbd_sim::robot::RobotSim::new(&self.model, &self.params())
-    }
-
-    /// The columns of `trajectory.csv` of a run of `sim`: `t, rx, ry, rz,
-    /// phi_x, phi_y, phi_z`, one per joint angle (rad, the joint's name);
-    /// per reaction `<joint>_fx, _fy, _fz` (force of the parent on the
-    /// child at the joint's origin, N, inertial) and `<joint>_mx, _my,
-    /// _mz` (its moment on the child about that point: constraint moments,
-    /// actuator torques and stops, N·m), named by the reaction's first
-    /// joint; `tau_<joint>` per joint (N·m); per contact point `<c>`:
-    /// `<c>_state`, `<c>_x, _y, _z` (where it touches, m), `<c>_fx, _fy,
-    /// _fz` (the ground's force on it, N, inertial) and `<c>_n` (its normal
-    /// component); then `com_x, com_y, com_z, kinetic, potential,
-    /// newton_iterations`.
-    pub fn columns(&self, sim: &fbd_sim::robot::RobotSim) -> RobotColumns {
-        let mut names: Vec<String> = MOTION_BASE_COLUMNS
-            .iter()
-            .map(|s| (*s).to_owned())
-            .collect();
-        names.insert(0, "t".to_owned());
-        names.extend(self.model.joints.iter().map(|j| j.name.clone()));
-        for r in &sim.mech.reactions {
-            let name = &self.model.joints[r.joints[0]].name;
-            for s in ["fx", "fy", "fz", "mx", "my", "mz"] {
-                names.push(format!("{name}_{s}"));
-            }
-        }
-        names.extend(self.model.joints.iter().map(|j| format!("tau_{}", j.name)));
-        let mut kinds = vec![ColumnKind::Number; names.len()];
-        for c in &sim.mech.contacts {
-            names.push(format!("{}_state", c.name));
-            kinds.push(ColumnKind::State);
-            for s in ["x", "y", "z", "fx", "fy", "fz", "n"] {
-                names.push(format!("{}_{s}", c.name));
-                kinds.push(ColumnKind::Number);
-            }
-        }
-        for s in ["com_x", "com_y", "com_z", "kinetic", "potential"] {
-            names.push(s.to_owned());
-            kinds.push(ColumnKind::Number);
-        }
-        names.push("newton_iterations".to_owned());
-        kinds.push(ColumnKind::Count);
-        RobotColumns { names, kinds }
-    }
-
-    /// The values of one record in the order of [`Self::columns`] (states
-    /// as 1, 2, 3; `newton_iterations` as a float), into `row` (cleared
-    /// first).
-    pub fn row(record: &fbd_sim::robot::RobotRecord, row: &mut Vec<f64>) {
-        row.clear();
-        row.push(record.t);
-        row.extend(&record.q);
-        for (f, m) in record.reaction_force.iter().zip(&record.reaction_moment) {
-            row.extend(f);
-            row.extend(m);
-        }
-        row.extend(&record.torque);
-        for c in &record.contacts {
-            row.push(f64::from(c.state as u8 + 1));
-            row.extend(c.point);
-            row.extend(c.force);
-            row.push(c.normal);
-        }
-        row.extend(record.com);
-        row.extend([
-            record.kinetic,
-            record.potential,
-            record.newton_iterations as f64,
-        ]);
     }
 
     /// Simulates the robot from its initial state over `[time]`, handing

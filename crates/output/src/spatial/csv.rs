@@ -4,7 +4,6 @@
 
 use std::path::{Path, PathBuf};
 
-use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
 use fbd_scenario::OutputFormat;
 use fbd_sim::robot::RobotRecord;
@@ -13,6 +12,7 @@ use fbd_sim::spatial::{LegIndex, RecordIndex, SpatialParams};
 use super::Layout;
 use crate::OutputError;
 use crate::output;
+use crate::tree::{Plan, Source};
 
 /// The body pose columns after `t`.
 pub const POSE_COLUMNS: [&str; 6] = ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"];
@@ -43,41 +43,86 @@ pub fn point_prefix(kind: PointKind) -> &'static str {
 /// * `roll, pitch, heading`: the body's attitude derived from φ
 ///   ([`crate::hexapod::ATTITUDE_COLUMNS`]).
 pub fn columns(layout: &Layout) -> Vec<String> {
-    let mut c: Vec<String> = std::iter::once("t")
-        .chain(POSE_COLUMNS)
-        .map(str::to_owned)
-        .collect();
+    plan(layout, &Slots::default()).names
+}
+
+/// The hexapod's [`Plan`]: the columns of [`columns`], each from where
+/// `slots` finds it in the record; a foot that is not a contact point
+/// (no slot) is placed by the kinematics ([`super::Feet`]), free and
+/// without force, a leg without a slot has no forces or torques.
+pub fn plan(layout: &Layout, slots: &Slots) -> Plan {
+    let mut p = Plan::default();
+    p.push("t", Source::Time);
+    for (i, name) in POSE_COLUMNS.iter().enumerate() {
+        p.push(*name, Source::Q(i));
+    }
+    // The joint angles, in the record's order.
+    let mut q = POSE_COLUMNS.len();
     for n in &layout.legs {
         for j in 1..=3 {
-            c.push(format!("theta{j}_{n}"));
+            p.push(format!("theta{j}_{n}"), Source::Q(q));
+            q += 1;
         }
     }
-    for n in &layout.legs {
-        for a in ["x", "y", "z"] {
-            c.push(format!("foot{n}_{a}"));
-        }
-        c.push(format!("state{n}"));
-        for a in ["fx", "fy", "fz", "n"] {
-            c.push(format!("foot{n}_{a}"));
-        }
-        for joint in ["hip", "knee"] {
-            for a in ["fx", "fy", "fz", "mx", "my", "mz"] {
-                c.push(format!("{joint}{n}_{a}"));
+    let xyz = ["x", "y", "z"];
+    for (i, n) in layout.legs.iter().enumerate() {
+        let foot = format!("foot{n}_");
+        match slots.tips.get(i).copied().flatten() {
+            Some(c) => {
+                p.push_each(&foot, xyz, |a| Source::ContactPoint(c, a));
+                p.push(format!("state{n}"), Source::ContactState(c));
+                p.push_each(&foot, ["fx", "fy", "fz"], |a| Source::ContactForce(c, a));
+                p.push(format!("{foot}n"), Source::ContactNormal(c));
+            }
+            None => {
+                p.push_each(&foot, xyz, |a| Source::Foot(i, a));
+                p.push(format!("state{n}"), Source::Free);
+                p.push_each(&foot, ["fx", "fy", "fz", "n"], |_| Source::Zero);
             }
         }
-        for j in 1..=3 {
-            c.push(format!("tau{j}_{n}"));
+        let leg = slots.legs.get(i).copied().flatten();
+        for (joint, reaction) in [("hip", leg.map(|l| l.hip)), ("knee", leg.map(|l| l.knee))] {
+            let prefix = format!("{joint}{n}_");
+            match reaction {
+                Some(r) => {
+                    p.push_each(&prefix, ["fx", "fy", "fz"], |a| Source::ReactionForce(r, a));
+                    p.push_each(&prefix, ["mx", "my", "mz"], |a| {
+                        Source::ReactionMoment(r, a)
+                    });
+                }
+                None => p.push_each(&prefix, ["fx", "fy", "fz", "mx", "my", "mz"], |_| {
+                    Source::Zero
+                }),
+            }
+        }
+        for j in 0..3 {
+            p.push(
+                format!("tau{}_{n}", j + 1),
+                leg.map_or(Source::Zero, |l| Source::Torque(l.joint + j)),
+            );
         }
     }
-    for &(n, kind) in &layout.extra_points {
-        let p = point_prefix(kind);
-        for a in ["state", "fx", "fy", "fz", "n"] {
-            c.push(format!("{p}{n}_{a}"));
+    for (e, &(n, kind)) in layout.extra_points.iter().enumerate() {
+        let prefix = format!("{}{n}_", point_prefix(kind));
+        match slots.extras.get(e).copied().flatten() {
+            Some(c) => {
+                p.push(format!("{prefix}state"), Source::ContactState(c));
+                p.push_each(&prefix, ["fx", "fy", "fz"], |a| Source::ContactForce(c, a));
+                p.push(format!("{prefix}n"), Source::ContactNormal(c));
+            }
+            None => {
+                p.push(format!("{prefix}state"), Source::Free);
+                p.push_each(&prefix, ["fx", "fy", "fz", "n"], |_| Source::Zero);
+            }
         }
     }
-    c.extend(["kinetic", "potential", "newton_iterations"].map(str::to_owned));
-    c.extend(crate::hexapod::ATTITUDE_COLUMNS.map(str::to_owned));
-    c
+    p.push("kinetic", Source::Kinetic);
+    p.push("potential", Source::Potential);
+    p.push("newton_iterations", Source::Iterations);
+    for (a, name) in crate::hexapod::ATTITUDE_COLUMNS.iter().enumerate() {
+        p.push(*name, Source::Attitude(a));
+    }
+    p
 }
 
 /// Where each column group of a row is found in a hexapod's
@@ -127,79 +172,11 @@ impl Slots {
     }
 }
 
-/// Receives the values of a row ([`row_values`]); the planar and the 3D
-/// files share it.
-pub use crate::output::RowSink;
-
-/// Hands the values of the row of `r` to `sink`, in the order of
-/// [`columns`]`(layout)`; `slots` are those of `layout` ([`Slots::of`]),
-/// `feet` places the feet that are not contact points. No allocation.
-pub fn row_values(
-    layout: &Layout,
-    slots: &Slots,
-    feet: &mut super::Feet,
-    r: &RobotRecord,
-    sink: &mut dyn RowSink,
-) {
-    sink.time(r.step, r.t);
-    for &x in &r.q {
-        sink.num(x);
-    }
-    // Without a foot contact point, the foot is placed by the kinematics.
-    if slots.tips.iter().any(Option::is_none) {
-        feet.update(&r.q);
-    }
-    let zero = [0.0; 3];
-    for i in 0..layout.legs.len() {
-        let tip = slots.tips[i].map(|c| &r.contacts[c]);
-        let p = tip.map_or_else(|| feet.tip(i), |c| c.point);
-        for x in p {
-            sink.num(x);
-        }
-        sink.state(tip.map_or(StateCode::St1, |c| c.state));
-        let (f, n) = tip.map_or((zero, 0.0), |c| (c.force, c.normal));
-        for x in f {
-            sink.num(x);
-        }
-        sink.num(n);
-        let leg = slots.leg(r, i);
-        for v in [
-            leg.map_or(zero, |l| l.hip_force),
-            leg.map_or(zero, |l| l.hip_moment),
-            leg.map_or(zero, |l| l.knee_force),
-            leg.map_or(zero, |l| l.knee_moment),
-            leg.map_or(zero, |l| l.torque),
-        ] {
-            for x in v {
-                sink.num(x);
-            }
-        }
-    }
-    for slot in &slots.extras {
-        let c = slot.map(|c| &r.contacts[c]);
-        sink.state(c.map_or(StateCode::St1, |c| c.state));
-        let (f, n) = c.map_or((zero, 0.0), |c| (c.force, c.normal));
-        for x in f {
-            sink.num(x);
-        }
-        sink.num(n);
-    }
-    sink.num(r.kinetic);
-    sink.num(r.potential);
-    sink.count(r.newton_iterations);
-    let pose =
-        fbd_kinematics::pose::BodyPose::new([r.q[0], r.q[1], r.q[2]], [r.q[3], r.q[4], r.q[5]]);
-    for a in pose.attitude() {
-        sink.num(a);
-    }
-}
-
 /// Streams the trajectory (`trajectory.csv` or `trajectory.parquet`)
 /// into a temporary file; no allocation per CSV row.
 pub struct TrajectoryWriter {
     table: output::Table,
-    layout: Layout,
-    slots: Slots,
+    plan: Plan,
     feet: super::Feet,
     rows: usize,
 }
@@ -217,11 +194,11 @@ impl TrajectoryWriter {
         format: OutputFormat,
     ) -> Result<Self, OutputError> {
         let layout = Layout::of(params);
+        let plan = plan(&layout, &Slots::of(&layout, &params.record_index()));
         Ok(Self {
-            table: output::Table::create(dir, format, columns(&layout), params.dt)?,
+            table: output::Table::create(dir, format, plan.names.clone(), params.dt)?,
             feet: super::Feet::new(params),
-            slots: Slots::of(&layout, &params.record_index()),
-            layout,
+            plan,
             rows: 0,
         })
     }
@@ -234,9 +211,8 @@ impl TrajectoryWriter {
     /// Appends the row of `r`. An I/O error is kept and reported by
     /// [`TrajectoryWriter::finish`]; later rows are skipped.
     pub fn write(&mut self, r: &RobotRecord) {
-        let (layout, slots, feet) = (&self.layout, &self.slots, &mut self.feet);
-        self.table
-            .row(|sink| row_values(layout, slots, feet, r, sink));
+        let (plan, feet) = (&self.plan, &mut self.feet);
+        self.table.row(|sink| plan.row(r, Some(feet), sink));
         if !self.table.failed() {
             self.rows += 1;
         }

@@ -1,11 +1,12 @@
 //! `fbd run` of a dynamic hexapod configuration (the 3D FBD dynamics,
 //! [`fbd_sim::spatial`]): `trajectory.csv` ([`csv`]), `events.csv` (the
 //! planar run's writer), `summary.json` ([`summary`]), `config.toml`,
-//! `feet.svg`, `torques.svg`, `body.svg`, `energy.svg` ([`plots`]) and
+//! `feet.svg`, `torques.svg`, `body.svg`, `energy.svg` (the plots of every
+//! model on the tree equations, [`crate::tree::plots`], in the hexapod's
+//! names and colours: [`plot_plan`]) and
 //! `viewer.html` (the hexapod viewer with contact states and forces).
 
 pub mod csv;
-pub mod plots;
 pub mod summary;
 
 use std::io::Write;
@@ -23,7 +24,9 @@ use crate::OutputError;
 use crate::config::ConfigError;
 use crate::driver::{Recording, RunFiles, RunOutput};
 use crate::output::{self, Ending};
+use crate::plot::EventMark;
 use crate::steptime::StepTimes;
+use crate::tree::plots::{self, Curve, PlotPlan, leg_color};
 use crate::viewer::hexapod::{HexDynamics, HexFrame, HexapodScene};
 
 pub use csv::{TrajectoryWriter, columns};
@@ -154,6 +157,49 @@ impl Feet {
     }
 }
 
+impl crate::tree::Feet for Feet {
+    fn update(&mut self, q: &[f64]) {
+        Feet::update(self, q);
+    }
+    fn tip(&self, i: usize) -> [f64; 3] {
+        Feet::tip(self, i)
+    }
+}
+
+/// The curves of the hexapod's plots: one colour per leg, each foot
+/// labelled `leg n`, and the torques τ1, τ2, τ3 of every leg, one chart
+/// per joint.
+pub fn plot_plan(layout: &Layout, slots: &csv::Slots) -> PlotPlan {
+    let leg = |n: usize, source: Option<usize>| Curve {
+        label: format!("leg {n}"),
+        short: n.to_string(),
+        color: leg_color(n),
+        source,
+    };
+    let joint = |j: usize| -> Vec<Curve> {
+        layout
+            .legs
+            .iter()
+            .enumerate()
+            .map(|(i, &n)| leg(n, slots.legs[i].map(|l| l.joint + j)))
+            .collect()
+    };
+    PlotPlan {
+        feet: layout
+            .legs
+            .iter()
+            .enumerate()
+            .map(|(i, &n)| leg(n, slots.tips[i]))
+            .collect(),
+        torques: vec![
+            ("τ1 (hip, about the body's vertical axis)".into(), joint(0)),
+            ("τ2 (hip, lift)".into(), joint(1)),
+            ("τ3 (knee)".into(), joint(2)),
+        ],
+        torques_title: "Joint torques".into(),
+    }
+}
+
 /// The viewer frame of a record.
 fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &RobotRecord) -> HexFrame {
     feet.update(&r.q);
@@ -247,12 +293,14 @@ impl Outputs {
             None => None,
         };
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
+        let slots = csv::Slots::of(&layout, &params.record_index());
         let files = Self {
             stability_check_seconds: 0.0,
             collect: Some(summary::Collector::new(&layout, &params.terrain)),
-            plot: out_dir
-                .filter(|_| output.plots)
-                .map(|_| plots::Recorder::new(&layout, t_end).with_surface(&params.terrain)),
+            plot: out_dir.filter(|_| output.plots).map(|_| {
+                plots::Recorder::new(plot_plan(&layout, &slots), t_end)
+                    .with_surface(&params.terrain)
+            }),
             view: out_dir.filter(|_| output.viewer).map(|_| {
                 HexapodScene::dynamic(
                     params.kinematic_model(),
@@ -267,7 +315,7 @@ impl Outputs {
             params: params.clone(),
             traj,
             output: output.clone(),
-            slots: csv::Slots::of(&layout, &params.record_index()),
+            slots,
             layout,
             steps,
         };
@@ -298,7 +346,7 @@ impl RunFiles for Outputs {
             c.push(r, &self.slots);
         }
         if let Some(p) = self.plot.as_mut() {
-            p.push(r, &self.slots);
+            p.push(r);
         }
     }
 
@@ -324,7 +372,7 @@ impl RunFiles for Outputs {
         keep: &mut output::FirstError,
     ) -> Vec<&'static str> {
         if let Some(plot) = self.plot {
-            let plot = plot.finish(run);
+            let plot = plot.finish(run.events.iter().map(EventMark::of).collect());
             crate::driver::write_svgs(
                 dir,
                 [

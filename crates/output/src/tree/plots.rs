@@ -1,23 +1,22 @@
-//! The plots of a dynamic hexapod run, drawn from every step (min/max
-//! reduced per time column, [`crate::plot::MinMax`]), one colour per leg
-//! (the plots' shared palette):
+//! The plots of a run of any model on the tree equations (the paper's
+//! hexapod, every imported robot), drawn from every step (min/max reduced
+//! per time column, [`crate::plot::MinMax`]); the model names and colours
+//! its curves ([`PlotPlan`]: the hexapod one colour per leg, in the plots'
+//! shared palette):
 //!
 //! * `feet.svg` — the normal force of every foot, and its height against
 //!   the height of the terrain under it (`ϱ(x, z)` at the foot, dashed);
-//! * `torques.svg` — the actuator torques τ1, τ2, τ3 of every leg, one
-//!   chart per joint;
-//! * `body.svg` — the forward position, the body height `Ry`, roll and
+//! * `torques.svg` — the actuator torques, one chart per group of joints
+//!   (the hexapod's τ1, τ2, τ3 of every leg);
+//! * `body.svg` — the forward position, the root's height `Ry`, roll and
 //!   pitch, and the heading (the attitude derived from φ);
 //! * `energy.svg` — kinetic, potential and total energy (as the planar
 //!   run draws it).
 
 use fbd_contact::Surface;
-use fbd_sim::RunSummary;
 use fbd_sim::robot::RobotRecord;
 use plotters::style::RGBColor;
 
-use super::Layout;
-use super::csv::Slots;
 use crate::plot::{
     self, Columns, EventMark, MinMax, PALETTE, PlotData, PlotResult, Style, Trace,
     stacked_time_chart,
@@ -25,20 +24,48 @@ use crate::plot::{
 
 /// The colour of leg `n` (1–6): the palette's `n`-th colour, as in every
 /// hexapod plot.
-fn leg_color(n: usize) -> RGBColor {
+pub fn leg_color(n: usize) -> RGBColor {
     PALETTE[(n + PALETTE.len() - 1) % PALETTE.len()]
+}
+
+/// One curve of a foot or a joint.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Curve {
+    /// Its legend label (`leg 3`, a point's or a joint's name).
+    pub label: String,
+    /// The name of a foot in its height curves (`foot 3`, `ground under
+    /// 3`).
+    pub short: String,
+    /// Its colour.
+    pub color: RGBColor,
+    /// Where its values are in the record: a contact point (a foot's
+    /// curves) or a joint (a torque); `None` draws a foot that is not a
+    /// contact point at zero force and without height.
+    pub source: Option<usize>,
+}
+
+/// What the plots of a model show, as its names and colours.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PlotPlan {
+    /// The feet (`feet.svg`).
+    pub feet: Vec<Curve>,
+    /// The charts of `torques.svg`: each one's title and joints.
+    pub torques: Vec<(String, Vec<Curve>)>,
+    /// The title of `torques.svg`.
+    pub torques_title: String,
 }
 
 /// Gathers the curves of a run step by step.
 pub struct Recorder {
     /// The time columns of every curve below.
     columns: Columns,
-    legs: Vec<usize>,
+    plan: PlotPlan,
     normal: Vec<MinMax>,
-    /// Per leg: the foot's height and the terrain's under it.
+    /// Per foot: its height and the terrain's under it.
     height: Vec<[MinMax; 2]>,
     surface: Option<Surface>,
-    torque: Vec<[MinMax; 3]>,
+    /// Per chart, per joint.
+    torque: Vec<Vec<MinMax>>,
     body: [MinMax; 4],
     /// Forward position (m), roll, pitch, heading (°).
     attitude: [MinMax; 4],
@@ -48,24 +75,25 @@ pub struct Recorder {
 }
 
 impl Recorder {
-    /// For a run from `t = 0` to `t_end` of a model with `layout`.
-    pub fn new(layout: &Layout, t_end: f64) -> Self {
+    /// For a run from `t = 0` to `t_end` of a model whose curves are
+    /// `plan`.
+    pub fn new(plan: PlotPlan, t_end: f64) -> Self {
         let m = || MinMax::new(0.0, t_end);
         Self {
             columns: Columns::new(0.0, t_end),
-            legs: layout.legs.clone(),
-            normal: layout.legs.iter().map(|_| m()).collect(),
-            height: layout
-                .legs
+            normal: plan.feet.iter().map(|_| m()).collect(),
+            height: plan
+                .feet
                 .iter()
                 .map(|_| std::array::from_fn(|_| m()))
                 .collect(),
             surface: None,
-            torque: layout
-                .legs
+            torque: plan
+                .torques
                 .iter()
-                .map(|_| std::array::from_fn(|_| m()))
+                .map(|(_, joints)| joints.iter().map(|_| m()).collect())
                 .collect(),
+            plan,
             body: std::array::from_fn(|_| m()),
             attitude: std::array::from_fn(|_| m()),
             origin: None,
@@ -79,32 +107,28 @@ impl Recorder {
         self
     }
 
-    /// Adds one step; `s` matches the record's rows to the layout.
+    /// Adds one step.
     ///
     /// Runs for every step: the step's time column is found once for all
     /// the curves ([`Columns::of`]).
-    pub fn push(&mut self, r: &RobotRecord, s: &Slots) {
+    pub fn push(&mut self, r: &RobotRecord) {
         let t = r.t;
         let col = self.columns.of(t);
-        for (i, m) in self.normal.iter_mut().enumerate() {
-            m.push_at(col, t, s.tips[i].map_or(0.0, |c| r.contacts[c].normal));
+        for (m, foot) in self.normal.iter_mut().zip(&self.plan.feet) {
+            m.push_at(col, t, foot.source.map_or(0.0, |c| r.contacts[c].normal));
         }
         if let Some(surface) = &self.surface {
-            for (i, [foot, ground]) in self.height.iter_mut().enumerate() {
-                if let Some(c) = s.tips[i] {
+            for ([foot, ground], curve) in self.height.iter_mut().zip(&self.plan.feet) {
+                if let Some(c) = curve.source {
                     let p = r.contacts[c].point;
                     foot.push_at(col, t, p[1]);
                     ground.push_at(col, t, surface.height(p[0], p[2]));
                 }
             }
         }
-        for (i, ms) in self.torque.iter_mut().enumerate() {
-            let tau = s.legs[i].map_or([0.0; 3], |l| {
-                let j = l.joint;
-                [r.torque[j], r.torque[j + 1], r.torque[j + 2]]
-            });
-            for (m, v) in ms.iter_mut().zip(tau) {
-                m.push_at(col, t, v);
+        for (ms, (_, joints)) in self.torque.iter_mut().zip(&self.plan.torques) {
+            for (m, joint) in ms.iter_mut().zip(joints) {
+                m.push_at(col, t, joint.source.map_or(0.0, |j| r.torque[j]));
             }
         }
         self.body[0].push_at(col, t, r.q[1]);
@@ -131,37 +155,47 @@ impl Recorder {
         self.energy[2].push_at(col, t, r.kinetic + r.potential);
     }
 
-    /// The curves, with the contact events of `run`.
-    pub fn finish(self, run: &RunSummary) -> SpatialPlotData {
+    /// The curves, with the contact events `events`.
+    pub fn finish(self, events: Vec<EventMark>) -> TreePlotData {
         let trace = |label: String, m: MinMax| Trace {
             label,
             pts: m.finish(),
         };
-        let mut torques: [Vec<Trace>; 3] = Default::default();
-        for (&n, ms) in self.legs.iter().zip(self.torque) {
-            for (j, m) in ms.into_iter().enumerate() {
-                torques[j].push(trace(format!("leg {n}"), m));
-            }
-        }
+        let torques = self
+            .plan
+            .torques
+            .iter()
+            .zip(self.torque)
+            .map(|((title, joints), ms)| {
+                let curves = joints
+                    .iter()
+                    .zip(ms)
+                    .map(|(j, m)| (trace(j.label.clone(), m), j.color))
+                    .collect();
+                (title.clone(), curves)
+            })
+            .collect();
         let [height, phi_x, phi_y, phi_z] = self.body;
         let [forward, roll, pitch, heading] = self.attitude;
         let [kinetic, potential, total] = self.energy;
         let mut heights = Vec::new();
         if self.surface.is_some() {
-            for (&n, [foot, ground]) in self.legs.iter().zip(self.height) {
-                heights.push(trace(format!("foot {n}"), foot));
-                heights.push(trace(format!("ground under {n}"), ground));
+            for (f, [foot, ground]) in self.plan.feet.iter().zip(self.height) {
+                heights.push((trace(format!("foot {}", f.short), foot), f.color));
+                heights.push((trace(format!("ground under {}", f.short), ground), f.color));
             }
         }
-        SpatialPlotData {
+        TreePlotData {
             heights,
             feet: self
-                .legs
+                .plan
+                .feet
                 .iter()
                 .zip(self.normal)
-                .map(|(n, m)| trace(format!("leg {n}"), m))
+                .map(|(f, m)| (trace(f.label.clone(), m), f.color))
                 .collect(),
             torques,
+            torques_title: self.plan.torques_title,
             height: trace("Ry".into(), height),
             forward: trace("forward".into(), forward),
             attitude: vec![trace("roll".into(), roll), trace("pitch".into(), pitch)],
@@ -176,31 +210,28 @@ impl Recorder {
                 trace("potential".into(), potential),
                 trace("total".into(), total),
             ],
-            legs: self.legs,
-            events: run.events.iter().map(EventMark::of).collect(),
+            events,
         }
     }
 }
 
-/// Everything the plots of a dynamic hexapod run show.
+/// Everything the plots of a run on the tree equations show.
 #[derive(Clone, Debug, Default, PartialEq)]
-pub struct SpatialPlotData {
-    /// Leg numbers, in the order of the per-leg curves.
-    pub legs: Vec<usize>,
-    /// Normal force of each leg's foot, labelled `leg n` (N).
-    pub feet: Vec<Trace>,
-    /// Per leg: its foot's height and the terrain's under it (m); empty
-    /// without ground.
-    pub heights: Vec<Trace>,
-    /// Torques τ1, τ2, τ3 (one vector per joint), one curve per leg,
-    /// labelled `leg n` (N·m).
-    pub torques: [Vec<Trace>; 3],
-    /// Body height `Ry` (m).
+pub struct TreePlotData {
+    /// Normal force of each foot, with its colour (N).
+    pub feet: Vec<(Trace, RGBColor)>,
+    /// Per foot: its height and the terrain's under it (m), with its
+    /// colour; empty without ground.
+    pub heights: Vec<(Trace, RGBColor)>,
+    /// The torque charts: each one's title and curves (N·m).
+    pub torques: Vec<(String, Vec<(Trace, RGBColor)>)>,
+    /// The title of `torques.svg`.
+    pub torques_title: String,
+    /// Root height `Ry` (m).
     pub height: Trace,
-    /// Body angles φx, φy, φz (degrees).
+    /// Root angles φx, φy, φz (degrees).
     pub angles: Vec<Trace>,
-    /// Body centre's horizontal distance along the first step's heading
-    /// (m).
+    /// The root's horizontal distance along the first step's heading (m).
     pub forward: Trace,
     /// Roll and pitch (degrees; `trajectory.csv`'s `roll`, `pitch`).
     pub attitude: Vec<Trace>,
@@ -212,7 +243,7 @@ pub struct SpatialPlotData {
     pub events: Vec<EventMark>,
 }
 
-impl SpatialPlotData {
+impl TreePlotData {
     fn t_range(&self) -> (f64, f64) {
         let (lo, hi) = self
             .height
@@ -224,29 +255,28 @@ impl SpatialPlotData {
             });
         if lo < hi { (lo, hi) } else { (0.0, 1.0) }
     }
+}
 
-    /// One solid curve per leg, in the leg's colour.
-    fn per_leg<'a>(&self, traces: &'a [Trace]) -> Vec<(&'a Trace, Style)> {
-        traces
-            .iter()
-            .zip(&self.legs)
-            .map(|(t, &n)| {
-                (
-                    t,
-                    Style {
-                        color: leg_color(n),
-                        width: 2,
-                        dashed: false,
-                    },
-                )
-            })
-            .collect()
-    }
+/// Solid curves, each in its colour.
+fn solid(traces: &[(Trace, RGBColor)]) -> Vec<(&Trace, Style)> {
+    traces
+        .iter()
+        .map(|(t, color)| {
+            (
+                t,
+                Style {
+                    color: *color,
+                    width: 2,
+                    dashed: false,
+                },
+            )
+        })
+        .collect()
 }
 
 /// `feet.svg`: the normal force of every foot versus time.
-pub fn feet_svg(d: &SpatialPlotData) -> PlotResult<String> {
-    let series = d.per_leg(&d.feet);
+pub fn feet_svg(d: &TreePlotData) -> PlotResult<String> {
+    let series = solid(&d.feet);
     if d.heights.is_empty() {
         return stacked_time_chart(
             None,
@@ -255,16 +285,16 @@ pub fn feet_svg(d: &SpatialPlotData) -> PlotResult<String> {
             d.t_range(),
         );
     }
-    // Each foot solid, the terrain under it dashed, in the leg's colour.
+    // Each foot solid, the terrain under it dashed, in the foot's colour.
     let heights: Vec<(&Trace, Style)> = d
         .heights
         .iter()
         .enumerate()
-        .map(|(k, t)| {
+        .map(|(k, (t, color))| {
             (
                 t,
                 Style {
-                    color: leg_color(d.legs[k / 2]),
+                    color: *color,
                     width: if k % 2 == 0 { 2 } else { 1 },
                     dashed: k % 2 == 1,
                 },
@@ -286,28 +316,21 @@ pub fn feet_svg(d: &SpatialPlotData) -> PlotResult<String> {
     )
 }
 
-/// `torques.svg`: the actuator torques of every leg, one chart per joint
-/// (θ1, θ2, θ3).
-pub fn torques_svg(d: &SpatialPlotData) -> PlotResult<String> {
-    let series: Vec<Vec<(&Trace, Style)>> = d.torques.iter().map(|t| d.per_leg(t)).collect();
-    stacked_time_chart(
-        Some("Joint torques"),
-        &[
-            (
-                "τ1 (hip, about the body's vertical axis)",
-                "torque (N·m)",
-                &series[0],
-            ),
-            ("τ2 (hip, lift)", "torque (N·m)", &series[1]),
-            ("τ3 (knee)", "torque (N·m)", &series[2]),
-        ],
-        &d.events,
-        d.t_range(),
-    )
+/// `torques.svg`: the actuator torques, one chart per group of joints.
+pub fn torques_svg(d: &TreePlotData) -> PlotResult<String> {
+    let series: Vec<Vec<(&Trace, Style)>> = d.torques.iter().map(|(_, t)| solid(t)).collect();
+    let panels: Vec<_> = d
+        .torques
+        .iter()
+        .zip(&series)
+        .map(|((title, _), s)| (title.as_str(), "torque (N·m)", &s[..]))
+        .collect();
+    stacked_time_chart(Some(&d.torques_title), &panels, &d.events, d.t_range())
 }
 
-/// `body.svg`: the body height and the three body angles versus time.
-pub fn body_svg(d: &SpatialPlotData) -> PlotResult<String> {
+/// `body.svg`: the root's forward position, height, roll, pitch and
+/// heading versus time.
+pub fn body_svg(d: &TreePlotData) -> PlotResult<String> {
     let style = |k: usize| Style {
         color: PALETTE[k],
         width: 2,
@@ -345,7 +368,7 @@ pub fn body_svg(d: &SpatialPlotData) -> PlotResult<String> {
 
 /// `energy.svg`: kinetic, potential and total energy, drawn as the planar
 /// run draws it.
-pub fn energy_svg(d: &SpatialPlotData) -> PlotResult<String> {
+pub fn energy_svg(d: &TreePlotData) -> PlotResult<String> {
     plot::energy_svg(&PlotData {
         energy: d.energy.clone(),
         events: d.events.clone(),

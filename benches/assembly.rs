@@ -40,7 +40,7 @@ fn bench(c: &mut Criterion) {
         let z = data.z.clone();
         let mut r = vec![0.0; n];
         let mut entries = Vec::new();
-        pattern(mech, &data.fbd, &mut entries);
+        pattern(mech, terrain, &data.fbd, &mut entries);
         entries.sort_unstable_by_key(|&(i, j)| (j, i));
         entries.dedup();
         let mut slot = vec![u32::MAX; n * n];

@@ -20,8 +20,8 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use fbd_dynamics::tree::assemble::{eval, pattern};
-use fbd_dynamics::{JacobianSink, NoJacobian};
+
+use fbd_dynamics::{JacobianSink, NoJacobian, eval, pattern};
 use fbd_scenario::Config;
 use fbd_sim::spatial::{SpatialData, SpatialModel, step};
 use fbd_solver::NewtonSolver;
@@ -98,7 +98,7 @@ fn bench(c: &mut Criterion) {
         })
     });
     let mut entries = Vec::new();
-    pattern(&stand.mech, &data.fbd, &mut entries);
+    pattern(&stand.mech, &stand.params.terrain, &data.fbd, &mut entries);
     println!(
         "standing: {n} unknowns, {} structural entries",
         entries.len()

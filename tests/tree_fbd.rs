@@ -220,7 +220,7 @@ fn check_lab(first_step: bool, contact: bool, complementarity: bool, limits_at: 
     }
     let mut r = vec![0.0; n];
     let mut jac = vec![0.0; n * n];
-    tree::eval(
+    fbd_dynamics::eval(
         &mech,
         &surface,
         &mut data,
@@ -229,7 +229,7 @@ fn check_lab(first_step: bool, contact: bool, complementarity: bool, limits_at: 
         &mut Dense { n, m: &mut jac },
     );
     let mut entries = Vec::new();
-    tree::pattern(&mech, &data, &mut entries);
+    fbd_dynamics::pattern(&mech, &surface, &data, &mut entries);
     check_pattern(n, n, &entries, |i, j| jac[i * n + j]).unwrap_or_else(|e| panic!("{e}"));
     // Every body row has its q[k+1] columns: the dynamics are coupled.
     for b in 0..dims.bodies {
@@ -240,7 +240,7 @@ fn check_lab(first_step: bool, contact: bool, complementarity: bool, limits_at: 
     check_jacobian(
         &z,
         n,
-        |x, out| tree::eval(&mech, &surface, &mut work, x, out, &mut NoJacobian),
+        |x, out| fbd_dynamics::eval(&mech, &surface, &mut work, x, out, &mut NoJacobian),
         |i, j| jac[i * n + j],
         FdTolerance {
             step: 1e-6,
@@ -292,12 +292,14 @@ impl fbd_solver::NewtonSystem for TreeSystem<'_> {
         tree::pattern_key(self.data)
     }
     fn pattern(&self, entries: &mut Vec<(usize, usize)>) {
-        tree::pattern(self.mech, self.data, entries);
+        fbd_dynamics::pattern(self.mech, self.surface, self.data, entries);
     }
     fn eval(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut fbd_solver::JacobianSink<'_>>) {
         match jac {
-            Some(j) => tree::eval(self.mech, self.surface, self.data, x, r, &mut SolverSink(j)),
-            None => tree::eval(self.mech, self.surface, self.data, x, r, &mut NoJacobian),
+            Some(j) => {
+                fbd_dynamics::eval(self.mech, self.surface, self.data, x, r, &mut SolverSink(j))
+            }
+            None => fbd_dynamics::eval(self.mech, self.surface, self.data, x, r, &mut NoJacobian),
         }
     }
 }

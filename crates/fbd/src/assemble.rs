@@ -28,8 +28,10 @@
 //! ([`FbdModel`] for [`Mechanism`]): its kinematics, and the rotation row's
 //! central difference of the body angle.
 
-use crate::assembly::{self, At, ContactView, Dims, FbdModel, Reaction, RowState, Slip, StopView};
-use crate::body::{BodyStep, Wrench};
+use crate::assembly::{
+    At, ContactView, Dims, FbdModel, Reaction, RowState, Slip, StepTerms, StopView,
+};
+use crate::body::BodyStep;
 use crate::mechanism::Mechanism;
 use crate::rows;
 use crate::space::Plane;
@@ -149,63 +151,38 @@ pub enum History<'a> {
     },
 }
 
-/// Mutable workspace of the assembly (allocated once per mechanism).
+/// Mutable workspace of the assembly (allocated once per mechanism); it
+/// dereferences to what every model's step holds alike ([`StepTerms`]:
+/// the kinematics at `q[k−1]`, `q[k]` (positions; Jacobians at `k = 0`
+/// only, see [`advance`]) and the iterate of `q[k+1]`, the contact
+/// equations, each body's constants, the stops' equations, the torques,
+/// `Δt` and the gains).
 #[derive(Clone, Debug)]
 pub struct FbdData {
-    /// Kinematics at `q[k−1]`.
-    pub kin_prev: PlanarData,
-    /// Kinematics at `q[k]`: positions; Jacobians at `k = 0` only (see
-    /// [`advance`]).
-    pub kin: PlanarData,
-    /// Kinematics at the current Newton iterate of `q[k+1]`.
-    pub kin_next: PlanarData,
-    /// Per-body constants of this step.
-    pub body: Vec<BodyStep>,
-    /// Per-contact equations of this step.
-    pub contact: Vec<ContactEquation>,
-    /// Per-limit equations of this step (order of [`Mechanism::limits`]).
-    pub limit: Vec<LimitEquation>,
-    /// Joint torques at `k` (N·m), positive towards larger joint angles.
-    pub torque: Vec<f64>,
-    /// Time step (s).
-    pub dt: f64,
-    /// Scale of contact position rows, `M/Δt²` (N/m).
-    pub position_gain: f64,
-    /// Scale of joint-limit rows, `Kθ = (M/Δt²)·ℓ²` (N·m/rad).
-    pub limit_gain: f64,
+    /// What every model's step holds.
+    pub terms: StepTerms<Plane, PlanarData, ContactEquation>,
     /// The mechanism's total mass `M` (kg), [`Mechanism::total_mass`].
     pub total_mass: f64,
     /// The mechanism's length scale `ℓ` (m), [`Mechanism::length_scale`].
     pub length_scale: f64,
-    /// `kin_next` holds the positions of a candidate set by
-    /// [`evaluate_next`] (and no Newton iterate since).
-    next_is_candidate: bool,
-    /// The `q[k+1]` at which `kin_next`'s positions were last evaluated
-    /// (NaN before the first evaluation).
-    next_q: Vec<f64>,
-    wrench: Vec<Wrench<Plane>>,
 }
+
+crate::assembly::step_terms!(FbdData, Plane, PlanarData, ContactEquation);
 
 impl FbdData {
     /// A workspace for `mech`.
     pub fn new(mech: &Mechanism) -> Self {
-        let kin = mech.chains.new_data();
         Self {
-            kin_prev: kin.clone(),
-            kin_next: kin.clone(),
-            kin,
-            body: vec![BodyStep::default(); mech.bodies.len()],
-            contact: vec![ContactEquation::default(); mech.contacts.len()],
-            limit: vec![LimitEquation::default(); mech.limits.len()],
-            torque: vec![0.0; mech.joints.len()],
-            dt: 0.0,
-            position_gain: 0.0,
-            limit_gain: 0.0,
+            terms: StepTerms::new(
+                mech.chains.new_data(),
+                mech.layout().nq,
+                mech.bodies.len(),
+                mech.contacts.len(),
+                mech.limits.len(),
+                mech.joints.len(),
+            ),
             total_mass: mech.total_mass(),
             length_scale: mech.length_scale(),
-            next_is_candidate: false,
-            next_q: vec![f64::NAN; mech.layout().nq],
-            wrench: vec![Wrench::default(); mech.bodies.len()],
         }
     }
 
@@ -227,10 +204,8 @@ pub fn set_configuration(mech: &Mechanism, data: &mut FbdData, q: &[f64]) {
 /// Stage "kinematics at k": the per-body constants of this step's second
 /// differences, given `q[k]` already set.
 pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, dt: f64) {
-    data.dt = dt;
-    data.position_gain = data.total_mass / (dt * dt);
-    let l = data.length_scale;
-    data.limit_gain = data.position_gain * l * l;
+    let (mass, length) = (data.total_mass, data.length_scale);
+    data.terms.set_dt(dt, mass, length);
     for b in 0..mech.bodies.len() {
         let x_k = FbdData::body_coords(mech, &data.kin, b);
         data.body[b] = match history {
@@ -253,11 +228,8 @@ pub fn prepare_step(mech: &Mechanism, data: &mut FbdData, history: History<'_>, 
 /// evaluated when `kin_next` already holds the positions at exactly
 /// `q_next` (the solver's last evaluation is usually at its solution).
 pub fn evaluate_next(mech: &Mechanism, data: &mut FbdData, q_next: &[f64]) {
-    if data.next_q != q_next {
-        mech.chains.eval_positions(q_next, &mut data.kin_next);
-        data.next_q.copy_from_slice(q_next);
-    }
-    data.next_is_candidate = true;
+    data.terms
+        .evaluate_candidate(q_next, |kin, q| mech.chains.eval_positions(q, kin));
 }
 
 /// Accepts the candidate of [`evaluate_next`]: `q[k]` becomes the previous
@@ -270,16 +242,7 @@ pub fn evaluate_next(mech: &Mechanism, data: &mut FbdData, q_next: &[f64]) {
 /// # Panics
 /// If [`evaluate_next`] was not called since the last [`eval`].
 pub fn advance(_mech: &Mechanism, data: &mut FbdData) {
-    assert!(
-        data.next_is_candidate,
-        "advance needs evaluate_next at the accepted configuration"
-    );
-    std::mem::swap(&mut data.kin_prev, &mut data.kin);
-    std::mem::swap(&mut data.kin, &mut data.kin_next);
-    // `kin_next` now holds what `kin_prev` held, which no longer matches
-    // `next_q`.
-    data.next_q.fill(f64::NAN);
-    data.next_is_candidate = false;
+    data.terms.accept_candidate();
 }
 
 /// A key identifying the sparsity pattern: the contact states' codes in
@@ -292,29 +255,12 @@ pub fn pattern_key(data: &FbdData) -> u64 {
     )
 }
 
-/// Pushes every structural `(row, col)` of the Jacobian for the current
-/// contact states.
-pub fn pattern(mech: &Mechanism, data: &FbdData, entries: &mut Vec<(usize, usize)>) {
-    assembly::pattern(mech, &Terrain::None, data, entries);
-}
-
-/// Residual `r(z)` and, through `jac`, the analytic Jacobian
-/// ([`crate::assembly::eval`]).
-pub fn eval<S: JacobianSink>(
-    mech: &Mechanism,
-    terrain: &Terrain,
-    data: &mut FbdData,
-    z: &[f64],
-    r: &mut [f64],
-    jac: &mut S,
-) {
-    assembly::eval(mech, terrain, data, z, r, jac);
-}
-
 /// The planar model's part of the assembly.
 impl FbdModel for Mechanism {
     type S = Plane;
     type Data = FbdData;
+    type Kin = PlanarData;
+    type Contact = ContactEquation;
     type Ground = Terrain;
     const IMPLICIT_SLIP: bool = false;
 
@@ -337,28 +283,12 @@ impl FbdModel for Mechanism {
         self.bodies[b].versor_z
     }
 
-    #[inline]
-    fn gains(&self, data: &FbdData) -> (f64, f64, f64) {
-        (data.dt, data.position_gain, data.limit_gain)
-    }
-
     fn kinematics_next(&self, data: &mut FbdData, q: &[f64], jacobians: bool) {
         self.chains.eval_positions(q, &mut data.kin_next);
-        data.next_q.copy_from_slice(q);
-        data.next_is_candidate = false;
+        data.terms.set_iterate(q);
         if jacobians {
             self.chains.eval_jacobians(&mut data.kin_next);
         }
-    }
-
-    #[inline]
-    fn body_step<'a>(&self, data: &'a FbdData, b: usize) -> &'a BodyStep<Plane> {
-        &data.body[b]
-    }
-
-    #[inline]
-    fn wrenches<'a>(&self, data: &'a mut FbdData) -> &'a mut [Wrench<Plane>] {
-        &mut data.wrench
     }
 
     #[inline]
@@ -412,11 +342,7 @@ impl FbdModel for Mechanism {
 
     #[inline]
     fn contact_point(&self, data: &FbdData, c: usize, at: At) -> [f64; 2] {
-        let kin = match at {
-            At::Now => &data.kin,
-            At::Next => &data.kin_next,
-        };
-        kin.pos[self.contacts[c].point]
+        data.kin_at(at).pos[self.contacts[c].point]
     }
 
     #[inline]

@@ -88,6 +88,164 @@ impl Dims {
     }
 }
 
+/// What a step's equations hold, alike for every model: the kinematics at
+/// `q[k−1]`, `q[k]` and the iterate of `q[k+1]` (the model's kind `K`),
+/// each contact point's equations (the model's kind `C`), each body's
+/// constants of the step, each stop's equation, the joint torques, `Δt`
+/// and the gains of the position rows, and each body's wrench at the last
+/// evaluation. A model's workspace holds them and dereferences to them
+/// ([`FbdModel::Data`]).
+#[derive(Clone, Debug)]
+pub struct StepTerms<S: Space, K, C> {
+    /// Kinematics at `q[k−1]`.
+    pub kin_prev: K,
+    /// Kinematics at `q[k]`.
+    pub kin: K,
+    /// Kinematics at the current iterate of `q[k+1]`.
+    pub kin_next: K,
+    /// Per contact point, its equations in this step.
+    pub contact: Vec<C>,
+    /// Per body, the constants of this step.
+    pub body: Vec<BodyStep<S>>,
+    /// Per stop (the model's order of its limits), its equation.
+    pub limit: Vec<LimitEquation>,
+    /// Actuator torque of every joint at k (N·m), positive towards larger
+    /// joint angles.
+    pub torque: Vec<f64>,
+    /// Time step (s).
+    pub dt: f64,
+    /// Scale of contact position rows, `K = M/Δt²` (N/m; `M` the total
+    /// mass).
+    pub position_gain: f64,
+    /// Scale of stop rows, `Kθ = K·ℓ²` (N·m/rad; `ℓ` the model's length
+    /// scale).
+    pub limit_gain: f64,
+    /// Per body, the sum of applied forces and moments (about its centre
+    /// of mass) at k of the last evaluation (N, N·m).
+    pub wrench: Vec<Wrench<S>>,
+    /// The `q[k+1]` `kin_next` was last evaluated at (NaN: none since the
+    /// last accepted step).
+    next_q: Vec<f64>,
+    /// `kin_next` holds a candidate set by [`Self::evaluate_candidate`]
+    /// (and no iterate since).
+    next_is_candidate: bool,
+}
+
+impl<S: Space, K: Clone, C: Clone + Default> StepTerms<S, K, C> {
+    /// Terms at the kinematics `kin` for `nq` coordinates, `bodies`
+    /// bodies, `contacts` contact points, `limits` stops and `joints`
+    /// joints.
+    pub fn new(
+        kin: K,
+        nq: usize,
+        bodies: usize,
+        contacts: usize,
+        limits: usize,
+        joints: usize,
+    ) -> Self {
+        Self {
+            kin_prev: kin.clone(),
+            kin_next: kin.clone(),
+            kin,
+            contact: vec![C::default(); contacts],
+            body: vec![BodyStep::default(); bodies],
+            limit: vec![LimitEquation::default(); limits],
+            torque: vec![0.0; joints],
+            dt: 0.0,
+            position_gain: 0.0,
+            limit_gain: 0.0,
+            wrench: vec![Wrench::default(); bodies],
+            next_q: vec![f64::NAN; nq],
+            next_is_candidate: false,
+        }
+    }
+}
+
+impl<S: Space, K, C> StepTerms<S, K, C> {
+    /// A step of `dt` for a model of total mass `mass` and length scale
+    /// `length`: `K = M/Δt²`, `Kθ = K·ℓ²`.
+    pub fn set_dt(&mut self, dt: f64, mass: f64, length: f64) {
+        self.dt = dt;
+        self.position_gain = mass / (dt * dt);
+        self.limit_gain = self.position_gain * length * length;
+    }
+
+    /// The kinematics at `q[k]` or at the iterate of `q[k+1]`.
+    #[inline]
+    pub fn kin_at(&self, at: At) -> &K {
+        match at {
+            At::Now => &self.kin,
+            At::Next => &self.kin_next,
+        }
+    }
+
+    /// Whether `kin_next` holds the kinematics at `q`.
+    #[inline]
+    pub fn next_at(&self, q: &[f64]) -> bool {
+        self.next_q[..] == q[..]
+    }
+
+    /// `kin_next` now holds the kinematics at the iterate `q` (not a
+    /// candidate).
+    #[inline]
+    pub fn set_iterate(&mut self, q: &[f64]) {
+        self.next_q.copy_from_slice(q);
+        self.next_is_candidate = false;
+    }
+
+    /// Makes the kinematics at a candidate `q[k+1]` (after the solve) the
+    /// candidate that [`Self::accept_candidate`] accepts, evaluating them
+    /// with `eval` unless `kin_next` holds them already (the solver's last
+    /// evaluation is usually at its solution); `true` when it evaluated.
+    pub fn evaluate_candidate(&mut self, q: &[f64], eval: impl FnOnce(&mut K, &[f64])) -> bool {
+        let fresh = !self.next_at(q);
+        if fresh {
+            eval(&mut self.kin_next, q);
+            self.next_q.copy_from_slice(q);
+        }
+        self.next_is_candidate = true;
+        fresh
+    }
+
+    /// Accepts the candidate: `q[k]` becomes the previous configuration and
+    /// `q[k+1]` the current one (its kinematics reused).
+    ///
+    /// # Panics
+    /// If [`Self::evaluate_candidate`] was not called since the last
+    /// iterate.
+    pub fn accept_candidate(&mut self) {
+        assert!(
+            self.next_is_candidate,
+            "advance needs evaluate_next at the accepted configuration"
+        );
+        std::mem::swap(&mut self.kin_prev, &mut self.kin);
+        std::mem::swap(&mut self.kin, &mut self.kin_next);
+        // `kin_next` now holds what `kin_prev` held.
+        self.next_q.fill(f64::NAN);
+        self.next_is_candidate = false;
+    }
+}
+
+/// `Deref` and `DerefMut` of a model's workspace `$data` (with a field
+/// `terms`) to its [`StepTerms`] in `$space` with kinematics `$kin` and
+/// contact equations `$contact`.
+macro_rules! step_terms {
+    ($data:ty, $space:ty, $kin:ty, $contact:ty) => {
+        impl std::ops::Deref for $data {
+            type Target = $crate::assembly::StepTerms<$space, $kin, $contact>;
+            fn deref(&self) -> &Self::Target {
+                &self.terms
+            }
+        }
+        impl std::ops::DerefMut for $data {
+            fn deref_mut(&mut self) -> &mut Self::Target {
+                &mut self.terms
+            }
+        }
+    };
+}
+pub(crate) use step_terms;
+
 /// What one joint exerts on its child body at step `k` (the opposite acts
 /// on its parent).
 #[derive(Clone, Copy, Debug)]
@@ -193,8 +351,13 @@ pub enum At {
 pub trait FbdModel {
     /// The plane or space.
     type S: Space;
-    /// The mutable workspace of the assembly.
-    type Data;
+    /// The mutable workspace of the assembly: the model's own, holding the
+    /// terms every model's equations hold alike ([`StepTerms`]).
+    type Data: std::ops::DerefMut<Target = StepTerms<Self::S, Self::Kin, Self::Contact>>;
+    /// The kinematics of a configuration.
+    type Kin: 'static;
+    /// A contact point's equations in a step.
+    type Contact: 'static;
     /// The terrain.
     type Ground: ?Sized;
     /// Whether a sliding point's friction direction is the step's own slip,
@@ -212,15 +375,24 @@ pub trait FbdModel {
     /// versor, ±1; 1 in space).
     fn rotation_projection(&self, b: usize) -> f64;
     /// `Δt` (s), `K = M/Δt²` and `Kθ = K·ℓ²` of this step.
-    fn gains(&self, data: &Self::Data) -> (f64, f64, f64);
+    #[inline]
+    fn gains(&self, data: &Self::Data) -> (f64, f64, f64) {
+        (data.dt, data.position_gain, data.limit_gain)
+    }
 
     /// Stage 1: the kinematics at the iterate `q` (and its Jacobians when
     /// `jacobians`).
     fn kinematics_next(&self, data: &mut Self::Data, q: &[f64], jacobians: bool);
     /// Body `b`'s constants of this step.
-    fn body_step<'a>(&self, data: &'a Self::Data, b: usize) -> &'a BodyStep<Self::S>;
+    #[inline]
+    fn body_step<'a>(&self, data: &'a Self::Data, b: usize) -> &'a BodyStep<Self::S> {
+        &data.body[b]
+    }
     /// The wrench accumulators, one per body.
-    fn wrenches<'a>(&self, data: &'a mut Self::Data) -> &'a mut [Wrench<Self::S>];
+    #[inline]
+    fn wrenches<'a>(&self, data: &'a mut Self::Data) -> &'a mut [Wrench<Self::S>] {
+        &mut data.wrench
+    }
     /// Body `b`'s centre of mass at the iterate.
     fn com_next(&self, data: &Self::Data, b: usize) -> <Self::S as Space>::Lin;
     /// The discrete rate of change of body `b`'s angular momentum about

@@ -68,8 +68,9 @@ pub mod tree;
 
 pub use assemble::{
     ContactEquation, FbdData, History, JacobianSink, LimitEquation, LimitState, NoJacobian,
-    advance, eval, evaluate_next, pattern, pattern_key, prepare_step, set_configuration,
+    advance, evaluate_next, pattern_key, prepare_step, set_configuration,
 };
+pub use assembly::{eval, pattern};
 pub use mechanism::{
     BodySpec, ContactPoints, ContactSpec, JointSpec, Layout, Mechanism, PointKind, TwoLegInertia,
 };

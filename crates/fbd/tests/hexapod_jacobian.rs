@@ -11,9 +11,10 @@
 use fbd_contact::spatial::frame;
 use fbd_contact::{SpatialState, Surface, Terrain};
 use fbd_dynamics::spatial::SpatialContactEquation;
-use fbd_dynamics::tree::assemble::{eval, pattern, prepare_step, set_configuration, set_previous};
+use fbd_dynamics::tree::assemble::{prepare_step, set_configuration, set_previous};
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism, contacts_by_kind};
 use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
+use fbd_dynamics::{eval, pattern};
 use fbd_kinematics::fd::{FdTolerance, check_jacobian, check_pattern};
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::{Joint, JointLimits, LimitSide};
@@ -190,7 +191,7 @@ fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementar
     }
     // The declared pattern covers every non-zero entry.
     let mut entries = Vec::new();
-    pattern(&mech, &data, &mut entries);
+    pattern(&mech, surface, &data, &mut entries);
     check_pattern(n, n, &entries, |i, j| jac[i * n + j]).unwrap_or_else(|e| panic!("{e}"));
     let mut work = data.clone();
     check_jacobian(

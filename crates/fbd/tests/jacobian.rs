@@ -128,7 +128,7 @@ fn check_with_limits(
     );
     // Every entry written must be in the declared pattern.
     let mut entries = Vec::new();
-    pattern(&mech, &data, &mut entries);
+    pattern(&mech, &Terrain::None, &data, &mut entries);
     check_pattern(n, n, &entries, |i, j| jm[i * n + j]).unwrap_or_else(|e| panic!("{e}"));
     let mut work = data.clone();
     check_jacobian(
@@ -247,7 +247,7 @@ fn stop_moment_enters_child_and_parent_rotation_rows_only() {
     let lay = mech.layout();
     let data = FbdData::new(&mech);
     let mut entries = Vec::new();
-    pattern(&mech, &data, &mut entries);
+    pattern(&mech, &Terrain::None, &data, &mut entries);
     for (l, &j) in mech.limits.iter().enumerate() {
         let col = lay.limit_moment(l);
         let mut rows: Vec<usize> = entries.iter().filter(|e| e.1 == col).map(|e| e.0).collect();

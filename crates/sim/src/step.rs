@@ -198,10 +198,11 @@ pub fn system<'a>(
     data: &'a mut Data,
 ) -> (StepSystem<'a>, &'a mut NewtonSolver, &'a mut [f64]) {
     set_contact_equations(model, data);
+    let regularization = beta(model, data.fbd.dt);
     for (eq, &state) in data.fbd.limit.iter_mut().zip(&data.limit_trial) {
         *eq = LimitEquation {
             state,
-            regularization: beta(model, data.fbd.dt),
+            regularization,
             complementarity: false,
         };
     }

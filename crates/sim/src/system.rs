@@ -24,7 +24,7 @@ impl NewtonSystem for StepSystem<'_> {
         fbd_dynamics::pattern_key(self.fbd)
     }
     fn pattern(&self, entries: &mut Vec<(usize, usize)>) {
-        fbd_dynamics::pattern(self.mech, self.fbd, entries);
+        fbd_dynamics::pattern(self.mech, self.terrain, self.fbd, entries);
     }
     fn eval(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut fbd_solver::JacobianSink<'_>>) {
         match jac {

@@ -9,14 +9,16 @@
 //! and the implicit slip direction of a sliding point.
 //!
 //! The stepping entry points: [`set_configuration`], [`set_previous`],
-//! [`prepare_step`], [`eval`], [`pattern_key`], [`pattern`],
-//! [`evaluate_next`], [`advance`].
+//! [`prepare_step`], [`pattern_key`], [`evaluate_next`], [`advance`]; the
+//! residual and its pattern are every model's ([`crate::assembly::eval`],
+//! [`crate::assembly::pattern`]).
 
 use super::kin::{Columns, TreeKin};
 use super::mechanism::TreeMechanism;
-use crate::assemble::{History, JacobianSink, LimitEquation};
-use crate::assembly::{self, At, ContactView, Dims, FbdModel, Reaction, RowState, Slip, StopView};
-use crate::body::Wrench;
+use crate::assemble::{History, JacobianSink};
+use crate::assembly::{
+    At, ContactView, Dims, FbdModel, Reaction, RowState, Slip, StepTerms, StopView,
+};
 use crate::rows;
 use crate::space::Space3;
 use crate::spatial::equations::{
@@ -27,29 +29,15 @@ use fbd_contact::spatial::clearance;
 use fbd_contact::{SpatialState, Surface};
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
 
-/// Mutable workspace of a [`TreeMechanism`]'s assembly (allocated once).
+/// Mutable workspace of a [`TreeMechanism`]'s assembly (allocated once);
+/// it dereferences to what every model's step holds alike ([`StepTerms`]:
+/// the kinematics at `q[k−1]`, `q[k]` and the iterate of `q[k+1]`, the
+/// contact equations, each body's constants, the stops' equations, the
+/// torques, `Δt` and the gains).
 #[derive(Clone, Debug)]
 pub struct TreeFbdData {
-    /// Kinematics at `q[k−1]`.
-    pub kin_prev: TreeKin,
-    /// Kinematics at `q[k]`.
-    pub kin: TreeKin,
-    /// Kinematics at the current iterate of `q[k+1]`.
-    pub kin_next: TreeKin,
-    /// Per FBD body, the constants of this step.
-    pub body: Vec<BodyStep3>,
-    /// Per contact point, its equations in this step.
-    pub contact: Vec<SpatialContactEquation>,
-    /// Per stop (order of [`TreeMechanism::limits`]), its equation.
-    pub limit: Vec<LimitEquation>,
-    /// Actuator torque of every model joint at k (N·m, about its axis).
-    pub torque: Vec<f64>,
-    /// Time step (s).
-    pub dt: f64,
-    /// Scale of contact position rows `M/Δt²` (N/m).
-    pub position_gain: f64,
-    /// Scale of stop rows `(M/Δt²)·ℓ²` (N·m/rad).
-    pub limit_gain: f64,
+    /// What every model's step holds.
+    pub terms: StepTerms<Space3, TreeKin, SpatialContactEquation>,
     /// Per reaction, the constraint-moment directions at k (a compound
     /// joint: `u1 × u2` normalised, the second unused; a single joint:
     /// `b1`, `b2 = u × b1` across its axis `u`).
@@ -61,9 +49,6 @@ pub struct TreeFbdData {
     /// Per FBD body, whether `l_next` and `psi_next` are those of the
     /// evaluated `kin_next` over this step's `dt` ([`step_momentum`]).
     l_next_fresh: Vec<bool>,
-    /// Per FBD body, the sum of applied forces and moments (about its CoM)
-    /// at k of the last evaluation (N, N·m).
-    pub wrench: Vec<Wrench<Space3>>,
     /// `L[k+½]` of every body at the accepted `q[k+1]` over a step of
     /// `l_carry_dt`, the next step's `L[k−½]` when `l_carry_valid`: a
     /// step accepted whole carries its momenta over, so that the next
@@ -101,32 +86,27 @@ pub struct TreeFbdData {
     /// evaluated iterate.
     pub limit_unloaded: Vec<bool>,
     rot_d: Vec<Matrix3<f64>>,
-    /// The `q` `kin_next` was last evaluated at (NaN: none).
-    kin_next_q: Vec<f64>,
-    next_is_candidate: bool,
 }
+
+crate::assembly::step_terms!(TreeFbdData, Space3, TreeKin, SpatialContactEquation);
 
 impl TreeFbdData {
     /// A workspace for `mech`.
     pub fn new(mech: &TreeMechanism) -> Self {
-        let kin = TreeKin::new(&mech.model);
         let (nb, nc, nl) = (mech.bodies.len(), mech.contacts.len(), mech.limits.len());
         Self {
-            kin_prev: kin.clone(),
-            kin_next: kin.clone(),
-            kin,
-            body: vec![BodyStep3::default(); nb],
-            contact: vec![SpatialContactEquation::default(); nc],
-            limit: vec![LimitEquation::default(); nl],
-            torque: vec![0.0; mech.model.joints.len()],
-            dt: 0.0,
-            position_gain: 0.0,
-            limit_gain: 0.0,
+            terms: StepTerms::new(
+                TreeKin::new(&mech.model),
+                mech.nq(),
+                nb,
+                nc,
+                nl,
+                mech.model.joints.len(),
+            ),
             moment_dir: vec![[Vector3::zeros(); 2]; mech.reactions.len()],
             l_next: vec![Vector3::zeros(); nb],
             psi_next: vec![Vector3::zeros(); nb],
             l_next_fresh: vec![false; nb],
-            wrench: vec![Wrench::default(); nb],
             l_carry: vec![Vector3::zeros(); nb],
             l_carry_dt: 0.0,
             l_carry_valid: false,
@@ -143,8 +123,6 @@ impl TreeFbdData {
             refrozen: false,
             limit_unloaded: vec![false; nl],
             rot_d: vec![Matrix3::zeros(); nb],
-            kin_next_q: vec![f64::NAN; mech.nq()],
-            next_is_candidate: false,
         }
     }
 }
@@ -201,14 +179,12 @@ fn moment_directions(mech: &TreeMechanism, kin: &TreeKin, i: usize) -> [Vector3<
 /// Stage "kinematics at k": every body's constants and the constraint
 /// directions of this step, given `q[k]` (and `q[k−1]`) already set.
 pub fn prepare_step(mech: &TreeMechanism, data: &mut TreeFbdData, history: History<'_>, dt: f64) {
-    data.dt = dt;
+    data.terms
+        .set_dt(dt, mech.total_mass(), mech.length_scale());
     data.l_next_fresh.fill(false);
     data.slip_bias = STOP_SPEED * dt;
     let carried = data.l_carry_valid;
     data.l_carry_valid = false;
-    data.position_gain = mech.total_mass() / (dt * dt);
-    let l = mech.length_scale();
-    data.limit_gain = data.position_gain * l * l;
     for (b, body) in mech.bodies.iter().enumerate() {
         let mb = body.model_body;
         let com_k = data.kin.com[mb];
@@ -249,12 +225,12 @@ pub fn prepare_step(mech: &TreeMechanism, data: &mut TreeFbdData, history: Histo
 /// Evaluates the kinematics at a candidate `q[k+1]` into `kin_next` (after
 /// the solve), so that [`advance`] can accept it.
 pub fn evaluate_next(mech: &TreeMechanism, data: &mut TreeFbdData, q_next: &[f64]) {
-    if data.kin_next_q != q_next {
-        data.kin_next.eval(&mech.model, q_next);
-        data.kin_next_q.copy_from_slice(q_next);
+    if data
+        .terms
+        .evaluate_candidate(q_next, |kin, q| kin.eval(&mech.model, q))
+    {
         data.l_next_fresh.fill(false);
     }
-    data.next_is_candidate = true;
 }
 
 /// Accepts the candidate of [`evaluate_next`]: `q[k]` becomes the previous
@@ -263,15 +239,8 @@ pub fn evaluate_next(mech: &TreeMechanism, data: &mut TreeFbdData, q_next: &[f64
 /// # Panics
 /// If [`evaluate_next`] was not called since the last [`eval`].
 pub fn advance(data: &mut TreeFbdData) {
-    assert!(
-        data.next_is_candidate,
-        "advance needs evaluate_next at the accepted configuration"
-    );
-    std::mem::swap(&mut data.kin_prev, &mut data.kin);
-    std::mem::swap(&mut data.kin, &mut data.kin_next);
-    data.kin_next_q.fill(f64::NAN);
+    data.terms.accept_candidate();
     data.l_next_fresh.fill(false);
-    data.next_is_candidate = false;
 }
 
 /// `L[k+½]` of FBD body `b` ([`crate::spatial::half_momentum_and_rotation`])
@@ -296,25 +265,6 @@ pub fn pattern_key(data: &TreeFbdData) -> u64 {
     )
 }
 
-/// Pushes every structural `(row, col)` of the Jacobian for the current
-/// states.
-pub fn pattern(mech: &TreeMechanism, data: &TreeFbdData, entries: &mut Vec<(usize, usize)>) {
-    assembly::pattern(mech, &Surface::default(), data, entries);
-}
-
-/// Residual `r(z)` and, through `jac`, the analytic Jacobian
-/// ([`crate::assembly::eval`]).
-pub fn eval<S: JacobianSink>(
-    mech: &TreeMechanism,
-    surface: &Surface,
-    data: &mut TreeFbdData,
-    z: &[f64],
-    r: &mut [f64],
-    jac: &mut S,
-) {
-    assembly::eval(mech, surface, data, z, r, jac);
-}
-
 #[inline]
 fn columns(cols: Columns<'_>, mut f: impl FnMut(usize, &[f64; 3])) {
     cols.for_each(|i, v| f(i, &[v.x, v.y, v.z]));
@@ -324,6 +274,8 @@ fn columns(cols: Columns<'_>, mut f: impl FnMut(usize, &[f64; 3])) {
 impl FbdModel for TreeMechanism {
     type S = Space3;
     type Data = TreeFbdData;
+    type Kin = TreeKin;
+    type Contact = SpatialContactEquation;
     type Ground = Surface;
     const IMPLICIT_SLIP: bool = true;
 
@@ -346,28 +298,12 @@ impl FbdModel for TreeMechanism {
         1.0
     }
 
-    #[inline]
-    fn gains(&self, data: &TreeFbdData) -> (f64, f64, f64) {
-        (data.dt, data.position_gain, data.limit_gain)
-    }
-
     fn kinematics_next(&self, data: &mut TreeFbdData, q: &[f64], _: bool) {
-        if data.kin_next_q[..] != q[..] {
+        if !data.next_at(q) {
             data.kin_next.eval(&self.model, q);
-            data.kin_next_q.copy_from_slice(q);
             data.l_next_fresh.fill(false);
         }
-        data.next_is_candidate = false;
-    }
-
-    #[inline]
-    fn body_step<'a>(&self, data: &'a TreeFbdData, b: usize) -> &'a BodyStep3 {
-        &data.body[b]
-    }
-
-    #[inline]
-    fn wrenches<'a>(&self, data: &'a mut TreeFbdData) -> &'a mut [Wrench<Space3>] {
-        &mut data.wrench
+        data.terms.set_iterate(q);
     }
 
     #[inline]
@@ -455,11 +391,7 @@ impl FbdModel for TreeMechanism {
 
     #[inline]
     fn contact_point(&self, data: &TreeFbdData, c: usize, at: At) -> [f64; 3] {
-        let kin = match at {
-            At::Now => &data.kin,
-            At::Next => &data.kin_next,
-        };
-        kin.contact[self.contacts[c].model_contact].into()
+        data.kin_at(at).contact[self.contacts[c].model_contact].into()
     }
 
     #[inline]

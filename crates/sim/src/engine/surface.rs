@@ -104,8 +104,8 @@ pub trait SearchFields {
 impl SearchFields for TreeFbdData {
     fn search(&mut self) -> Search<'_> {
         Search {
-            contact: &mut self.contact,
-            limit: &mut self.limit,
+            contact: &mut self.terms.contact,
+            limit: &mut self.terms.limit,
             branch: &self.branch,
             frozen: &mut self.frozen,
             first_frozen: &mut self.first_frozen,

@@ -169,7 +169,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             fbd_sim::spatial::modes_slower_than(
                 black_box(&walk_params),
-                &fbd_sim::spatial::closed_form(&walk_params),
+                &walk_params.robot_model(),
                 limit,
             )
         })

@@ -141,7 +141,7 @@ fn spatial_params(name: &str, overrides: &[Override]) -> fbd_sim::spatial::Spati
 #[test]
 fn the_fast_check_gives_the_eigenvalues_verdict() {
     use fbd_sim::spatial::{
-        SpatialControl, SpatialModel, closed_form, fastest_mode_over_poses, modes_slower_than,
+        SpatialControl, SpatialModel, fastest_mode_over_poses, modes_slower_than,
     };
     let mut checked = 0;
     for name in [
@@ -161,7 +161,7 @@ fn the_fast_check_gives_the_eigenvalues_verdict() {
                     Override::new("control.kd", 0.0),
                 ],
             );
-            let probe = closed_form(&base);
+            let probe = base.robot_model();
             let (inertia, _) = fastest_mode_over_poses(&base, &probe);
             assert!(inertia > 0.0 && inertia.is_finite(), "{name}: {inertia}");
             // Bisection on the fast test recovers the smallest inertia.
@@ -211,4 +211,75 @@ fn the_fast_check_gives_the_eigenvalues_verdict() {
         }
     }
     assert!(checked > 500, "{checked}");
+}
+
+/// The start-up check on the hexapod's D-H instance (the generic robot
+/// model, `tree_modes_slower_than`, as for any robot) against the
+/// closed-form hexapod's leg-by-leg test (`spatial_modes_slower_than`, an
+/// independent reference): on random poses (every joint within ±0.4 rad
+/// of the examples' initial angles) and random sets of standing feet, the
+/// smallest inertia each test passes, found by bisection, agrees to 1e-9.
+#[test]
+fn the_generic_check_is_the_closed_form_hexapod_s() {
+    use fbd_dynamics::spatial::SpatialKin;
+    use fbd_sim::joint_inertia::{ModeWork, spatial_modes_slower_than, tree_modes_slower_than};
+    use fbd_sim::spatial::closed_form;
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut compared = 0;
+    for name in [
+        "hexapod_walk.toml",
+        "hexapod_stand.toml",
+        "hexapod_slope.toml",
+    ] {
+        let p = spatial_params(name, &[]);
+        let robot = p.robot_model();
+        let hexapod = closed_form(&p);
+        let (mut tk, mut sk) = (ModeWork::new(&robot), SpatialKin::new(&hexapod));
+        for _ in 0..40 {
+            let mut q = p.q0.clone();
+            for x in &mut q[6..] {
+                *x += 0.8 * (uniform() - 0.5);
+            }
+            let slots: Vec<usize> = (0..p.legs.len()).filter(|_| uniform() < 0.6).collect();
+            let feet: Vec<usize> = slots
+                .iter()
+                .map(|&s| {
+                    let tip = format!("tip{}", p.legs[s]);
+                    robot.contacts.iter().position(|c| c.name == tip).unwrap()
+                })
+                .collect();
+            let threshold = |test: &mut dyn FnMut(f64) -> Option<bool>| {
+                let (mut lo, mut hi) = (0.0, 1.0);
+                for _ in 0..80 {
+                    let mid = 0.5 * (lo + hi);
+                    match test(mid)? {
+                        true => lo = mid,
+                        false => hi = mid,
+                    }
+                }
+                Some(lo)
+            };
+            let generic = threshold(&mut |i| tree_modes_slower_than(&robot, &mut tk, &q, &feet, i));
+            let closed =
+                threshold(&mut |i| spatial_modes_slower_than(&hexapod, &mut sk, &q, &slots, i));
+            match (generic, closed) {
+                (Some(a), Some(b)) => {
+                    assert!(
+                        a > 0.0 && (a - b).abs() <= 1e-9 * b,
+                        "{name}: standing {slots:?}: generic {a:e}, closed form {b:e}"
+                    );
+                    compared += 1;
+                }
+                (None, None) => {}
+                other => panic!("{name}: standing {slots:?}: {other:?}"),
+            }
+        }
+    }
+    assert!(compared > 100, "{compared}");
 }

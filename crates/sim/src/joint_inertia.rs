@@ -31,8 +31,10 @@
 
 use fbd_dynamics::spatial::so3::hat;
 use fbd_dynamics::spatial::{SpatialKin, SpatialMechanism, lower_body, upper_body};
+use fbd_dynamics::tree::kin::TreeKin;
 use fbd_dynamics::{Mechanism, PointKind};
 use fbd_kinematics::nalgebra::{DMatrix, Matrix3, Matrix3x6, Matrix6, SMatrix, Vector3};
+use fbd_robot::RobotModel;
 
 /// The mass matrix `M(q)` (kinetic energy `½·q̇ᵀ·M·q̇`) of the planar
 /// model at `q`.
@@ -287,4 +289,202 @@ fn world_inertia(r: Matrix3<f64>, inertia: &Matrix3<f64>) -> Matrix3<f64> {
     } else {
         r * inertia * r.transpose()
     }
+}
+
+/// The Jacobian of the contact points `standing` (indices into
+/// `robot.contacts`) of any robot at `q` (3 rows per point): the
+/// constraints of its feet on the ground (a sticking sphere does not roll:
+/// its centre's velocity).
+pub fn tree_feet_jacobian(robot: &RobotModel, standing: &[usize], q: &[f64]) -> DMatrix<f64> {
+    let mut kin = TreeKin::new(robot);
+    kin.eval(robot, q);
+    let mut g = DMatrix::zeros(3 * standing.len(), q.len());
+    for (r, &c) in standing.iter().enumerate() {
+        kin.contact_jacobian(c).for_each(|i, v| {
+            for a in 0..3 {
+                g[(3 * r + a, i)] += v[a];
+            }
+        });
+    }
+    g
+}
+
+/// The workspace of [`tree_modes_slower_than`] for one robot.
+#[derive(Clone, Debug)]
+pub struct ModeWork {
+    kin: TreeKin,
+    stance: Vec<bool>,
+    limbs: Vec<([usize; 3], usize)>,
+    ia: Vec<Matrix6<f64>>,
+}
+
+impl ModeWork {
+    /// A workspace for `robot`.
+    pub fn new(robot: &RobotModel) -> Self {
+        Self {
+            kin: TreeKin::new(robot),
+            stance: vec![false; robot.joints.len()],
+            limbs: Vec::with_capacity(robot.contacts.len()),
+            ia: vec![Matrix6::zeros(); robot.bodies.len()],
+        }
+    }
+}
+
+/// Body `b`'s kinetic energy as a quadratic form of a twist `(ω, v_o)`
+/// (`v_o` the velocity of the inertial point at `o`): its 6×6 inertia
+/// about `o` in the inertial frame.
+fn inertia_about(robot: &RobotModel, kin: &TreeKin, b: usize, o: &Vector3<f64>) -> Matrix6<f64> {
+    let body = &robot.bodies[b];
+    let mut k = Matrix6::zeros();
+    if body.mass == 0.0 {
+        return k;
+    }
+    let m = body.mass;
+    let r = kin.com[b] - o;
+    let ic = world_inertia(kin.rotation[b], &body.inertia);
+    let h = hat(&(m * r));
+    k.fixed_view_mut::<3, 3>(0, 0).copy_from(
+        &(ic + m * (Matrix3::from_diagonal_element(r.norm_squared()) - r * r.transpose())),
+    );
+    k.fixed_view_mut::<3, 3>(0, 3).copy_from(&h);
+    k.fixed_view_mut::<3, 3>(3, 0).copy_from(&h.transpose());
+    k.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&Matrix3::from_diagonal_element(m));
+    k
+}
+
+/// Joint `j`'s twist per unit rate in the coordinates of
+/// [`inertia_about`]: `(u, u × (o − p))`, `u` its axis through `p`.
+fn joint_twist(kin: &TreeKin, j: usize, o: &Vector3<f64>) -> SMatrix<f64, 6, 1> {
+    let u = kin.axis[j];
+    let v = u.cross(&(o - kin.joint_origin[j]));
+    SMatrix::<f64, 6, 1>::new(u.x, u.y, u.z, v.x, v.y, v.z)
+}
+
+/// [`spatial_modes_slower_than`] for any robot on the tree equations: the
+/// same test (`K = M − I·SᵀS` positive definite on the motions the
+/// standing points allow), decided along its tree by eliminations in the
+/// twist coordinates `(ω, v_o)` of the root about its centre of mass `o`,
+/// in which every body's twist is its parent's plus its joint's
+/// ([`joint_twist`]):
+///
+/// * a joint whose subtree swings, children first: its pivot
+///   `d = sᵀ·Ĩ·s − I` (`Ĩ` its child's inertia with the subtree's
+///   eliminated) must be positive, and `Ĩ − (Ĩs)(Ĩs)ᵀ/d` adds to its
+///   parent's;
+/// * a limb standing on a contact point (a chain of three joints from the
+///   root to the point's body, without branches): its rates follow from
+///   the root's twist (`θ̇ = T·V`, `T = −G_leg⁻¹·G_root`, `G` the point's
+///   velocity), and its energy, `M_rr + M_lrᵀT + TᵀM_lr + Tᵀ(M_ll − I)T`
+///   from its composite inertias, adds to the root's;
+/// * the root's 6×6 block must then be positive definite.
+///
+/// Some 100 flops per joint and a 6×6 Cholesky per pose, no allocation.
+/// `None` when a standing limb is not such a chain or is near a singular
+/// pose (the eigenvalues decide: [`fastest_mode`] on
+/// [`crate::robot::mass_matrix`] and [`tree_feet_jacobian`]). `standing`
+/// are indices into `robot.contacts`.
+pub fn tree_modes_slower_than(
+    robot: &RobotModel,
+    work: &mut ModeWork,
+    q: &[f64],
+    standing: &[usize],
+    inertia: f64,
+) -> Option<bool> {
+    let ModeWork {
+        kin,
+        stance,
+        limbs,
+        ia,
+    } = work;
+    kin.eval(robot, q);
+    let o = kin.com[0];
+    let nj = robot.joints.len();
+    // The standing limbs' joints, root first.
+    stance.fill(false);
+    limbs.clear();
+    for &c in standing {
+        let mut chain = Vec::with_capacity(3);
+        let mut j = robot.bodies[robot.contacts[c].body].joint;
+        while let Some(k) = j {
+            if chain.len() == 3 || stance[k] {
+                return None;
+            }
+            chain.push(k);
+            j = robot.bodies[robot.joints[k].parent].joint;
+        }
+        if chain.len() != 3 {
+            return None;
+        }
+        chain.reverse();
+        for &k in &chain {
+            stance[k] = true;
+        }
+        limbs.push(([chain[0], chain[1], chain[2]], c));
+    }
+    // No branch off a standing limb: every child of one of its bodies is
+    // its next joint's.
+    for (j, joint) in robot.joints.iter().enumerate() {
+        if !stance[j]
+            && let Some(up) = robot.bodies[joint.parent].joint
+            && stance[up]
+        {
+            return None;
+        }
+    }
+    for (b, k) in ia.iter_mut().enumerate() {
+        *k = inertia_about(robot, kin, b, &o);
+    }
+    // The swinging subtrees, children first.
+    for j in (0..nj).rev() {
+        if stance[j] {
+            continue;
+        }
+        let (parent, child) = (robot.joints[j].parent, robot.joints[j].child);
+        let s = joint_twist(kin, j, &o);
+        let h = ia[child] * s;
+        let d = s.dot(&h) - inertia;
+        // A NaN pivot (a degenerate pose) is no proof of stability.
+        if d.is_nan() || d <= 0.0 {
+            return Some(false);
+        }
+        let add = ia[child] - h * h.transpose() / d;
+        ia[parent] += add;
+    }
+    let mut k = ia[0];
+    for &(chain, c) in limbs.iter() {
+        let f = kin.contact_center[c];
+        let s = chain.map(|j| joint_twist(kin, j, &o));
+        let body = chain.map(|j| robot.joints[j].child);
+        // Composite inertias below each joint.
+        let ic2 = ia[body[2]];
+        let ic1 = ia[body[1]] + ic2;
+        let ic0 = ia[body[0]] + ic1;
+        let ic = [ic0, ic1, ic2];
+        let g_leg =
+            Matrix3::from_columns(&chain.map(|j| kin.axis[j].cross(&(f - kin.joint_origin[j]))));
+        let scale = g_leg.column(0).norm() * g_leg.column(1).norm() * g_leg.column(2).norm();
+        let det = g_leg.determinant().abs();
+        if !det.is_finite() || det <= 1e-6 * scale {
+            return None;
+        }
+        let g_inv = g_leg.try_inverse()?;
+        // The point's velocity v_o + ω × (f − o) + G_leg·θ̇ = 0.
+        let mut t = Matrix3x6::zeros();
+        t.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(g_inv * hat(&(f - o))));
+        t.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-g_inv));
+        let mut m_lr = Matrix3x6::zeros();
+        let mut m_ll = Matrix3::zeros();
+        for a in 0..3 {
+            m_lr.row_mut(a).copy_from(&(s[a].transpose() * ic[a]));
+            for b in 0..3 {
+                m_ll[(a, b)] = (s[a].transpose() * ic[a.max(b)] * s[b])[(0, 0)];
+            }
+        }
+        let c = m_lr.transpose() * t;
+        k += ic0 + c + c.transpose() + t.transpose() * (m_ll - Matrix3::identity() * inertia) * t;
+    }
+    let k = 0.5 * (k + k.transpose());
+    Some(k.cholesky().is_some())
 }

@@ -2,16 +2,15 @@
 
 use super::params::{SpatialControl, SpatialParams};
 use crate::SimError;
-use crate::joint_inertia::{
-    fastest_mode, spatial_feet_jacobian, spatial_mass_matrix, spatial_modes_slower_than,
-};
+use crate::joint_inertia::{ModeWork, fastest_mode, tree_feet_jacobian, tree_modes_slower_than};
 use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
-use fbd_dynamics::spatial::{SpatialInertia, SpatialKin, SpatialMechanism, q_joint};
+use fbd_dynamics::spatial::{SpatialInertia, SpatialMechanism, q_joint};
 use fbd_dynamics::tree::{TreeMechanism, contacts_by_kind};
 use fbd_dynamics::{ContactSpec, PointKind};
 use fbd_kinematics::Joint;
 use fbd_kinematics::nalgebra::{Matrix3, Vector3};
+use fbd_robot::RobotModel;
 use fbd_solver::NewtonParams;
 
 /// A joint stop of the hexapod: which leg slot and which joint of it.
@@ -227,7 +226,7 @@ impl SpatialModel {
         let robot = p.robot_model();
         let mech = TreeMechanism::with_contacts(&robot, p.gravity, &contacts_by_kind(&robot));
         let start = std::time::Instant::now();
-        pd_stability(p, &closed_form(p))?;
+        pd_stability(p, &robot)?;
         let stability_check_seconds = start.elapsed().as_secs_f64();
         let legs = p.legs.clone();
         // Model joint 3·slot + j is θ(j+1) of leg `legs[slot]`.
@@ -356,9 +355,8 @@ pub(crate) fn hexapod_contacts(mech: &TreeMechanism, legs: &[usize]) -> Vec<Cont
 
 /// The hexapod of `p` in closed form ([`fbd_dynamics::spatial`]): its
 /// bodies' masses and inertias on the leg kinematics of
-/// `fbd_kinematics::hexapod`, on which [`pd_stability`] decides the joint
-/// controller's stability leg by leg, and the tests have an independent
-/// reference for the positions the generic tree kinematics computes.
+/// `fbd_kinematics::hexapod`, the tests' independent reference for the
+/// positions, statics and modes the generic tree computes.
 pub fn closed_form(p: &SpatialParams) -> SpatialMechanism {
     let inertia = SpatialInertia {
         body_mass: p.body_mass,
@@ -394,8 +392,9 @@ const GAIT_POSES: usize = 200;
 ///
 /// The rule holds when every pose's modes are slower than the inertia
 /// limit of the gains ([`crate::rules::pd_inertia_limit`]), which
-/// [`spatial_modes_slower_than`] decides from a few small Cholesky
-/// factorisations per pose (about 4 % of the eigenvalues' cost). Only
+/// [`tree_modes_slower_than`] decides along the hexapod's D-H instance
+/// (the generic robot model, as for any robot) from some 100 flops per
+/// joint and a 6×6 Cholesky factorisation per pose. Only
 /// when that fails (or is undecided at a singular standing leg) the
 /// eigenvalues of every pose ([`fastest_mode_over_poses`]) give the
 /// verdict and the error's inertia and joint (kept in the process,
@@ -403,7 +402,7 @@ const GAIT_POSES: usize = 200;
 /// relative 1e-6 for the fast test, so that a pose within round-off of it
 /// is left to the eigenvalues: both paths give the same verdict
 /// (`tests/pd_stability.rs` compares them over a grid of gains and steps).
-fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimError> {
+fn pd_stability(p: &SpatialParams, robot: &RobotModel) -> Result<(), SimError> {
     let (kp, kd) = match &p.control {
         SpatialControl::None => return Ok(()),
         SpatialControl::Pd { kp, kd, .. }
@@ -414,14 +413,14 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
         return Ok(());
     }
     let limit = crate::rules::pd_inertia_limit(kp, kd, p.dt) * (1.0 + 1e-6);
-    if modes_slower_than(p, mech, limit) == Some(true) {
+    if modes_slower_than(p, robot, limit) == Some(true) {
         return Ok(());
     }
     // Only now the parameters are cloned for the cache's key: a passing
     // check costs less than cloning a large terrain.
     let key = cache_key(p);
     let (inertia, joint) = cached(&MODES, &key).unwrap_or_else(|| {
-        let mode = fastest_mode_over_poses(p, mech);
+        let mode = fastest_mode_over_poses(p, robot);
         keep(&MODES, key, mode);
         mode
     });
@@ -430,19 +429,20 @@ fn pd_stability(p: &SpatialParams, mech: &SpatialMechanism) -> Result<(), SimErr
         kd,
         inertia,
         p.dt,
-        &format!("leg {} theta{}", mech.legs[joint / 3], joint % 3 + 1),
+        &format!("leg {} theta{}", p.legs[joint / 3], joint % 3 + 1),
     )
 }
 
 /// Whether every pose of [`pd_stability`] has every joint mode slower
 /// than a joint of inertia `inertia` (kg·m²,
-/// [`spatial_modes_slower_than`]): `Some(false)` at the first pose that
+/// [`tree_modes_slower_than`] on `robot`, the D-H instance of `p`,
+/// [`SpatialParams::robot_model`]): `Some(false)` at the first pose that
 /// has a faster one, `None` when a pose is undecided.
-pub fn modes_slower_than(p: &SpatialParams, mech: &SpatialMechanism, inertia: f64) -> Option<bool> {
-    let mut kin = SpatialKin::new(mech);
+pub fn modes_slower_than(p: &SpatialParams, robot: &RobotModel, inertia: f64) -> Option<bool> {
+    let mut work = ModeWork::new(robot);
     let mut verdict = Some(true);
-    for_each_pose(p, mech, |q, standing| {
-        match spatial_modes_slower_than(mech, &mut kin, q, standing, inertia) {
+    for_each_pose(p, robot, |q, standing| {
+        match tree_modes_slower_than(robot, &mut work, q, standing, inertia) {
             Some(true) => true,
             Some(false) => {
                 verdict = Some(false);
@@ -529,16 +529,16 @@ fn keep<T>(cache: &std::sync::Mutex<Vec<(SpatialParams, T)>>, key: SpatialParams
 }
 
 /// The smallest effective joint inertia over the poses of
-/// [`pd_stability`] and its joint (index `3·slot + j`).
-pub fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f64, usize) {
-    let joints: Vec<usize> = (0..mech.legs.len())
-        .flat_map(|s| (0..3).map(move |j| q_joint(s, j)))
-        .collect();
+/// [`pd_stability`] and its joint (index `3·slot + j`), from the
+/// eigenvalues of each pose ([`fastest_mode`] on the mass matrix of
+/// `robot`, the D-H instance of `p`).
+pub fn fastest_mode_over_poses(p: &SpatialParams, robot: &RobotModel) -> (f64, usize) {
+    let joints: Vec<usize> = (0..robot.joints.len()).map(|j| 6 + j).collect();
     let (mut inertia, mut joint) = (f64::INFINITY, 0);
-    for_each_pose(p, mech, |q, standing| {
+    for_each_pose(p, robot, |q, standing| {
         let mode = fastest_mode(
-            &spatial_mass_matrix(mech, q),
-            &spatial_feet_jacobian(mech, standing, q),
+            &crate::robot::mass_matrix(robot, q),
+            &tree_feet_jacobian(robot, standing, q),
             &joints,
         );
         if mode.inertia < inertia {
@@ -550,17 +550,30 @@ pub fn fastest_mode_over_poses(p: &SpatialParams, mech: &SpatialMechanism) -> (f
 }
 
 /// Calls `visit(q, standing)` on every pose of [`pd_stability`] (the
-/// coordinates, the slots standing) in order, until it returns `false`.
+/// coordinates, the feet standing: indices into `robot.contacts`) in
+/// order, until it returns `false`. A leg whose foot is not a contact
+/// point never stands.
 fn for_each_pose(
     p: &SpatialParams,
-    mech: &SpatialMechanism,
+    robot: &RobotModel,
     mut visit: impl FnMut(&[f64], &[usize]) -> bool,
 ) {
-    let nlegs = mech.legs.len();
+    let nlegs = p.legs.len();
+    // Each slot's foot among the contact points.
+    let foot: Vec<Option<usize>> = p
+        .legs
+        .iter()
+        .map(|n| {
+            robot
+                .contacts
+                .iter()
+                .position(|c| c.name == format!("tip{n}"))
+        })
+        .collect();
     // Without ground no foot ever stands: the free robot's modes.
     let ground = p.terrain.exists();
     let all: Vec<usize> = if ground {
-        (0..nlegs).collect()
+        foot.iter().flatten().copied().collect()
     } else {
         Vec::new()
     };
@@ -605,8 +618,12 @@ fn for_each_pose(
                 }
                 let stance = g.stance();
                 standing.clear();
-                standing.extend((0..nlegs).filter(|&s| ground && stance[mech.legs[s] - 1]));
-                at(&mut q, mech.legs.iter().map(|&n| g.legs[n - 1].theta));
+                standing.extend(
+                    (0..nlegs)
+                        .filter(|&s| ground && stance[p.legs[s] - 1])
+                        .filter_map(|s| foot[s]),
+                );
+                at(&mut q, p.legs.iter().map(|&n| g.legs[n - 1].theta));
                 if !visit(&q, &standing) {
                     return;
                 }

@@ -290,7 +290,226 @@ impl Mechanism {
         self
     }
 
-    /// The paper's planar model: central body, legs 3 and 4 (docs/reference.md).
+    /// The mechanism of a robot model in the plane (`fbd_robot`: every
+    /// joint axis along `±Z`, every joint origin, centre of mass and
+    /// contact point at `z = 0`; e.g. the paper's planar model,
+    /// `fbd_robot::dh::planar`), with the contact points `contacts`
+    /// (indices into `robot.contacts`, in the order of their unknowns) as
+    /// contact points, under `gravity`. Its coordinates are `q = (Rx, Ry,
+    /// φz, θ per joint)`, the root's frame at `(Rx, Ry)` turned by `φz`.
+    ///
+    /// Each body's planar frame is an angle linear in `q` and an origin
+    /// point; each body's angle (of its rotation row) is its frame's,
+    /// projected on its joint's axis (the root's on `+Z`); a joint's
+    /// point is its origin; the points are named as the model names them
+    /// (a body's origin as its joint, or as the root body, its centre of
+    /// mass `{body}_com`, a contact point by its name). Angle offsets are
+    /// kept in `(−π, π]`, and within 1e-12 rad of a quarter turn they are
+    /// that quarter turn exactly; points at the same place of a body are
+    /// one point (a knee joint and a knee contact point), named by the
+    /// first. A joint named `theta{k}_{n}`, `hip{n}` (θ2) or `knee{n}`
+    /// (θ3) is that joint of leg `n`, a contact point named `tip{n}`
+    /// (`knee{n}`, `hip{n}`) that point of leg `n` (others: leg 0, `θ2`, a
+    /// tip).
+    ///
+    /// # Errors
+    /// A description of what is not in the plane.
+    pub fn in_plane(
+        robot: &fbd_robot::RobotModel,
+        contacts: &[usize],
+        gravity: f64,
+    ) -> Result<Self, String> {
+        use fbd_kinematics::planar::{LinearAngle, PHI_Z, PointDef};
+        use fbd_robot::nalgebra::Vector3;
+        const TOL: f64 = 1e-12;
+        let snap = |offset: f64| {
+            use std::f64::consts::{FRAC_PI_2, PI};
+            let mut a = offset;
+            if a > PI {
+                a -= 2.0 * PI;
+            } else if a <= -PI {
+                a += 2.0 * PI;
+            }
+            let k = (a / FRAC_PI_2).round();
+            if (a - k * FRAC_PI_2).abs() < TOL {
+                a = match k as i64 {
+                    0 => 0.0,
+                    1 => FRAC_PI_2,
+                    -1 => -FRAC_PI_2,
+                    _ => PI,
+                };
+            }
+            a
+        };
+        let in_plane = |what: &str, v: &Vector3<f64>| {
+            if v.z.abs() > TOL {
+                Err(format!("{what} is off the plane z = 0 (z = {:e})", v.z))
+            } else {
+                Ok(())
+            }
+        };
+        let mut angles: Vec<LinearAngle> = Vec::new();
+        // An angle's index, the same for equal angles.
+        fn intern(angles: &mut Vec<LinearAngle>, a: LinearAngle) -> usize {
+            match angles.iter().position(|b| *b == a) {
+                Some(i) => i,
+                None => {
+                    angles.push(a);
+                    angles.len() - 1
+                }
+            }
+        }
+        let mut points: Vec<PointDef> = Vec::new();
+        // A point's index, the same for the same segments.
+        fn place(points: &mut Vec<PointDef>, name: String, segments: Vec<(usize, f64)>) -> usize {
+            match points.iter().position(|p| p.segments == segments) {
+                Some(i) => i,
+                None => {
+                    points.push(PointDef { name, segments });
+                    points.len() - 1
+                }
+            }
+        }
+        let mut frame_angle: Vec<LinearAngle> = Vec::with_capacity(robot.bodies.len());
+        let mut mirror: Vec<f64> = Vec::with_capacity(robot.bodies.len());
+        let mut origin: Vec<Vec<(usize, f64)>> = Vec::with_capacity(robot.bodies.len());
+        // The segments of a point of a body: its frame's origin's (`base`),
+        // then `local` turned into the frame (`m = −1`: its z is −Z).
+        let segment = |angles: &mut Vec<LinearAngle>,
+                       frame: &LinearAngle,
+                       m: f64,
+                       base: &[(usize, f64)],
+                       local: &Vector3<f64>| {
+            let mut segs = base.to_vec();
+            let len = local.x.hypot(local.y);
+            if len > 0.0 {
+                let dir = (m * local.y + 0.0).atan2(local.x);
+                let a = LinearAngle {
+                    offset: snap(frame.offset + dir),
+                    terms: frame.terms.clone(),
+                };
+                segs.push((intern(angles, a), len));
+            }
+            segs
+        };
+        let nq = 3 + robot.joints.len();
+        let mut bodies = Vec::with_capacity(robot.bodies.len());
+        let mut joints = Vec::with_capacity(robot.joints.len());
+        for (b, body) in robot.bodies.iter().enumerate() {
+            let (frame, m, base, versor, name) = match body.joint {
+                None => {
+                    if b != 0 {
+                        return Err(format!("body {}: a second root", body.name));
+                    }
+                    let frame = LinearAngle {
+                        offset: 0.0,
+                        terms: vec![(PHI_Z, 1.0)],
+                    };
+                    (frame, 1.0, Vec::new(), 1.0, body.name.clone())
+                }
+                Some(j) => {
+                    let joint = &robot.joints[j];
+                    let p = joint.parent;
+                    let t = joint.origin.translation.vector;
+                    in_plane(&format!("joint {}'s origin", joint.name), &t)?;
+                    let r = joint.origin.rotation.to_rotation_matrix();
+                    let z = r.matrix().column(2).into_owned();
+                    if z.x.hypot(z.y) > TOL {
+                        return Err(format!(
+                            "joint {}'s frame is not turned about Z",
+                            joint.name
+                        ));
+                    }
+                    let axis = joint.axis.into_inner();
+                    if axis.x.hypot(axis.y) > TOL {
+                        return Err(format!("joint {}'s axis is not along Z", joint.name));
+                    }
+                    let (mp, fp) = (mirror[p], frame_angle[p].clone());
+                    let base = segment(&mut angles, &fp, mp, &origin[p], &t);
+                    let m = mp * z.z.signum();
+                    let beta = r.matrix()[(1, 0)].atan2(r.matrix()[(0, 0)]);
+                    let coef = m * axis.z.signum();
+                    let mut terms = fp.terms.clone();
+                    terms.push((3 + j, coef));
+                    let frame = LinearAngle {
+                        offset: snap(fp.offset + mp * beta),
+                        terms,
+                    };
+                    (frame, m, base, coef, joint.name.clone())
+                }
+            };
+            let origin_point = place(&mut points, name, base.clone());
+            in_plane(&format!("body {}'s centre of mass", body.name), &body.com)?;
+            let segs = segment(&mut angles, &frame, m, &base, &body.com);
+            let com = place(&mut points, format!("{}_com", body.name), segs);
+            bodies.push(BodySpec {
+                name: body.name.clone(),
+                mass: body.mass,
+                inertia: body.inertia[(2, 2)],
+                com,
+                angle: intern(&mut angles, frame.clone()),
+                versor_z: versor,
+            });
+            if let Some(j) = body.joint {
+                let joint = &robot.joints[j];
+                let (leg, kind) = leg_joint(&joint.name);
+                joints.push(JointSpec {
+                    name: joint.name.clone(),
+                    parent: joint.parent,
+                    child: b,
+                    point: origin_point,
+                    axis_z: versor,
+                    q_index: 3 + j,
+                    leg,
+                    joint: kind,
+                });
+            }
+            frame_angle.push(frame);
+            mirror.push(m);
+            origin.push(base);
+        }
+        let mut contact_point = Vec::with_capacity(robot.contacts.len());
+        for c in &robot.contacts {
+            in_plane(&format!("contact point {}", c.name), &c.position)?;
+            if c.radius != 0.0 {
+                return Err(format!(
+                    "contact point {}: a sphere (the plane has points)",
+                    c.name
+                ));
+            }
+            let segs = segment(
+                &mut angles,
+                &frame_angle[c.body],
+                mirror[c.body],
+                &origin[c.body],
+                &c.position,
+            );
+            contact_point.push(place(&mut points, c.name.clone(), segs));
+        }
+        let contacts = contacts
+            .iter()
+            .map(|&c| {
+                let point = &robot.contacts[c];
+                let (leg, kind) = leg_point(&point.name);
+                ContactSpec {
+                    name: point.name.clone(),
+                    leg,
+                    kind,
+                    body: point.body,
+                    point: contact_point[c],
+                }
+            })
+            .collect();
+        let chains = PlanarChains::new(nq, angles, points);
+        Ok(Self::new(chains, bodies, joints, contacts, gravity))
+    }
+
+    /// The paper's planar model written out by hand: central body, legs 3
+    /// and 4 (docs/reference.md). The runs build it as an instance of the
+    /// generic robot model in the plane ([`Mechanism::in_plane`] of
+    /// `fbd_robot::dh::planar`), which is this mechanism to the bit
+    /// (`crates/fbd/tests/planar_instance.rs`); this one is the tests'
+    /// reference.
     /// Bodies `[body, upper3, lower3, upper4, lower4]`; joints
     /// `[hip3, knee3, hip4, knee4]`; contacts in the order tips (3, 4), knees
     /// (3, 4), hips (3, 4) for those enabled.
@@ -405,4 +624,35 @@ impl Mechanism {
     pub fn point_columns(&self, p: usize) -> &[usize] {
         &self.point_cols[p]
     }
+}
+
+/// Leg `n` and joint `k` of a joint named `theta{k}_{n}`, `hip{n}` (θ2)
+/// or `knee{n}` (θ3) (leg 0, θ2 otherwise).
+fn leg_joint(name: &str) -> (usize, fbd_kinematics::Joint) {
+    use fbd_kinematics::Joint;
+    for (prefix, joint) in [("hip", Joint::Theta2), ("knee", Joint::Theta3)] {
+        if let Some(n) = name.strip_prefix(prefix).and_then(|n| n.parse().ok()) {
+            return (n, joint);
+        }
+    }
+    let parsed = name.strip_prefix("theta").and_then(|rest| {
+        let (k, n) = rest.split_once('_')?;
+        let joint = match k {
+            "1" => Joint::Theta1,
+            "2" => Joint::Theta2,
+            "3" => Joint::Theta3,
+            _ => return None,
+        };
+        Some((n.parse().ok()?, joint))
+    });
+    parsed.unwrap_or((0, Joint::Theta2))
+}
+
+/// Leg `n` and kind of a contact point named `tip{n}`, `knee{n}` or
+/// `hip{n}` (leg 0, a tip otherwise).
+fn leg_point(name: &str) -> (usize, PointKind) {
+    PointKind::ALL
+        .into_iter()
+        .find_map(|kind| Some((name.strip_prefix(kind.as_str())?.parse().ok()?, kind)))
+        .unwrap_or((0, PointKind::Tip))
 }

@@ -282,3 +282,138 @@ pub fn hexapod(
         .collect();
     model
 }
+
+/// Masses and inertias of the paper's planar model (as `[body]` and
+/// `[leg]` of a planar configuration): each body's inertia about `Z`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlanarMasses {
+    /// Central body mass (kg).
+    pub body_mass: f64,
+    /// Central body inertia about `Z` (kg·m²).
+    pub body_inertia: f64,
+    /// Upper link mass (kg).
+    pub upper_mass: f64,
+    /// Upper link inertia about `Z` at its centre of mass (kg·m²).
+    pub upper_inertia: f64,
+    /// Lower link mass (kg).
+    pub lower_mass: f64,
+    /// Lower link inertia about `Z` at its centre of mass (kg·m²).
+    pub lower_inertia: f64,
+}
+
+/// The paper's planar model (its legs 3 and 4 in the `X–Y` plane, θ1 = 0)
+/// as a [`RobotModel`] in the plane: every joint axis along `±Z`, every
+/// frame origin, centre of mass and point at `z = 0`, so that it is
+/// stepped by the planar FBD equations (`fbd_dynamics::Mechanism::in_plane`).
+///
+/// The central body `body` (its frame at its centre of mass); per leg `n`
+/// (3 and 4, on the side `s = −1`, `+1` of the body: the hip at
+/// `(s·d, 0, 0)`) the joints `hip{n}` (θ2) and `knee{n}` (θ3), named as
+/// the planar run's columns name them (`hip3_fx`, `tau_hip3`, …), each
+/// about `Z·(−s)` (leg 3's axes `+Z`, leg 4's `−Z`, paper §5.2), and the
+/// links `upper{n}` and `lower{n}`, each with its frame's `x` along the
+/// link (hip → knee, knee → tip: their angles are the links' absolute
+/// angles) and its centre of mass on it; the points `tip{n}` (the lower
+/// link's end), `knee{n}` and `hip{n}` (on the central body). Each body's
+/// inertia tensor is isotropic with the planar value (only its `Z` part
+/// acts in the plane).
+pub fn planar(
+    geometry: &fbd_kinematics::planar::PlanarGeometry,
+    masses: &PlanarMasses,
+) -> RobotModel {
+    use fbd_kinematics::planar::{hexapod_leg_number, side_sign};
+    use std::f64::consts::PI;
+    let iso = |m: f64, com: Vector3<f64>, i: f64, name: String| Body {
+        name,
+        mass: m,
+        com,
+        inertia: Matrix3::from_diagonal_element(i),
+        joint: None,
+    };
+    let mut model = RobotModel {
+        name: "planar".to_owned(),
+        bodies: vec![iso(
+            masses.body_mass,
+            Vector3::zeros(),
+            masses.body_inertia,
+            "body".to_owned(),
+        )],
+        joints: Vec::new(),
+        contacts: Vec::new(),
+        actuators: Vec::new(),
+    };
+    let g = geometry;
+    let turn = |angle: f64| {
+        Isometry3::from_parts(
+            Translation3::identity(),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), angle),
+        )
+    };
+    for leg in 0..2 {
+        let (s, n) = (side_sign(leg), hexapod_leg_number(leg));
+        let axis = Unit::new_normalize(Vector3::new(0.0, 0.0, -s));
+        // The upper link's x along hip → knee at θ2 = 0 (outwards), the
+        // lower link's along knee → tip (turned back by π from it).
+        let hip = Translation3::new(s * g.d, 0.0, 0.0) * turn(if s < 0.0 { PI } else { 0.0 });
+        let knee = Translation3::new(g.a, 0.0, 0.0) * turn(PI);
+        let upper = model.bodies.len();
+        for (joint, parent, origin, body) in [
+            (
+                format!("hip{n}"),
+                0,
+                hip,
+                iso(
+                    masses.upper_mass,
+                    Vector3::new(g.a * g.upper_com, 0.0, 0.0),
+                    masses.upper_inertia,
+                    format!("upper{n}"),
+                ),
+            ),
+            (
+                format!("knee{n}"),
+                upper,
+                knee,
+                iso(
+                    masses.lower_mass,
+                    Vector3::new(g.c * g.lower_com, 0.0, 0.0),
+                    masses.lower_inertia,
+                    format!("lower{n}"),
+                ),
+            ),
+        ] {
+            model.joints.push(Joint {
+                name: joint,
+                parent,
+                child: model.bodies.len(),
+                origin,
+                axis,
+                limits: None,
+                effort: None,
+                velocity: None,
+            });
+            model.bodies.push(Body {
+                joint: Some(model.joints.len() - 1),
+                ..body
+            });
+        }
+        let point = |name: String, body: usize, position: Vector3<f64>| ContactPoint {
+            name,
+            body,
+            position,
+            radius: 0.0,
+        };
+        model.contacts.extend([
+            point(format!("tip{n}"), upper + 1, Vector3::new(g.c, 0.0, 0.0)),
+            point(format!("knee{n}"), upper + 1, Vector3::zeros()),
+            point(format!("hip{n}"), 0, Vector3::new(s * g.d, 0.0, 0.0)),
+        ]);
+    }
+    model.actuators = (0..model.joints.len())
+        .map(|j| Actuator {
+            name: model.joints[j].name.clone(),
+            joint: j,
+            effort_limit: None,
+        })
+        .collect();
+    model
+}

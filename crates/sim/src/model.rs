@@ -5,9 +5,9 @@ use crate::joint_inertia::{fastest_mode, planar_feet_jacobian, planar_mass_matri
 use crate::rules::{check, positive};
 use crate::{PlanarParams, SimError};
 use fbd_contact::{ContactParams, ContactState};
-use fbd_dynamics::{Mechanism, PointKind, TwoLegInertia};
+use fbd_dynamics::{Mechanism, PointKind};
 use fbd_kinematics::Joint;
-use fbd_kinematics::planar::{PlanarGeometry, TwoLegIndex, theta2_index, theta3_index};
+use fbd_kinematics::planar::{TwoLegIndex, theta2_index, theta3_index};
 use fbd_solver::NewtonParams;
 
 /// Everything fixed during a run: parameters, mechanism, tolerances.
@@ -179,6 +179,47 @@ impl PlanarParams {
     }
 }
 
+/// The named angles and points of the two-leg model in its mechanism's
+/// kinematics ([`Mechanism::in_plane`] of `fbd_robot::dh::planar`): its
+/// bodies' angles and centres of mass, its joints' points, and the feet
+/// (contact points of the model, named `tip{n}`, whether or not they are
+/// contact points of the run).
+fn two_leg_index(mech: &Mechanism) -> TwoLegIndex {
+    let body = |name: String| {
+        mech.bodies
+            .iter()
+            .find(|b| b.name == name)
+            .expect("a body of the planar model")
+    };
+    let joint = |name: String| {
+        mech.joints
+            .iter()
+            .find(|j| j.name == name)
+            .expect("a joint of the planar model")
+            .point
+    };
+    let tip = |n: usize| {
+        let name = format!("tip{n}");
+        mech.chains
+            .points
+            .iter()
+            .position(|p| p.name == name)
+            .expect("a foot of the planar model")
+    };
+    let legs = |f: &dyn Fn(usize) -> usize| [f(3), f(4)];
+    TwoLegIndex {
+        body_angle: mech.bodies[0].angle,
+        upper_angle: legs(&|n| body(format!("upper{n}")).angle),
+        lower_angle: legs(&|n| body(format!("lower{n}")).angle),
+        hip: legs(&|n| joint(format!("hip{n}"))),
+        knee: legs(&|n| joint(format!("knee{n}"))),
+        tip: legs(&tip),
+        upper_com: legs(&|n| body(format!("upper{n}")).com),
+        lower_com: legs(&|n| body(format!("lower{n}")).com),
+        body_com: mech.bodies[0].com,
+    }
+}
+
 impl Model {
     /// Validates `params` and builds the model. Errors name the
     /// configuration key at fault.
@@ -187,22 +228,25 @@ impl Model {
         p.validate()?;
         let steps_f = (p.duration / p.dt).round();
 
-        let geometry = PlanarGeometry {
-            d: p.side * (std::f64::consts::PI / 6.0).cos(),
-            a: p.upper_length,
-            c: p.lower_length,
-            upper_com: p.upper_com,
-            lower_com: p.lower_com,
-        };
-        let inertia = TwoLegInertia {
-            body_mass: p.body_mass,
-            body_inertia: p.body_inertia,
-            upper_mass: p.upper_mass,
-            upper_inertia: p.upper_inertia,
-            lower_mass: p.lower_mass,
-            lower_inertia: p.lower_inertia,
-        };
-        let (mech, index) = Mechanism::two_leg(&geometry, &inertia, p.gravity, p.contact_points);
+        let robot = p.robot_model();
+        let cp = p.contact_points;
+        let contacts: Vec<usize> = fbd_dynamics::tree::contacts_by_kind(&robot)
+            .into_iter()
+            .filter(|&c| {
+                let kind = PointKind::ALL
+                    .into_iter()
+                    .find(|k| robot.contacts[c].name.starts_with(k.as_str()));
+                match kind {
+                    Some(PointKind::Tip) => cp.tips,
+                    Some(PointKind::Knee) => cp.knees,
+                    Some(PointKind::Hip) => cp.hips,
+                    None => false,
+                }
+            })
+            .collect();
+        let mech = Mechanism::in_plane(&robot, &contacts, p.gravity)
+            .expect("the planar model lies in the plane");
+        let index = two_leg_index(&mech);
         check(
             p.joint_limits.is_valid(),
             "leg.theta2_deg",

@@ -113,17 +113,40 @@ impl Default for PlanarParams {
 }
 
 impl PlanarParams {
-    /// Height (m) of the lowest contact point of the initial configuration
-    /// above the terrain under it (negative when below).
-    pub fn lowest_clearance(&self) -> f64 {
-        let geometry = fbd_kinematics::planar::PlanarGeometry {
+    /// The planar model of these parameters as an instance of the generic
+    /// robot model in the plane (`fbd_robot::dh::planar`: its D-H rows of
+    /// legs 3 and 4 at θ1 = 0, the masses and inertias about `Z`), which
+    /// the planar engine steps (`fbd_dynamics::Mechanism::in_plane`).
+    pub fn robot_model(&self) -> fbd_robot::RobotModel {
+        fbd_robot::dh::planar(
+            &self.geometry(),
+            &fbd_robot::dh::PlanarMasses {
+                body_mass: self.body_mass,
+                body_inertia: self.body_inertia,
+                upper_mass: self.upper_mass,
+                upper_inertia: self.upper_inertia,
+                lower_mass: self.lower_mass,
+                lower_inertia: self.lower_inertia,
+            },
+        )
+    }
+
+    /// The two-leg geometry: `d = side·cos 30°` from the body centre to
+    /// each hip, the link lengths and their centres of mass.
+    pub fn geometry(&self) -> fbd_kinematics::planar::PlanarGeometry {
+        fbd_kinematics::planar::PlanarGeometry {
             d: self.side * (std::f64::consts::PI / 6.0).cos(),
             a: self.upper_length,
             c: self.lower_length,
             upper_com: self.upper_com,
             lower_com: self.lower_com,
-        };
-        let (chains, ix) = fbd_kinematics::planar::PlanarChains::two_leg(&geometry);
+        }
+    }
+
+    /// Height (m) of the lowest contact point of the initial configuration
+    /// above the terrain under it (negative when below).
+    pub fn lowest_clearance(&self) -> f64 {
+        let (chains, ix) = fbd_kinematics::planar::PlanarChains::two_leg(&self.geometry());
         let mut kin = chains.new_data();
         chains.eval_positions(&self.q0, &mut kin);
         let cp = self.contact_points;

@@ -63,15 +63,16 @@ impl<'a> PlanarScene<'a> {
         let mut lines = Vec::new();
         for leg in 0..2 {
             let base = drawn.len();
-            for p in [
-                ix.hip[leg],
-                ix.knee[leg],
-                ix.tip[leg],
-                ix.upper_com[leg],
-                ix.lower_com[leg],
+            let n = leg + 3;
+            for (p, name) in [
+                (ix.hip[leg], format!("hip{n}")),
+                (ix.knee[leg], format!("knee{n}")),
+                (ix.tip[leg], format!("tip{n}")),
+                (ix.upper_com[leg], format!("upper_com{n}")),
+                (ix.lower_com[leg], format!("lower_com{n}")),
             ] {
                 drawn.push(p);
-                names.push(chains.points[p].name.clone());
+                names.push(name);
             }
             lines.push(Line {
                 a: base,

@@ -99,6 +99,7 @@ pub fn half_momentum_value(
 }
 
 /// [`half_momentum_value`] and the step's rotation `ψ` it is made of.
+#[inline]
 pub fn half_momentum_and_rotation(
     r_k: &Matrix3<f64>,
     r_next: &Matrix3<f64>,

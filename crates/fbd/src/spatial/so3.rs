@@ -54,6 +54,7 @@ pub fn rotate(phi: &Vector3<f64>, v: &Vector3<f64>) -> Vector3<f64> {
 
 /// `log(R)`: the rotation vector of `r` (angle in `[0, π)`; accurate for
 /// small angles, where it is taken from the skew part).
+#[inline]
 pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
     // v = sin θ · axis, cos θ from the trace.
     let v = 0.5

@@ -377,6 +377,7 @@ impl FbdModel for TreeMechanism {
 
     /// `(c·L[k+½] − L[k−½])/Δt` ([`crate::spatial::half_momentum`]); with `jacobian`, its
     /// derivative for [`FbdModel::rotation_entries`].
+    #[inline]
     fn angular_rate(&self, data: &mut TreeFbdData, b: usize, jacobian: bool) -> [f64; 3] {
         let bs = data.body[b];
         let body = &self.bodies[b];
@@ -404,6 +405,7 @@ impl FbdModel for TreeMechanism {
     /// Reaction `i` at k: the force at its first joint's origin, its
     /// constraint moments ([`TreeFbdData::moment_dir`]) and the actuator
     /// torques `Σ τ_j·u_j` of its joints.
+    #[inline]
     fn reaction(&self, data: &TreeFbdData, i: usize) -> Reaction<Space3> {
         let re = &self.reactions[i];
         let mut torque = Vector3::zeros();

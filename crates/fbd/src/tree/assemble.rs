@@ -54,6 +54,10 @@ pub struct TreeFbdData {
     /// joint: `u1 × u2` normalised, the second unused; a single joint:
     /// `b1`, `b2 = u × b1` across its axis `u`).
     pub moment_dir: Vec<[Vector3<f64>; 2]>,
+    /// Per reaction, [`FbdModel::reaction`] at k but for its actuator
+    /// torque (zero here): the columns and bodies from the mechanism, the
+    /// point and constraint-moment directions made by [`prepare_step`].
+    reaction_k: Vec<Reaction<Space3>>,
     /// Per FBD body, `L[k+½]` at the last evaluated iterate.
     pub l_next: Vec<Vector3<f64>>,
     /// Per FBD body, the rotation `ψ[k+½]` of `l_next`.
@@ -123,6 +127,9 @@ impl TreeFbdData {
             position_gain: 0.0,
             limit_gain: 0.0,
             moment_dir: vec![[Vector3::zeros(); 2]; mech.reactions.len()],
+            reaction_k: (0..mech.reactions.len())
+                .map(|i| reaction_layout(mech, i))
+                .collect(),
             l_next: vec![Vector3::zeros(); nb],
             psi_next: vec![Vector3::zeros(); nb],
             l_next_fresh: vec![false; nb],
@@ -198,6 +205,26 @@ fn moment_directions(mech: &TreeMechanism, kin: &TreeKin, i: usize) -> [Vector3<
     [b1, u.cross(&b1)]
 }
 
+/// Reaction `i`'s bodies, force column and constraint-moment columns, its
+/// point, directions and torque zero.
+fn reaction_layout(mech: &TreeMechanism, i: usize) -> Reaction<Space3> {
+    let re = &mech.reactions[i];
+    let m1 = (mech.reaction_moment(i, 0), [0.0; 3]);
+    Reaction {
+        child: re.child,
+        parent: re.parent,
+        point: [0.0; 3],
+        force_col: mech.reaction_force(i, 0),
+        torque: [0.0; 3],
+        moments: if re.compound {
+            [m1, (0, [0.0; 3])]
+        } else {
+            [m1, (mech.reaction_moment(i, 1), [0.0; 3])]
+        },
+        n_moments: re.moments(),
+    }
+}
+
 /// Stage "kinematics at k": every body's constants and the constraint
 /// directions of this step, given `q[k]` (and `q[k−1]`) already set.
 pub fn prepare_step(mech: &TreeMechanism, data: &mut TreeFbdData, history: History<'_>, dt: f64) {
@@ -241,8 +268,15 @@ pub fn prepare_step(mech: &TreeMechanism, data: &mut TreeFbdData, history: Histo
             }
         };
     }
-    for i in 0..mech.reactions.len() {
-        data.moment_dir[i] = moment_directions(mech, &data.kin, i);
+    for (i, re) in mech.reactions.iter().enumerate() {
+        let [d1, d2] = moment_directions(mech, &data.kin, i);
+        data.moment_dir[i] = [d1, d2];
+        let r = &mut data.reaction_k[i];
+        r.point = data.kin.joint_origin[re.joints[0]].into();
+        r.moments[0].1 = d1.into();
+        if !re.compound {
+            r.moments[1].1 = d2.into();
+        }
     }
 }
 
@@ -403,29 +437,18 @@ impl FbdModel for TreeMechanism {
     }
 
     /// Reaction `i` at k: the force at its first joint's origin, its
-    /// constraint moments ([`TreeFbdData::moment_dir`]) and the actuator
-    /// torques `Σ τ_j·u_j` of its joints.
+    /// constraint moments ([`TreeFbdData::moment_dir`]), both kept by
+    /// [`prepare_step`], and the actuator torques `Σ τ_j·u_j` of its joints
+    /// (the torques as they are now).
     #[inline]
     fn reaction(&self, data: &TreeFbdData, i: usize) -> Reaction<Space3> {
-        let re = &self.reactions[i];
         let mut torque = Vector3::zeros();
-        for &j in re.joint_list() {
+        for &j in self.reactions[i].joint_list() {
             torque += data.torque[j] * data.kin.axis[j];
         }
-        let [d1, d2] = data.moment_dir[i];
-        let m1 = (self.reaction_moment(i, 0), d1.into());
         Reaction {
-            child: re.child,
-            parent: re.parent,
-            point: data.kin.joint_origin[re.joints[0]].into(),
-            force_col: self.reaction_force(i, 0),
             torque: torque.into(),
-            moments: if re.compound {
-                [m1, (0, [0.0; 3])]
-            } else {
-                [m1, (self.reaction_moment(i, 1), d2.into())]
-            },
-            n_moments: re.moments(),
+            ..data.reaction_k[i]
         }
     }
 

@@ -458,12 +458,13 @@ fn body_rows<M: FbdModel>(
         let mass = model.mass(b);
         let row = dims.body_row(b);
         let w = model.wrenches(data)[b];
-        for i in 0..M::S::LIN {
-            r[row + i] = mass * bs.acceleration(i, x.as_ref()[i], inv_dt2) - w.force.as_ref()[i];
+        let (lin, ang) = r[row..row + M::S::LIN + M::S::ANG].split_at_mut(M::S::LIN);
+        for (i, ri) in lin.iter_mut().enumerate() {
+            *ri = mass * bs.acceleration(i, x.as_ref()[i], inv_dt2) - w.force.as_ref()[i];
         }
         let p = model.rotation_projection(b);
-        for i in 0..M::S::ANG {
-            r[row + M::S::LIN + i] = p * (rate.as_ref()[i] - w.moment.as_ref()[i]);
+        for (i, ri) in ang.iter_mut().enumerate() {
+            *ri = p * (rate.as_ref()[i] - w.moment.as_ref()[i]);
         }
     }
 }

@@ -58,6 +58,8 @@ pub struct TreeFbdData {
     /// torque (zero here): the columns and bodies from the mechanism, the
     /// point and constraint-moment directions made by [`prepare_step`].
     reaction_k: Vec<Reaction<Space3>>,
+    /// Per stop, its bodies and joint from the mechanism, in one place.
+    stop_k: Vec<StopK>,
     /// Per FBD body, `L[k+½]` at the last evaluated iterate.
     pub l_next: Vec<Vector3<f64>>,
     /// Per FBD body, the rotation `ψ[k+½]` of `l_next`.
@@ -129,6 +131,19 @@ impl TreeFbdData {
             moment_dir: vec![[Vector3::zeros(); 2]; mech.reactions.len()],
             reaction_k: (0..mech.reactions.len())
                 .map(|i| reaction_layout(mech, i))
+                .collect(),
+            stop_k: mech
+                .limits
+                .iter()
+                .map(|lim| {
+                    let re = &mech.reactions[lim.reaction];
+                    StopK {
+                        child: re.child,
+                        parent: re.parent,
+                        q_index: lim.q_index,
+                        joint: lim.joint,
+                    }
+                })
                 .collect(),
             l_next: vec![Vector3::zeros(); nb],
             psi_next: vec![Vector3::zeros(); nb],
@@ -203,6 +218,15 @@ fn moment_directions(mech: &TreeMechanism, kin: &TreeKin, i: usize) -> [Vector3<
         (e - u * u.dot(&e)).normalize()
     };
     [b1, u.cross(&b1)]
+}
+
+/// A stop's bodies (its reaction's), joint angle index and joint.
+#[derive(Clone, Copy, Debug)]
+struct StopK {
+    child: usize,
+    parent: usize,
+    q_index: usize,
+    joint: usize,
 }
 
 /// Reaction `i`'s bodies, force column and constraint-moment columns, its
@@ -489,13 +513,12 @@ impl FbdModel for TreeMechanism {
 
     #[inline]
     fn stop<'a>(&self, data: &'a TreeFbdData, l: usize) -> StopView<'a, Space3> {
-        let lim = &self.limits[l];
-        let re = &self.reactions[lim.reaction];
+        let stop = &data.stop_k[l];
         StopView {
-            child: re.child,
-            parent: re.parent,
-            axis: data.kin.axis[lim.joint].into(),
-            q_index: lim.q_index,
+            child: stop.child,
+            parent: stop.parent,
+            axis: data.kin.axis[stop.joint].into(),
+            q_index: stop.q_index,
             equation: &data.limit[l],
         }
     }

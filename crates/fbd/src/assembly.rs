@@ -355,12 +355,13 @@ pub fn eval<M: FbdModel, J: JacobianSink>(
     loads(model, &dims, data, z);
     body_rows(model, &dims, data, r, J::ACTIVE);
     contact_rows(model, &dims, ground, data, z, r);
-    for l in 0..dims.limits {
+    let limit_gain = model.gains(data).2;
+    let lambdas = &z[dims.limit_moment(0)..][..dims.limits];
+    let limit_rows = &mut r[dims.limit_row(0)..][..dims.limits];
+    for (l, (&lambda, row)) in lambdas.iter().zip(limit_rows).enumerate() {
         let stop = model.stop(data, l);
-        let lambda = z[dims.limit_moment(l)];
-        let (v, unloaded) =
-            rows::limit_row(stop.equation, lambda, z[stop.q_index], model.gains(data).2);
-        r[dims.limit_row(l)] = v;
+        let (v, unloaded) = rows::limit_row(stop.equation, lambda, z[stop.q_index], limit_gain);
+        *row = v;
         model.set_limit_unloaded(data, l, unloaded);
     }
     if J::ACTIVE {

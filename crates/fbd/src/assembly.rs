@@ -405,9 +405,13 @@ fn loads<M: FbdModel>(model: &M, dims: &Dims, data: &mut M::Data, z: &[f64]) {
         f.as_mut()
             .copy_from_slice(&z[re.force_col..re.force_col + M::S::LIN]);
         let mut m = re.torque;
-        for &(col, dir) in &re.moments[..re.n_moments] {
-            for (mi, di) in m.as_mut().iter_mut().zip(dir.as_ref()) {
-                *mi += z[col] * di;
+        // Both slots, the unused one skipped: no slice of a length known
+        // only at run time, so that the reaction can stay in registers.
+        for (k, &(col, dir)) in re.moments.iter().enumerate() {
+            if k < re.n_moments {
+                for (mi, di) in m.as_mut().iter_mut().zip(dir.as_ref()) {
+                    *mi += z[col] * di;
+                }
             }
         }
         for (b, sgn) in [(re.child, 1.0), (re.parent, -1.0)] {

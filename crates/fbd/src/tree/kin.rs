@@ -102,10 +102,50 @@ enum FixedRotation {
     Identity,
     /// `O` a signed permutation (to 1e-15; a D-H `α` of ±90°, an axis
     /// swap): column `i` of `F` is `sign[i]` times column `from[i]` of
-    /// `R_parent`.
-    Permutation { from: [usize; 3], sign: [f64; 3] },
+    /// `R_parent`, `from` one of the six orders ([`Order`]).
+    Permutation { from: Order, sign: [f64; 3] },
     /// Any other rotation.
     General(Matrix3<f64>),
+}
+
+/// The order `from` of a [`FixedRotation::Permutation`]'s columns, named so
+/// that [`FixedRotation::apply`] reads them at fixed places.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Order {
+    O012,
+    O021,
+    O102,
+    O120,
+    O201,
+    O210,
+}
+
+impl Order {
+    fn of(from: [usize; 3]) -> Option<Self> {
+        Some(match from {
+            [0, 1, 2] => Self::O012,
+            [0, 2, 1] => Self::O021,
+            [1, 0, 2] => Self::O102,
+            [1, 2, 0] => Self::O120,
+            [2, 0, 1] => Self::O201,
+            [2, 1, 0] => Self::O210,
+            _ => return None,
+        })
+    }
+
+    /// The columns `(a[from[0]], a[from[1]], a[from[2]])`.
+    #[inline]
+    fn pick<T: Copy>(self, a: [T; 3]) -> [T; 3] {
+        let [x, y, z] = a;
+        match self {
+            Self::O012 => [x, y, z],
+            Self::O021 => [x, z, y],
+            Self::O102 => [y, x, z],
+            Self::O120 => [y, z, x],
+            Self::O201 => [z, x, y],
+            Self::O210 => [z, y, x],
+        }
+    }
 }
 
 impl FixedRotation {
@@ -124,10 +164,10 @@ impl FixedRotation {
             from[i] = k;
             sign[i] = col[k].signum();
         }
-        if from == [0, 1, 2] && sign == [1.0; 3] {
-            Self::Identity
-        } else {
-            Self::Permutation { from, sign }
+        match Order::of(from) {
+            Some(Order::O012) if sign == [1.0; 3] => Self::Identity,
+            Some(from) => Self::Permutation { from, sign },
+            None => Self::General(*r),
         }
     }
 
@@ -136,11 +176,14 @@ impl FixedRotation {
     fn apply(&self, rp: &Matrix3<f64>) -> Matrix3<f64> {
         match self {
             Self::Identity => *rp,
-            Self::Permutation { from, sign } => Matrix3::from_columns(&[
-                sign[0] * rp.column(from[0]),
-                sign[1] * rp.column(from[1]),
-                sign[2] * rp.column(from[2]),
-            ]),
+            Self::Permutation { from, sign } => {
+                let [a, b, c] = from.pick([
+                    rp.column(0).into_owned(),
+                    rp.column(1).into_owned(),
+                    rp.column(2).into_owned(),
+                ]);
+                Matrix3::from_columns(&[sign[0] * a, sign[1] * b, sign[2] * c])
+            }
             Self::General(r) => rp * r,
         }
     }

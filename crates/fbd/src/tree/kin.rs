@@ -82,6 +82,11 @@ pub struct TreeKin {
     body_com: Vec<Vector3<f64>>,
     /// Each contact point's position in its body's frame (from the model).
     contact_local: Vec<Vector3<f64>>,
+    /// Scratch of [`Self::eval`]: per joint, the sine and cosine of its
+    /// angle times its [`JointConst::angle_sign`], all taken before the
+    /// frames are placed (no library call among them, whose registers
+    /// would have to be saved).
+    sin_cos: Vec<(f64, f64)>,
 }
 
 /// The axis of a joint in its child's frame, as the rotation about it is
@@ -227,14 +232,24 @@ impl JointConst {
         }
     }
 
+    /// The factor of the joint angle whose sine and cosine [`Self::turn`]
+    /// takes: the sign of a coordinate axis, 1 for any other.
+    #[inline]
+    fn angle_sign(&self) -> f64 {
+        match self.axis {
+            AxisKind::Coordinate { sign, .. } => sign,
+            AxisKind::General(_) => 1.0,
+        }
+    }
+
     /// The child's rotation `F·T(θ)` and the joint's axis `F·u`, with
     /// `F` the parent's rotation times the fixed origin rotation and
-    /// `T(θ)` the turn by `θ` about `u`.
+    /// `T(θ)` the turn by `θ` about `u`, given `(s, c)` the sine and cosine
+    /// of `θ` times [`Self::angle_sign`].
     #[inline]
-    fn turn(&self, f: &Matrix3<f64>, theta: f64) -> (Matrix3<f64>, Vector3<f64>) {
+    fn turn(&self, f: &Matrix3<f64>, (s, c): (f64, f64)) -> (Matrix3<f64>, Vector3<f64>) {
         match self.axis {
             AxisKind::Coordinate { k, sign } => {
-                let (s, c) = (sign * theta).sin_cos();
                 // T turns column a towards column b, (a, b, k) cyclic; the
                 // columns are named, not indexed, so that the result stays
                 // in registers.
@@ -261,7 +276,6 @@ impl JointConst {
                 (Matrix3::from_columns(&cols), sign * axis)
             }
             AxisKind::General(u) => {
-                let (s, c) = theta.sin_cos();
                 let k = u.cross_matrix();
                 let t = Matrix3::identity() + s * k + (1.0 - c) * (k * k);
                 (f * t, f * u)
@@ -333,6 +347,7 @@ impl TreeKin {
             joints: model.joints.iter().map(JointConst::of).collect(),
             body_com: model.bodies.iter().map(|b| b.com).collect(),
             contact_local: model.contacts.iter().map(|c| c.position).collect(),
+            sin_cos: vec![(0.0, 1.0); nj],
         }
     }
 
@@ -378,16 +393,24 @@ impl TreeKin {
         ];
         self.origin[0] = pose.position;
         self.rotation[0] = rot;
-        for ((jc, &theta), (axis, joint_origin)) in self
+        for ((sc, jc), &theta) in self
+            .sin_cos
+            .iter_mut()
+            .zip(&self.joints)
+            .zip(&q[BASE_DOF..])
+        {
+            *sc = (jc.angle_sign() * theta).sin_cos();
+        }
+        for ((jc, &sc), (axis, joint_origin)) in self
             .joints
             .iter()
-            .zip(&q[BASE_DOF..])
+            .zip(&self.sin_cos)
             .zip(self.axis.iter_mut().zip(self.joint_origin.iter_mut()))
         {
             let (p, c) = (jc.parent, jc.child);
             let rp = &self.rotation[p];
             let o = self.origin[p] + rp * jc.translation;
-            let (rc, u) = jc.turn(&jc.rotation.apply(rp), theta);
+            let (rc, u) = jc.turn(&jc.rotation.apply(rp), sc);
             self.rotation[c] = rc;
             self.origin[c] = o;
             *axis = u;

@@ -612,9 +612,11 @@ fn force_entries<M: FbdModel, J: JacobianSink>(
                 jac.add(row + a, re.force_col + a, -sgn);
             }
             M::S::moment_arm_entries(jac, row + lin, re.force_col, &r, scale);
-            for &(col, dir) in &re.moments[..re.n_moments] {
-                for a in 0..ang {
-                    jac.add(row + lin + a, col, -scale * dir.as_ref()[a]);
+            for (k, &(col, dir)) in re.moments.iter().enumerate() {
+                if k < re.n_moments {
+                    for a in 0..ang {
+                        jac.add(row + lin + a, col, -scale * dir.as_ref()[a]);
+                    }
                 }
             }
         }

@@ -527,12 +527,13 @@ pub fn eval<M: FbdModel, J: JacobianSink>(
     loads(model, &dims, data, z);
     body_rows(model, &dims, data, r, J::ACTIVE);
     contact_rows(model, &dims, ground, data, z, r);
-    for l in 0..dims.limits {
+    let limit_gain = model.gains(data).2;
+    let lambdas = &z[dims.limit_moment(0)..][..dims.limits];
+    let limit_rows = &mut r[dims.limit_row(0)..][..dims.limits];
+    for (l, (&lambda, row)) in lambdas.iter().zip(limit_rows).enumerate() {
         let stop = model.stop(data, l);
-        let lambda = z[dims.limit_moment(l)];
-        let (v, unloaded) =
-            rows::limit_row(stop.equation, lambda, z[stop.q_index], model.gains(data).2);
-        r[dims.limit_row(l)] = v;
+        let (v, unloaded) = rows::limit_row(stop.equation, lambda, z[stop.q_index], limit_gain);
+        *row = v;
         model.set_limit_unloaded(data, l, unloaded);
     }
     if J::ACTIVE {
@@ -576,9 +577,13 @@ fn loads<M: FbdModel>(model: &M, dims: &Dims, data: &mut M::Data, z: &[f64]) {
         f.as_mut()
             .copy_from_slice(&z[re.force_col..re.force_col + M::S::LIN]);
         let mut m = re.torque;
-        for &(col, dir) in &re.moments[..re.n_moments] {
-            for (mi, di) in m.as_mut().iter_mut().zip(dir.as_ref()) {
-                *mi += z[col] * di;
+        // Both slots, the unused one skipped: no slice of a length known
+        // only at run time, so that the reaction can stay in registers.
+        for (k, &(col, dir)) in re.moments.iter().enumerate() {
+            if k < re.n_moments {
+                for (mi, di) in m.as_mut().iter_mut().zip(dir.as_ref()) {
+                    *mi += z[col] * di;
+                }
             }
         }
         for (b, sgn) in [(re.child, 1.0), (re.parent, -1.0)] {
@@ -630,12 +635,13 @@ fn body_rows<M: FbdModel>(
         let mass = model.mass(b);
         let row = dims.body_row(b);
         let w = model.wrenches(data)[b];
-        for i in 0..M::S::LIN {
-            r[row + i] = mass * bs.acceleration(i, x.as_ref()[i], inv_dt2) - w.force.as_ref()[i];
+        let (lin, ang) = r[row..row + M::S::LIN + M::S::ANG].split_at_mut(M::S::LIN);
+        for (i, ri) in lin.iter_mut().enumerate() {
+            *ri = mass * bs.acceleration(i, x.as_ref()[i], inv_dt2) - w.force.as_ref()[i];
         }
         let p = model.rotation_projection(b);
-        for i in 0..M::S::ANG {
-            r[row + M::S::LIN + i] = p * (rate.as_ref()[i] - w.moment.as_ref()[i]);
+        for (i, ri) in ang.iter_mut().enumerate() {
+            *ri = p * (rate.as_ref()[i] - w.moment.as_ref()[i]);
         }
     }
 }
@@ -778,9 +784,11 @@ fn force_entries<M: FbdModel, J: JacobianSink>(
                 jac.add(row + a, re.force_col + a, -sgn);
             }
             M::S::moment_arm_entries(jac, row + lin, re.force_col, &r, scale);
-            for &(col, dir) in &re.moments[..re.n_moments] {
-                for a in 0..ang {
-                    jac.add(row + lin + a, col, -scale * dir.as_ref()[a]);
+            for (k, &(col, dir)) in re.moments.iter().enumerate() {
+                if k < re.n_moments {
+                    for a in 0..ang {
+                        jac.add(row + lin + a, col, -scale * dir.as_ref()[a]);
+                    }
                 }
             }
         }

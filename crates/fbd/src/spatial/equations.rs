@@ -55,6 +55,26 @@ impl Default for SpatialContactEquation {
 /// `ang` the momentum's (`L[k−½]`, or `2·L(0)` at k = 0).
 pub type BodyStep3 = BodyStep<Space3>;
 
+/// `aᵀ·b`, every entry summed as nalgebra's product sums it,
+/// `(a₀ᵢ·b₀ⱼ + a₁ᵢ·b₁ⱼ) + a₂ᵢ·b₂ⱼ`: bit for bit `a.transpose() * b`, with
+/// neither the transposed copy nor the product's shuffles.
+#[inline]
+fn tr_mul(a: &Matrix3<f64>, b: &Matrix3<f64>) -> Matrix3<f64> {
+    let d =
+        |i: usize, j: usize| a[(0, i)] * b[(0, j)] + a[(1, i)] * b[(1, j)] + a[(2, i)] * b[(2, j)];
+    Matrix3::new(
+        d(0, 0),
+        d(0, 1),
+        d(0, 2),
+        d(1, 0),
+        d(1, 1),
+        d(1, 2),
+        d(2, 0),
+        d(2, 1),
+        d(2, 2),
+    )
+}
+
 /// The discrete angular momentum of a body over a step (inertial frame):
 /// `L = R[k]·exp(ψ/2)·I·ψ/Δt` with `ψ = log(R[k]ᵀ·R[k+1])`, and its
 /// derivative `∂L/∂η` for a spatial perturbation `R[k+1] → exp([η]×)·R[k+1]`.
@@ -75,7 +95,7 @@ pub fn half_momentum_derivative_and_rotation(
     inertia: &Matrix3<f64>,
     dt: f64,
 ) -> (Vector3<f64>, Matrix3<f64>, Vector3<f64>) {
-    let psi = so3::log(&(r_k.transpose() * r_next));
+    let psi = so3::log(&tr_mul(r_k, r_next));
     let r_mid = r_k * so3::exp(&(0.5 * psi));
     let ipsi = inertia * psi;
     // The same operations as `half_momentum_value`: bit-identical values.
@@ -99,13 +119,14 @@ pub fn half_momentum_value(
 }
 
 /// [`half_momentum_value`] and the step's rotation `ψ` it is made of.
+#[inline]
 pub fn half_momentum_and_rotation(
     r_k: &Matrix3<f64>,
     r_next: &Matrix3<f64>,
     inertia: &Matrix3<f64>,
     dt: f64,
 ) -> (Vector3<f64>, Vector3<f64>) {
-    let psi = so3::log(&(r_k.transpose() * r_next));
+    let psi = so3::log(&tr_mul(r_k, r_next));
     (r_k * so3::rotate(&(0.5 * psi), &(inertia * psi)) / dt, psi)
 }
 

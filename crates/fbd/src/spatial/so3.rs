@@ -38,6 +38,7 @@ fn coefficients(t: f64) -> (f64, f64, f64) {
 }
 
 /// `exp(φ)`: the rotation matrix of rotation vector `phi`.
+#[inline]
 pub fn exp(phi: &Vector3<f64>) -> Matrix3<f64> {
     let (a, b, _) = coefficients(phi.norm());
     let h = hat(phi);
@@ -54,6 +55,7 @@ pub fn rotate(phi: &Vector3<f64>, v: &Vector3<f64>) -> Vector3<f64> {
 
 /// `log(R)`: the rotation vector of `r` (angle in `[0, π)`; accurate for
 /// small angles, where it is taken from the skew part).
+#[inline]
 pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
     // v = sin θ · axis, cos θ from the trace.
     let v = 0.5
@@ -78,6 +80,7 @@ pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
 }
 
 /// The right Jacobian `Jr(φ) = I − (1 − cos θ)/θ²·[φ]× + (θ − sin θ)/θ³·[φ]×²`.
+#[inline]
 pub fn right_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
     let (_, b, c) = coefficients(phi.norm());
     let h = hat(phi);
@@ -85,6 +88,7 @@ pub fn right_jacobian(phi: &Vector3<f64>) -> Matrix3<f64> {
 }
 
 /// `Jr⁻¹(φ) = I + ½[φ]× + (1/θ² − (1 + cos θ)/(2θ sin θ))·[φ]×²`.
+#[inline]
 pub fn right_jacobian_inv(phi: &Vector3<f64>) -> Matrix3<f64> {
     let t = phi.norm();
     let d = if t < SMALL {

@@ -42,6 +42,12 @@ pub struct TreeFbdData {
     /// joint: `u1 × u2` normalised, the second unused; a single joint:
     /// `b1`, `b2 = u × b1` across its axis `u`).
     pub moment_dir: Vec<[Vector3<f64>; 2]>,
+    /// Per reaction, [`FbdModel::reaction`] at k but for its actuator
+    /// torque (zero here): the columns and bodies from the mechanism, the
+    /// point and constraint-moment directions made by [`prepare_step`].
+    reaction_k: Vec<Reaction<Space3>>,
+    /// Per stop, its bodies and joint from the mechanism, in one place.
+    stop_k: Vec<StopK>,
     /// Per FBD body, `L[k+½]` at the last evaluated iterate.
     pub l_next: Vec<Vector3<f64>>,
     /// Per FBD body, the rotation `ψ[k+½]` of `l_next`.
@@ -104,6 +110,22 @@ impl TreeFbdData {
                 mech.model.joints.len(),
             ),
             moment_dir: vec![[Vector3::zeros(); 2]; mech.reactions.len()],
+            reaction_k: (0..mech.reactions.len())
+                .map(|i| reaction_layout(mech, i))
+                .collect(),
+            stop_k: mech
+                .limits
+                .iter()
+                .map(|lim| {
+                    let re = &mech.reactions[lim.reaction];
+                    StopK {
+                        child: re.child,
+                        parent: re.parent,
+                        q_index: lim.q_index,
+                        joint: lim.joint,
+                    }
+                })
+                .collect(),
             l_next: vec![Vector3::zeros(); nb],
             psi_next: vec![Vector3::zeros(); nb],
             l_next_fresh: vec![false; nb],
@@ -176,6 +198,35 @@ fn moment_directions(mech: &TreeMechanism, kin: &TreeKin, i: usize) -> [Vector3<
     [b1, u.cross(&b1)]
 }
 
+/// A stop's bodies (its reaction's), joint angle index and joint.
+#[derive(Clone, Copy, Debug)]
+struct StopK {
+    child: usize,
+    parent: usize,
+    q_index: usize,
+    joint: usize,
+}
+
+/// Reaction `i`'s bodies, force column and constraint-moment columns, its
+/// point, directions and torque zero.
+fn reaction_layout(mech: &TreeMechanism, i: usize) -> Reaction<Space3> {
+    let re = &mech.reactions[i];
+    let m1 = (mech.reaction_moment(i, 0), [0.0; 3]);
+    Reaction {
+        child: re.child,
+        parent: re.parent,
+        point: [0.0; 3],
+        force_col: mech.reaction_force(i, 0),
+        torque: [0.0; 3],
+        moments: if re.compound {
+            [m1, (0, [0.0; 3])]
+        } else {
+            [m1, (mech.reaction_moment(i, 1), [0.0; 3])]
+        },
+        n_moments: re.moments(),
+    }
+}
+
 /// Stage "kinematics at k": every body's constants and the constraint
 /// directions of this step, given `q[k]` (and `q[k−1]`) already set.
 pub fn prepare_step(mech: &TreeMechanism, data: &mut TreeFbdData, history: History<'_>, dt: f64) {
@@ -217,8 +268,16 @@ pub fn prepare_step(mech: &TreeMechanism, data: &mut TreeFbdData, history: Histo
             }
         };
     }
-    for i in 0..mech.reactions.len() {
-        data.moment_dir[i] = moment_directions(mech, &data.kin, i);
+    for (i, re) in mech.reactions.iter().enumerate() {
+        let [d1, d2] = moment_directions(mech, &data.kin, i);
+        data.moment_dir[i] = [d1, d2];
+        let point = data.kin.joint_origin[re.joints[0]].into();
+        let r = &mut data.reaction_k[i];
+        r.point = point;
+        r.moments[0].1 = d1.into();
+        if !re.compound {
+            r.moments[1].1 = d2.into();
+        }
     }
 }
 
@@ -265,9 +324,13 @@ pub fn pattern_key(data: &TreeFbdData) -> u64 {
     )
 }
 
+/// Calls `f` for every column of `cols`, from one loop: one call site,
+/// so that `f` (the assembly's entries) is inlined into it.
 #[inline]
 fn columns(cols: Columns<'_>, mut f: impl FnMut(usize, &[f64; 3])) {
-    cols.for_each(|i, v| f(i, &[v.x, v.y, v.z]));
+    for (i, v) in cols.iter() {
+        f(i, &[v.x, v.y, v.z]);
+    }
 }
 
 /// Any robot's part of the assembly.
@@ -313,6 +376,7 @@ impl FbdModel for TreeMechanism {
 
     /// `(c·L[k+½] − L[k−½])/Δt` ([`crate::spatial::half_momentum`]); with `jacobian`, its
     /// derivative for [`FbdModel::rotation_entries`].
+    #[inline]
     fn angular_rate(&self, data: &mut TreeFbdData, b: usize, jacobian: bool) -> [f64; 3] {
         let bs = data.body[b];
         let body = &self.bodies[b];
@@ -338,28 +402,18 @@ impl FbdModel for TreeMechanism {
     }
 
     /// Reaction `i` at k: the force at its first joint's origin, its
-    /// constraint moments ([`TreeFbdData::moment_dir`]) and the actuator
-    /// torques `Σ τ_j·u_j` of its joints.
+    /// constraint moments ([`TreeFbdData::moment_dir`]), both kept by
+    /// [`prepare_step`], and the actuator torques `Σ τ_j·u_j` of its joints
+    /// (the torques as they are now).
+    #[inline]
     fn reaction(&self, data: &TreeFbdData, i: usize) -> Reaction<Space3> {
-        let re = &self.reactions[i];
         let mut torque = Vector3::zeros();
-        for &j in re.joint_list() {
+        for &j in self.reactions[i].joint_list() {
             torque += data.torque[j] * data.kin.axis[j];
         }
-        let [d1, d2] = data.moment_dir[i];
-        let m1 = (self.reaction_moment(i, 0), d1.into());
         Reaction {
-            child: re.child,
-            parent: re.parent,
-            point: data.kin.joint_origin[re.joints[0]].into(),
-            force_col: self.reaction_force(i, 0),
             torque: torque.into(),
-            moments: if re.compound {
-                [m1, (0, [0.0; 3])]
-            } else {
-                [m1, (self.reaction_moment(i, 1), d2.into())]
-            },
-            n_moments: re.moments(),
+            ..data.reaction_k[i]
         }
     }
 
@@ -396,13 +450,12 @@ impl FbdModel for TreeMechanism {
 
     #[inline]
     fn stop<'a>(&self, data: &'a TreeFbdData, l: usize) -> StopView<'a, Space3> {
-        let lim = &self.limits[l];
-        let re = &self.reactions[lim.reaction];
+        let stop = &data.stop_k[l];
         StopView {
-            child: re.child,
-            parent: re.parent,
-            axis: data.kin.axis[lim.joint].into(),
-            q_index: lim.q_index,
+            child: stop.child,
+            parent: stop.parent,
+            axis: data.kin.axis[stop.joint].into(),
+            q_index: stop.q_index,
             equation: &data.limit[l],
         }
     }

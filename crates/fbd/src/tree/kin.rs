@@ -82,6 +82,11 @@ pub struct TreeKin {
     body_com: Vec<Vector3<f64>>,
     /// Each contact point's position in its body's frame (from the model).
     contact_local: Vec<Vector3<f64>>,
+    /// Scratch of [`Self::eval`]: per joint, the sine and cosine of its
+    /// angle times its [`JointConst::angle_sign`], all taken before the
+    /// frames are placed (no library call among them, whose registers
+    /// would have to be saved).
+    sin_cos: Vec<(f64, f64)>,
 }
 
 /// The axis of a joint in its child's frame, as the rotation about it is
@@ -102,10 +107,50 @@ enum FixedRotation {
     Identity,
     /// `O` a signed permutation (to 1e-15; a D-H `α` of ±90°, an axis
     /// swap): column `i` of `F` is `sign[i]` times column `from[i]` of
-    /// `R_parent`.
-    Permutation { from: [usize; 3], sign: [f64; 3] },
+    /// `R_parent`, `from` one of the six orders ([`Order`]).
+    Permutation { from: Order, sign: [f64; 3] },
     /// Any other rotation.
     General(Matrix3<f64>),
+}
+
+/// The order `from` of a [`FixedRotation::Permutation`]'s columns, named so
+/// that [`FixedRotation::apply`] reads them at fixed places.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Order {
+    O012,
+    O021,
+    O102,
+    O120,
+    O201,
+    O210,
+}
+
+impl Order {
+    fn of(from: [usize; 3]) -> Option<Self> {
+        Some(match from {
+            [0, 1, 2] => Self::O012,
+            [0, 2, 1] => Self::O021,
+            [1, 0, 2] => Self::O102,
+            [1, 2, 0] => Self::O120,
+            [2, 0, 1] => Self::O201,
+            [2, 1, 0] => Self::O210,
+            _ => return None,
+        })
+    }
+
+    /// The columns `(a[from[0]], a[from[1]], a[from[2]])`.
+    #[inline]
+    fn pick<T: Copy>(self, a: [T; 3]) -> [T; 3] {
+        let [x, y, z] = a;
+        match self {
+            Self::O012 => [x, y, z],
+            Self::O021 => [x, z, y],
+            Self::O102 => [y, x, z],
+            Self::O120 => [y, z, x],
+            Self::O201 => [z, x, y],
+            Self::O210 => [z, y, x],
+        }
+    }
 }
 
 impl FixedRotation {
@@ -124,10 +169,10 @@ impl FixedRotation {
             from[i] = k;
             sign[i] = col[k].signum();
         }
-        if from == [0, 1, 2] && sign == [1.0; 3] {
-            Self::Identity
-        } else {
-            Self::Permutation { from, sign }
+        match Order::of(from) {
+            Some(Order::O012) if sign == [1.0; 3] => Self::Identity,
+            Some(from) => Self::Permutation { from, sign },
+            None => Self::General(*r),
         }
     }
 
@@ -136,11 +181,14 @@ impl FixedRotation {
     fn apply(&self, rp: &Matrix3<f64>) -> Matrix3<f64> {
         match self {
             Self::Identity => *rp,
-            Self::Permutation { from, sign } => Matrix3::from_columns(&[
-                sign[0] * rp.column(from[0]),
-                sign[1] * rp.column(from[1]),
-                sign[2] * rp.column(from[2]),
-            ]),
+            Self::Permutation { from, sign } => {
+                let [a, b, c] = from.pick([
+                    rp.column(0).into_owned(),
+                    rp.column(1).into_owned(),
+                    rp.column(2).into_owned(),
+                ]);
+                Matrix3::from_columns(&[sign[0] * a, sign[1] * b, sign[2] * c])
+            }
             Self::General(r) => rp * r,
         }
     }
@@ -184,14 +232,24 @@ impl JointConst {
         }
     }
 
+    /// The factor of the joint angle whose sine and cosine [`Self::turn`]
+    /// takes: the sign of a coordinate axis, 1 for any other.
+    #[inline]
+    fn angle_sign(&self) -> f64 {
+        match self.axis {
+            AxisKind::Coordinate { sign, .. } => sign,
+            AxisKind::General(_) => 1.0,
+        }
+    }
+
     /// The child's rotation `F·T(θ)` and the joint's axis `F·u`, with
     /// `F` the parent's rotation times the fixed origin rotation and
-    /// `T(θ)` the turn by `θ` about `u`.
+    /// `T(θ)` the turn by `θ` about `u`, given `(s, c)` the sine and cosine
+    /// of `θ` times [`Self::angle_sign`].
     #[inline]
-    fn turn(&self, f: &Matrix3<f64>, theta: f64) -> (Matrix3<f64>, Vector3<f64>) {
+    fn turn(&self, f: &Matrix3<f64>, (s, c): (f64, f64)) -> (Matrix3<f64>, Vector3<f64>) {
         match self.axis {
             AxisKind::Coordinate { k, sign } => {
-                let (s, c) = (sign * theta).sin_cos();
                 // T turns column a towards column b, (a, b, k) cyclic; the
                 // columns are named, not indexed, so that the result stays
                 // in registers.
@@ -218,7 +276,6 @@ impl JointConst {
                 (Matrix3::from_columns(&cols), sign * axis)
             }
             AxisKind::General(u) => {
-                let (s, c) = theta.sin_cos();
                 let k = u.cross_matrix();
                 let t = Matrix3::identity() + s * k + (1.0 - c) * (k * k);
                 (f * t, f * u)
@@ -290,6 +347,7 @@ impl TreeKin {
             joints: model.joints.iter().map(JointConst::of).collect(),
             body_com: model.bodies.iter().map(|b| b.com).collect(),
             contact_local: model.contacts.iter().map(|c| c.position).collect(),
+            sin_cos: vec![(0.0, 1.0); nj],
         }
     }
 
@@ -335,16 +393,24 @@ impl TreeKin {
         ];
         self.origin[0] = pose.position;
         self.rotation[0] = rot;
-        for ((jc, &theta), (axis, joint_origin)) in self
+        for ((sc, jc), &theta) in self
+            .sin_cos
+            .iter_mut()
+            .zip(&self.joints)
+            .zip(&q[BASE_DOF..])
+        {
+            *sc = (jc.angle_sign() * theta).sin_cos();
+        }
+        for ((jc, &sc), (axis, joint_origin)) in self
             .joints
             .iter()
-            .zip(&q[BASE_DOF..])
+            .zip(&self.sin_cos)
             .zip(self.axis.iter_mut().zip(self.joint_origin.iter_mut()))
         {
             let (p, c) = (jc.parent, jc.child);
             let rp = &self.rotation[p];
             let o = self.origin[p] + rp * jc.translation;
-            let (rc, u) = jc.turn(&jc.rotation.apply(rp), theta);
+            let (rc, u) = jc.turn(&jc.rotation.apply(rp), sc);
             self.rotation[c] = rc;
             self.origin[c] = o;
             *axis = u;

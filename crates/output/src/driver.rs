@@ -45,26 +45,51 @@ impl Stepper<fbd_sim::gait::GaitData> for fbd_sim::gait::GaitModel {
     }
 }
 
-/// A model's files and summary, fed by the driver.
+/// A record of one step: its step number (a written row when a multiple
+/// of the stride).
+pub trait Stepped {
+    /// The step index k.
+    fn step(&self) -> usize;
+}
+
+impl Stepped for fbd_sim::StepRecord {
+    fn step(&self) -> usize {
+        self.step
+    }
+}
+
+impl Stepped for fbd_sim::robot::RobotRecord {
+    fn step(&self) -> usize {
+        self.step
+    }
+}
+
+impl Stepped for fbd_sim::gait::GaitData {
+    fn step(&self) -> usize {
+        self.step
+    }
+}
+
+/// A model's files and summary, fed by the driver; the trajectory's file
+/// is the driver's ([`Recording`]), the model gives its rows' values.
 pub trait RunFiles {
     /// One step's record.
-    type Record;
+    type Record: Stepped;
     /// What the stepping returns.
     type Run;
     /// `summary.json`'s content.
     type Summary: Serialize;
-    /// The step number of a record (a written row when a multiple of the
-    /// stride).
-    fn step_of(r: &Self::Record) -> usize;
-    /// A written row: the trajectory, the viewer frame.
-    fn row(&mut self, r: &Self::Record);
-    /// Every step (the written ones too, after [`RunFiles::row`]): plots,
-    /// peaks.
+    /// The values of a written row of the trajectory, in its columns'
+    /// order.
+    fn row_values(&mut self, r: &Self::Record, sink: &mut dyn output::RowSink);
+    /// What else a written row makes (the viewer's frame); nothing by
+    /// default.
+    fn written(&mut self, _r: &Self::Record) {}
+    /// Every step (the written ones too, after [`RunFiles::written`]):
+    /// plots, peaks.
     fn observe(&mut self, r: &Self::Record);
     /// The summary of `run`, of which `rows` rows were written.
     fn summary(&mut self, run: &Self::Run, rows: usize) -> Self::Summary;
-    /// Completes the trajectory file (`None` without an output directory).
-    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>>;
     /// `events.csv`'s text.
     fn events_csv(&self, run: &Self::Run) -> String;
     /// Writes the plots and the viewer into `dir` (each attempted, the
@@ -130,19 +155,23 @@ impl Outcome for fbd_scenario::robot::RobotRun {
     }
 }
 
-/// A run being recorded: the model's files, the stride, the rows written.
+/// A run being recorded: the model's files, the trajectory's file (with
+/// an output directory), the stride, the rows written.
 pub struct Recording<F> {
     files: F,
+    table: Option<output::Table>,
     stride: usize,
     rows: usize,
     dir: Option<PathBuf>,
 }
 
 impl<F: RunFiles> Recording<F> {
-    /// Records into `files` every `stride`-th step; the files go to `dir`.
-    pub fn new(files: F, stride: usize, dir: Option<&Path>) -> Self {
+    /// Records into `files` every `stride`-th step; the trajectory's rows
+    /// go to `table`, the files to `dir`.
+    pub fn new(files: F, table: Option<output::Table>, stride: usize, dir: Option<&Path>) -> Self {
         Self {
             files,
+            table,
             stride: stride.max(1),
             rows: 0,
             dir: dir.map(Path::to_owned),
@@ -152,8 +181,12 @@ impl<F: RunFiles> Recording<F> {
     /// Adds one step's record, handing a written one to `on_row`.
     #[inline]
     pub fn push(&mut self, r: &F::Record, on_row: &mut dyn FnMut(&F::Record)) {
-        if F::step_of(r).is_multiple_of(self.stride) {
-            self.files.row(r);
+        if r.step().is_multiple_of(self.stride) {
+            if let Some(t) = self.table.as_mut() {
+                let files = &mut self.files;
+                t.row(|sink| files.row_values(r, sink));
+            }
+            self.files.written(r);
             on_row(r);
             self.rows += 1;
         }
@@ -171,7 +204,7 @@ impl<F: RunFiles> Recording<F> {
     /// one does not write removed.
     pub fn finish(mut self, run: F::Run, config_toml: &str) -> RunOutput<F::Run, F::Summary> {
         let summary = self.files.summary(&run, self.rows);
-        let (Some(dir), Some(trajectory)) = (self.dir, self.files.finish_trajectory()) else {
+        let (Some(dir), Some(table)) = (self.dir, self.table) else {
             return RunOutput {
                 run,
                 summary,
@@ -180,7 +213,7 @@ impl<F: RunFiles> Recording<F> {
             };
         };
         let mut keep = FirstError::default();
-        keep.keep(trajectory);
+        keep.keep(table.finish());
         output::write_run_files(
             &dir,
             &self.files.events_csv(&run),

@@ -774,58 +774,6 @@ impl Table {
     }
 }
 
-/// Streams the planar trajectory (`trajectory.csv`, or
-/// `trajectory.parquet`) into a temporary file; no allocation per CSV row.
-pub struct TrajectoryWriter {
-    table: Table,
-    slots: ContactSlots,
-    rows: usize,
-}
-
-impl TrajectoryWriter {
-    /// Opens the temporary `trajectory.csv` in `dir` and writes the header
-    /// for a model whose contact points are `contacts` (record order); `dt`
-    /// is the time step (times are written as the decimal of k·Δt).
-    pub fn create(dir: &Path, contacts: &[ContactSpec], dt: f64) -> Result<Self, OutputError> {
-        Self::create_as(dir, contacts, dt, fbd_scenario::OutputFormat::Csv)
-    }
-
-    /// [`TrajectoryWriter::create`] in `format` (`[output] format`).
-    pub fn create_as(
-        dir: &Path,
-        contacts: &[ContactSpec],
-        dt: f64,
-        format: fbd_scenario::OutputFormat,
-    ) -> Result<Self, OutputError> {
-        let slots = ContactSlots::of(contacts);
-        Ok(Self {
-            table: Table::create(dir, format, slots.columns(), dt)?,
-            slots,
-            rows: 0,
-        })
-    }
-
-    /// Rows written so far.
-    pub fn rows(&self) -> usize {
-        self.rows
-    }
-
-    /// Appends the row of `r`. An I/O error is kept and reported by
-    /// [`TrajectoryWriter::finish`]; later rows are skipped.
-    pub fn write(&mut self, r: &StepRecord) {
-        let slots = &self.slots;
-        self.table.row(|sink| row_values(slots, r, sink));
-        if !self.table.failed() {
-            self.rows += 1;
-        }
-    }
-
-    /// Flushes and renames the file into place.
-    pub fn finish(self) -> Result<PathBuf, OutputError> {
-        self.table.finish()
-    }
-}
-
 /// The `point` of a retried step's event (`events.csv`, `summary.json`).
 pub const RETRY_POINT: &str = "substeps";
 

@@ -12,7 +12,7 @@
 //! after a simulation error or an interruption.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use fbd_sim::robot::{RobotRecord, RobotSim};
@@ -314,9 +314,7 @@ impl Stepper<RobotRecord> for RobotStepper<'_> {
 struct RobotFiles<'a> {
     robot: &'a LoadedRobot,
     sim: &'a RobotSim,
-    traj: Option<output::Table>,
     plan: Plan,
-    rows: usize,
     plot: Option<plots::Recorder>,
     frames: Option<crate::viewer::robot::RobotFrames>,
     states: Vec<u8>,
@@ -331,11 +329,11 @@ impl RunFiles for RobotFiles<'_> {
     type Run = RobotRun;
     type Summary = RobotSummary;
 
-    fn step_of(r: &RobotRecord) -> usize {
-        r.step
+    fn row_values(&mut self, r: &RobotRecord, sink: &mut dyn output::RowSink) {
+        self.plan.row(r, None, sink);
     }
 
-    fn row(&mut self, r: &RobotRecord) {
+    fn written(&mut self, r: &RobotRecord) {
         for c in &r.contacts {
             self.peak_normal = self.peak_normal.max(c.normal);
         }
@@ -354,13 +352,6 @@ impl RunFiles for RobotFiles<'_> {
                 (contacts > 0).then_some((&self.states[..], &self.forces[..])),
             );
         }
-        if let Some(t) = self.traj.as_mut() {
-            let plan = &self.plan;
-            t.row(|sink| plan.row(r, None, sink));
-            if !t.failed() {
-                self.rows += 1;
-            }
-        }
     }
 
     fn observe(&mut self, r: &RobotRecord) {
@@ -369,8 +360,7 @@ impl RunFiles for RobotFiles<'_> {
         }
     }
 
-    /// The rows counted are those written before a failure.
-    fn summary(&mut self, run: &RobotRun, _: usize) -> RobotSummary {
+    fn summary(&mut self, run: &RobotRun, rows: usize) -> RobotSummary {
         let (robot, sim) = (self.robot, self.sim);
         let dt = robot.config.time.dt;
         let times = StepTimes::new(dt);
@@ -393,7 +383,7 @@ impl RunFiles for RobotFiles<'_> {
             steps: s.steps,
             steps_planned: run.steps_planned,
             stride: robot.config.output.stride,
-            rows_written: self.rows,
+            rows_written: rows,
             contact_points: sim.mech.contacts.iter().map(|c| c.name.clone()).collect(),
             distance: (run.final_q[0] - robot.params().q0[0])
                 .hypot(run.final_q[2] - robot.params().q0[2]),
@@ -425,10 +415,6 @@ impl RunFiles for RobotFiles<'_> {
             resolved_cycles: s.resolved_cycles,
             max_law_violation: s.max_law_violation,
         }
-    }
-
-    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
-        self.traj.take().map(output::Table::finish)
     }
 
     fn events_csv(&self, _: &RobotRun) -> String {
@@ -495,9 +481,7 @@ pub fn simulate(
     let files = RobotFiles {
         robot,
         sim: &sim,
-        traj: Some(traj),
         plan,
-        rows: 0,
         plot: output.plots.then(|| {
             let r = plots::Recorder::new(plot_plan(robot, &sim), t_end);
             if contacts > 0 {
@@ -518,7 +502,7 @@ pub fn simulate(
     let stepper = RobotStepper { robot, sim: &sim };
     Ok(driver::drive(
         &stepper,
-        Recording::new(files, output.stride, Some(out_dir)),
+        Recording::new(files, Some(traj), output.stride, Some(out_dir)),
         stop,
         &robot.config.to_toml(),
         on_row,

@@ -2,7 +2,7 @@
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use fbd_dynamics::PointKind;
@@ -12,7 +12,7 @@ use fbd_sim::{Model, RunSummary, StepRecord};
 use crate::OutputError;
 use crate::config::{self, Config};
 use crate::driver::{self, Recording, RunFiles, RunOutput};
-use crate::output::{self, Ending, Energy, EventJson, PeakForce, Summary, TrajectoryWriter};
+use crate::output::{self, Ending, Energy, EventJson, PeakForce, Summary};
 use crate::plot::{self, PlotData, PlotRecorder, Stance};
 use crate::steptime::StepTimes;
 use crate::viewer::{self, planar::PlanarScene};
@@ -229,7 +229,7 @@ struct PlanarFiles<'a> {
     model: &'a Model,
     planar: &'a fbd_scenario::PlanarConfig,
     names: Vec<String>,
-    traj: Option<TrajectoryWriter>,
+    slots: output::ContactSlots,
     collect: Option<Collector>,
     view: Option<PlanarScene<'a>>,
     plot: Option<PlotData>,
@@ -240,14 +240,11 @@ impl RunFiles for PlanarFiles<'_> {
     type Run = RunSummary;
     type Summary = Summary;
 
-    fn step_of(r: &StepRecord) -> usize {
-        r.step
+    fn row_values(&mut self, r: &StepRecord, sink: &mut dyn output::RowSink) {
+        output::row_values(&self.slots, r, sink);
     }
 
-    fn row(&mut self, r: &StepRecord) {
-        if let Some(t) = self.traj.as_mut() {
-            t.write(r);
-        }
+    fn written(&mut self, r: &StepRecord) {
         if let Some(v) = self.view.as_mut() {
             v.push(r);
         }
@@ -264,10 +261,6 @@ impl RunFiles for PlanarFiles<'_> {
         let (plot, last, peaks, joints) = collect.finish(self.model, run);
         self.plot = Some(plot);
         summary(self.model, &self.names, run, rows, last, peaks, joints)
-    }
-
-    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
-        self.traj.take().map(TrajectoryWriter::finish)
     }
 
     fn events_csv(&self, run: &RunSummary) -> String {
@@ -336,22 +329,22 @@ pub fn simulate(
     let model = planar.model(source)?;
 
     let names: Vec<String> = model.mech.contacts.iter().map(|c| c.name.clone()).collect();
-    let traj = match out_dir {
+    let slots = output::ContactSlots::of(&model.mech.contacts);
+    let table = match out_dir {
         Some(dir) => {
             output::prepare_dir(dir)?;
+            let columns = slots.columns();
             output::warn_size(
                 model.steps.div_ceil(model.params.stride.max(1)),
-                output::ContactSlots::of(&model.mech.contacts)
-                    .columns()
-                    .len(),
+                columns.len(),
                 model.params.stride,
                 planar.output.format,
             );
-            Some(TrajectoryWriter::create_as(
+            Some(output::Table::create(
                 dir,
-                &model.mech.contacts,
-                model.dt(),
                 planar.output.format,
+                columns,
+                model.dt(),
             )?)
         }
         None => None,
@@ -374,12 +367,12 @@ pub fn simulate(
         model: &model,
         planar,
         names,
-        traj,
+        slots,
         collect: Some(collect),
         view,
         plot: None,
     };
-    let rec = Recording::new(files, stride, out_dir);
+    let rec = Recording::new(files, table, stride, out_dir);
     Ok(driver::drive(
         &every_step,
         rec,

@@ -7,7 +7,7 @@ mod plots;
 
 use std::collections::BTreeMap;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use fbd_sim::gait::{GaitData, GaitEvent, GaitModel, GaitSummary, LEGS};
@@ -123,45 +123,17 @@ pub fn row_values(d: &GaitData, out: &mut [f64; ROW_VALUES]) {
     .for_each(&mut put);
 }
 
-/// Streams the hexapod trajectory (`trajectory.csv` or
-/// `trajectory.parquet`) into a temporary file.
-struct Writer {
-    table: output::Table,
-    rows: usize,
-}
-
-impl Writer {
-    fn create(
-        dir: &Path,
-        dt: f64,
-        format: fbd_scenario::OutputFormat,
-    ) -> Result<Self, OutputError> {
-        Ok(Self {
-            table: output::Table::create(dir, format, columns(), dt)?,
-            rows: 0,
-        })
-    }
-
-    fn write(&mut self, d: &GaitData) {
-        let mut v = [0.0; ROW_VALUES];
-        row_values(d, &mut v);
-        self.table.row(|sink| {
-            sink.time(d.step, d.t);
-            for (i, x) in v.iter().enumerate() {
-                if STANCE.contains(&i) {
-                    sink.flag(*x == 1.0);
-                } else {
-                    sink.num(*x);
-                }
-            }
-        });
-        if !self.table.failed() {
-            self.rows += 1;
+/// The values of the trajectory row of `d`, in [`columns`]' order.
+fn gait_row(d: &GaitData, sink: &mut dyn output::RowSink) {
+    let mut v = [0.0; ROW_VALUES];
+    row_values(d, &mut v);
+    sink.time(d.step, d.t);
+    for (i, x) in v.iter().enumerate() {
+        if STANCE.contains(&i) {
+            sink.flag(*x == 1.0);
+        } else {
+            sink.num(*x);
         }
-    }
-
-    fn finish(self) -> Result<PathBuf, OutputError> {
-        self.table.finish()
     }
 }
 
@@ -335,7 +307,6 @@ pub type HexapodRun = RunOutput<GaitSummary, HexapodSummary>;
 struct GaitFiles {
     model: GaitModel,
     output: fbd_scenario::OutputConfig,
-    traj: Option<Writer>,
     plot: Option<GaitPlotData>,
     view: Option<HexapodScene>,
 }
@@ -345,14 +316,11 @@ impl RunFiles for GaitFiles {
     type Run = GaitSummary;
     type Summary = HexapodSummary;
 
-    fn step_of(d: &GaitData) -> usize {
-        d.step
+    fn row_values(&mut self, d: &GaitData, sink: &mut dyn output::RowSink) {
+        gait_row(d, sink);
     }
 
-    fn row(&mut self, d: &GaitData) {
-        if let Some(t) = self.traj.as_mut() {
-            t.write(d);
-        }
+    fn written(&mut self, d: &GaitData) {
         if let Some(v) = self.view.as_mut() {
             v.push(&HexFrame::of_gait(d));
         }
@@ -366,10 +334,6 @@ impl RunFiles for GaitFiles {
 
     fn summary(&mut self, run: &GaitSummary, rows: usize) -> HexapodSummary {
         summary(&self.model, self.output.stride.max(1), rows, run)
-    }
-
-    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
-        self.traj.take().map(Writer::finish)
     }
 
     fn events_csv(&self, run: &GaitSummary) -> String {
@@ -426,7 +390,12 @@ pub fn simulate(
                 stride,
                 h.output.format,
             );
-            Some(Writer::create(dir, model.dt, h.output.format)?)
+            Some(output::Table::create(
+                dir,
+                h.output.format,
+                columns(),
+                model.dt,
+            )?)
         }
         None => None,
     };
@@ -445,11 +414,10 @@ pub fn simulate(
     let files = GaitFiles {
         model: model.clone(),
         output: h.output.clone(),
-        traj,
         plot,
         view,
     };
-    let rec = Recording::new(files, stride, out_dir);
+    let rec = Recording::new(files, traj, stride, out_dir);
     Ok(crate::driver::drive(
         &model,
         rec,

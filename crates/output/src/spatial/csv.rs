@@ -2,16 +2,11 @@
 //! the model's legs and contact points (`{leg, kind}` data), and the
 //! streaming writer.
 
-use std::path::{Path, PathBuf};
-
 use fbd_dynamics::PointKind;
-use fbd_scenario::OutputFormat;
 use fbd_sim::robot::RobotRecord;
-use fbd_sim::spatial::{LegIndex, RecordIndex, SpatialParams};
+use fbd_sim::spatial::{LegIndex, RecordIndex};
 
 use super::Layout;
-use crate::OutputError;
-use crate::output;
 use crate::tree::{Plan, Source};
 
 /// The body pose columns after `t`.
@@ -172,65 +167,13 @@ impl Slots {
     }
 }
 
-/// Streams the trajectory (`trajectory.csv` or `trajectory.parquet`)
-/// into a temporary file; no allocation per CSV row.
-pub struct TrajectoryWriter {
-    table: output::Table,
-    plan: Plan,
-    feet: super::Feet,
-    rows: usize,
-}
-
-impl TrajectoryWriter {
-    /// Opens the temporary `trajectory.csv` in `dir` and writes the header.
-    pub fn create(dir: &Path, params: &SpatialParams) -> Result<Self, OutputError> {
-        Self::create_as(dir, params, OutputFormat::Csv)
-    }
-
-    /// [`TrajectoryWriter::create`] in `format` (`[output] format`).
-    pub fn create_as(
-        dir: &Path,
-        params: &SpatialParams,
-        format: OutputFormat,
-    ) -> Result<Self, OutputError> {
-        let layout = Layout::of(params);
-        let plan = plan(&layout, &Slots::of(&layout, &params.record_index()));
-        Ok(Self {
-            table: output::Table::create(dir, format, plan.names.clone(), params.dt)?,
-            feet: super::Feet::new(params),
-            plan,
-            rows: 0,
-        })
-    }
-
-    /// Rows written so far.
-    pub fn rows(&self) -> usize {
-        self.rows
-    }
-
-    /// Appends the row of `r`. An I/O error is kept and reported by
-    /// [`TrajectoryWriter::finish`]; later rows are skipped.
-    pub fn write(&mut self, r: &RobotRecord) {
-        let (plan, feet) = (&self.plan, &mut self.feet);
-        self.table.row(|sink| plan.row(r, Some(feet), sink));
-        if !self.table.failed() {
-            self.rows += 1;
-        }
-    }
-
-    /// Flushes and renames the file into place.
-    pub fn finish(self) -> Result<PathBuf, OutputError> {
-        self.table.finish()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
     fn joint_and_contact_point_columns_never_clash() {
-        let layout = Layout::of(&SpatialParams::default());
+        let layout = Layout::of(&fbd_sim::spatial::SpatialParams::default());
         let c = columns(&layout);
         let mut sorted = c.clone();
         sorted.sort();

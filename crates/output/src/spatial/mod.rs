@@ -10,7 +10,7 @@ pub mod csv;
 pub mod summary;
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use fbd_dynamics::PointKind;
@@ -29,7 +29,7 @@ use crate::steptime::StepTimes;
 use crate::tree::plots::{self, Curve, PlotPlan, leg_color};
 use crate::viewer::hexapod::{HexDynamics, HexFrame, HexapodScene};
 
-pub use csv::{TrajectoryWriter, columns};
+pub use csv::columns;
 pub use summary::SpatialSummary;
 
 /// The files a dynamic hexapod run writes, in order.
@@ -245,7 +245,7 @@ pub struct Outputs {
     params: SpatialParams,
     layout: Layout,
     steps: usize,
-    traj: Option<TrajectoryWriter>,
+    plan: crate::tree::Plan,
     output: OutputConfig,
     plot: Option<plots::Recorder>,
     view: Option<HexapodScene>,
@@ -279,21 +279,22 @@ impl Outputs {
         let format = output.format;
         let layout = Layout::of(params);
         let stride = params.stride.max(1);
-        let traj = match out_dir {
+        let slots = csv::Slots::of(&layout, &params.record_index());
+        let plan = csv::plan(&layout, &slots);
+        let table = match out_dir {
             Some(dir) => {
                 output::prepare_dir(dir)?;
-                output::warn_size(
-                    steps.div_ceil(stride),
-                    columns(&layout).len(),
-                    stride,
+                output::warn_size(steps.div_ceil(stride), plan.names.len(), stride, format);
+                Some(output::Table::create(
+                    dir,
                     format,
-                );
-                Some(TrajectoryWriter::create_as(dir, params, format)?)
+                    plan.names.clone(),
+                    params.dt,
+                )?)
             }
             None => None,
         };
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
-        let slots = csv::Slots::of(&layout, &params.record_index());
         let files = Self {
             stability_check_seconds: 0.0,
             collect: Some(summary::Collector::new(&layout, &params.terrain)),
@@ -313,13 +314,13 @@ impl Outputs {
             }),
             feet: Feet::new(params),
             params: params.clone(),
-            traj,
+            plan,
             output: output.clone(),
             slots,
             layout,
             steps,
         };
-        Ok(Recording::new(files, stride, out_dir))
+        Ok(Recording::new(files, table, stride, out_dir))
     }
 }
 
@@ -328,14 +329,11 @@ impl RunFiles for Outputs {
     type Run = RunSummary;
     type Summary = SpatialSummary;
 
-    fn step_of(r: &RobotRecord) -> usize {
-        r.step
+    fn row_values(&mut self, r: &RobotRecord, sink: &mut dyn output::RowSink) {
+        self.plan.row(r, Some(&mut self.feet), sink);
     }
 
-    fn row(&mut self, r: &RobotRecord) {
-        if let Some(t) = self.traj.as_mut() {
-            t.write(r);
-        }
+    fn written(&mut self, r: &RobotRecord) {
         if let Some(v) = self.view.as_mut() {
             v.push(&frame(&mut self.feet, &self.layout, &self.slots, r));
         }
@@ -355,10 +353,6 @@ impl RunFiles for Outputs {
         let mut s = collect.finish(&self.params, self.steps, &self.layout, run, rows);
         s.stability_check_seconds = self.stability_check_seconds;
         s
-    }
-
-    fn finish_trajectory(&mut self) -> Option<Result<PathBuf, OutputError>> {
-        self.traj.take().map(TrajectoryWriter::finish)
     }
 
     fn events_csv(&self, run: &RunSummary) -> String {

@@ -94,22 +94,9 @@ pub struct ContactSpec {
     pub point: usize,
 }
 
-/// Masses and inertias of the two-leg model (both legs alike).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TwoLegInertia {
-    /// Central body mass (kg).
-    pub body_mass: f64,
-    /// Central body inertia about Z through R (kg·m²).
-    pub body_inertia: f64,
-    /// Upper link mass (kg).
-    pub upper_mass: f64,
-    /// Upper link inertia about its centre of mass (kg·m²).
-    pub upper_inertia: f64,
-    /// Lower link mass (kg).
-    pub lower_mass: f64,
-    /// Lower link inertia about its centre of mass (kg·m²).
-    pub lower_inertia: f64,
-}
+/// Masses and inertias (about Z) of the two-leg model's bodies: those of
+/// its D-H instance in the plane (`fbd_robot::dh::planar`).
+pub use fbd_robot::dh::PlanarMasses as TwoLegInertia;
 
 /// Index layout of unknowns and equations of one step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

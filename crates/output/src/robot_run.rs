@@ -429,16 +429,7 @@ impl RunFiles for RobotFiles<'_> {
     ) -> Vec<&'static str> {
         if let Some(plot) = self.plot {
             let plot = plot.finish(event_marks(self.sim, &run.summary));
-            driver::write_svgs(
-                dir,
-                [
-                    ("feet.svg", plots::feet_svg(&plot)),
-                    ("torques.svg", plots::torques_svg(&plot)),
-                    ("body.svg", plots::body_svg(&plot)),
-                    ("energy.svg", plots::energy_svg(&plot)),
-                ],
-                keep,
-            );
+            plots::write(dir, &plot, keep);
         }
         if let Some(mut f) = self.frames {
             if !self.states.is_empty() {

@@ -146,6 +146,18 @@ impl Default for HexapodLayout {
     }
 }
 
+/// One actuator per joint of `model`, named as the joint, without an
+/// effort limit.
+fn actuate_every_joint(model: &mut RobotModel) {
+    model.actuators = (0..model.joints.len())
+        .map(|j| Actuator {
+            name: model.joints[j].name.clone(),
+            joint: j,
+            effort_limit: None,
+        })
+        .collect();
+}
+
 /// A body with mass `m`, centre of mass `com` and diagonal inertia.
 fn body(name: String, m: f64, com: Vector3<f64>, diag: [f64; 3]) -> Body {
     Body {
@@ -273,13 +285,7 @@ pub fn hexapod(
             model.contacts.push(point(format!("hip{n}"), 0, mount.hip));
         }
     }
-    model.actuators = (0..model.joints.len())
-        .map(|j| Actuator {
-            name: model.joints[j].name.clone(),
-            joint: j,
-            effort_limit: None,
-        })
-        .collect();
+    actuate_every_joint(&mut model);
     model
 }
 
@@ -408,12 +414,6 @@ pub fn planar(
             point(format!("hip{n}"), 0, Vector3::new(s * g.d, 0.0, 0.0)),
         ]);
     }
-    model.actuators = (0..model.joints.len())
-        .map(|j| Actuator {
-            name: model.joints[j].name.clone(),
-            joint: j,
-            effort_limit: None,
-        })
-        .collect();
+    actuate_every_joint(&mut model);
     model
 }

@@ -244,19 +244,7 @@ pub fn spatial_modes_slower_than(
                 axes[1].cross(&(p - pivots[1])),
                 axes[2].cross(&(p - pivots[2])),
             ]);
-            // Near a singular leg the null space is ill-conditioned: the
-            // eigenvalues decide (so do non-finite values).
-            let scale = g_leg.column(0).norm() * g_leg.column(1).norm() * g_leg.column(2).norm();
-            let det = g_leg.determinant().abs();
-            if !det.is_finite() || det <= 1e-6 * scale {
-                return None;
-            }
-            let g_inv = g_leg.try_inverse()?;
-            // The foot's velocity v + ω × (p − o) + G_leg·θ̇ = 0.
-            let mut t = Matrix3x6::zeros();
-            t.fixed_view_mut::<3, 3>(0, 0)
-                .copy_from(&(g_inv * hat(&(p - o))));
-            t.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-g_inv));
+            let t = standing_rates(&g_leg, &(p - o))?;
             let c = m_bl * t;
             k_body += c + c.transpose() + t.transpose() * k_leg * t;
         } else {
@@ -276,6 +264,24 @@ pub fn spatial_modes_slower_than(
     k += k_body;
     let k = 0.5 * (k + k.transpose());
     Some(k.cholesky().is_some())
+}
+
+/// The rates `θ̇ = T·(ω, v)` of a leg whose foot stands still, its foot at
+/// `r` from the point `o` whose velocity is `v`, the foot's velocity per
+/// unit joint rate the columns of `g_leg`: from `v + ω × r + G_leg·θ̇ = 0`.
+/// `None` near a singular leg, where the null space is ill-conditioned
+/// (the eigenvalues decide; so do non-finite values).
+fn standing_rates(g_leg: &Matrix3<f64>, r: &Vector3<f64>) -> Option<Matrix3x6<f64>> {
+    let scale = g_leg.column(0).norm() * g_leg.column(1).norm() * g_leg.column(2).norm();
+    let det = g_leg.determinant().abs();
+    if !det.is_finite() || det <= 1e-6 * scale {
+        return None;
+    }
+    let g_inv = g_leg.try_inverse()?;
+    let mut t = Matrix3x6::zeros();
+    t.fixed_view_mut::<3, 3>(0, 0).copy_from(&(g_inv * hat(r)));
+    t.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-g_inv));
+    Some(t)
 }
 
 /// `R·I·Rᵀ`: a body's inertia tensor in the inertial frame; for a link's
@@ -463,17 +469,7 @@ pub fn tree_modes_slower_than(
         let ic = [ic0, ic1, ic2];
         let g_leg =
             Matrix3::from_columns(&chain.map(|j| kin.axis[j].cross(&(f - kin.joint_origin[j]))));
-        let scale = g_leg.column(0).norm() * g_leg.column(1).norm() * g_leg.column(2).norm();
-        let det = g_leg.determinant().abs();
-        if !det.is_finite() || det <= 1e-6 * scale {
-            return None;
-        }
-        let g_inv = g_leg.try_inverse()?;
-        // The point's velocity v_o + ω × (f − o) + G_leg·θ̇ = 0.
-        let mut t = Matrix3x6::zeros();
-        t.fixed_view_mut::<3, 3>(0, 0)
-            .copy_from(&(g_inv * hat(&(f - o))));
-        t.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-g_inv));
+        let t = standing_rates(&g_leg, &(f - o))?;
         let mut m_lr = Matrix3x6::zeros();
         let mut m_ll = Matrix3::zeros();
         for a in 0..3 {

@@ -367,16 +367,7 @@ impl RunFiles for Outputs {
     ) -> Vec<&'static str> {
         if let Some(plot) = self.plot {
             let plot = plot.finish(run.events.iter().map(EventMark::of).collect());
-            crate::driver::write_svgs(
-                dir,
-                [
-                    ("feet.svg", plots::feet_svg(&plot)),
-                    ("torques.svg", plots::torques_svg(&plot)),
-                    ("body.svg", plots::body_svg(&plot)),
-                    ("energy.svg", plots::energy_svg(&plot)),
-                ],
-                keep,
-            );
+            plots::write(dir, &plot, keep);
         }
         if let Some(view) = self.view {
             let mut scene = view.finish();

@@ -274,6 +274,21 @@ fn solid(traces: &[(Trace, RGBColor)]) -> Vec<(&Trace, Style)> {
         .collect()
 }
 
+/// Writes `feet.svg`, `torques.svg`, `body.svg` and `energy.svg` of `d`
+/// into `dir` (each attempted, the first failure kept).
+pub fn write(dir: &std::path::Path, d: &TreePlotData, keep: &mut crate::output::FirstError) {
+    crate::driver::write_svgs(
+        dir,
+        [
+            ("feet.svg", feet_svg(d)),
+            ("torques.svg", torques_svg(d)),
+            ("body.svg", body_svg(d)),
+            ("energy.svg", energy_svg(d)),
+        ],
+        keep,
+    );
+}
+
 /// `feet.svg`: the normal force of every foot versus time.
 pub fn feet_svg(d: &TreePlotData) -> PlotResult<String> {
     let series = solid(&d.feet);

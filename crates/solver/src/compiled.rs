@@ -16,7 +16,8 @@
 //! and `U` gets a slot in one dense-free value array, and the elimination
 //! becomes
 //!
-//! * a scatter of the Jacobian's values (CSC order) into their slots;
+//! * a copy of the Jacobian's values (CSC order) into the first slots,
+//!   in one block, and zeros into the fill-in's;
 //! * for each pivot `k`, in order: the pivot check, the scaling of `L`'s
 //!   column `k` by `1/u_kk`, and the rank-one update
 //!   `a_ij −= l_ik·u_kj` of every `(i, j)` of `L`'s column `k` times `U`'s
@@ -95,8 +96,9 @@ pub const MAX_PERTURBED: usize = 8;
 pub(crate) struct CompiledLu {
     /// Dimension.
     m: usize,
-    /// Slot of each value of the reduced CSC structure.
-    scatter: Vec<u32>,
+    /// Number of values of the reduced CSC structure: value `e` has slot
+    /// `e`, the fill-in the slots after them.
+    values: usize,
     /// Slot of pivot `k`.
     pivot: Vec<u32>,
     /// `L`'s column `k` below the diagonal: `l_slots[l_ptr[k]..l_ptr[k+1]]`.
@@ -112,6 +114,9 @@ pub(crate) struct CompiledLu {
     slots: usize,
     /// The value array.
     a: Vec<f64>,
+    /// Scratch of [`Self::factor`]: `U`'s row `k` right of the diagonal,
+    /// the values (as long as the longest row).
+    u_row: Vec<f64>,
     /// The pivot row order: reduced row of pivot position `i`.
     pub(crate) row_perm: Vec<usize>,
     /// The forward sweep's stream `(row, column, slot)`, `L`'s columns in
@@ -214,10 +219,10 @@ impl CompiledLu {
             self.u_slots.reserve(2 * n_u.min(dense));
             self.upper.reserve(2 * n_u.min(dense));
             self.updates.reserve(2 * n_upd.min(dense * m));
-            self.scatter.reserve(row_idx.len());
             self.pivot.reserve(m);
             self.l_ptr.reserve(m + 1);
             self.u_ptr.reserve(m + 1);
+            self.u_row.reserve(m);
             self.row_perm.reserve(m);
         } else if !grow
             && (n_slots > self.a.capacity()
@@ -228,24 +233,26 @@ impl CompiledLu {
             return false;
         }
         self.m = m;
-        // Slots, row-major.
+        // Slots: the values' in their CSC order (a factorisation copies
+        // them in one block), then the fill-in's, row-major.
         let slot = &mut sc.slot;
+        slot.clear();
+        slot.resize(m * m, u32::MAX);
         let mut slots = 0u32;
-        for (s, &z) in slot.iter_mut().zip(nz.iter()) {
-            *s = if z {
-                slots += 1;
-                slots - 1
-            } else {
-                u32::MAX
-            };
-        }
-        self.slots = slots as usize;
-        self.scatter.clear();
         for j in 0..m {
             for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                self.scatter.push(slot[sc.row_pos[r] * m + sc.col_pos[j]]);
+                slot[sc.row_pos[r] * m + sc.col_pos[j]] = slots;
+                slots += 1;
             }
         }
+        self.values = slots as usize;
+        for (s, &z) in slot.iter_mut().zip(nz.iter()) {
+            if z && *s == u32::MAX {
+                *s = slots;
+                slots += 1;
+            }
+        }
+        self.slots = slots as usize;
         self.pivot.clear();
         self.l_ptr.clear();
         self.l_slots.clear();
@@ -293,6 +300,9 @@ impl CompiledLu {
         self.row_perm.extend_from_slice(row_perm);
         self.a.clear();
         self.a.resize(self.slots, 0.0);
+        let widest = self.u_ptr.windows(2).map(|p| p[1] - p[0]).max();
+        self.u_row.clear();
+        self.u_row.resize(widest.unwrap_or(0) as usize, 0.0);
         // The scratch (dense m × m arrays) is not needed again: a pattern
         // is compiled once.
         self.scratch = Scratch::default();
@@ -413,10 +423,9 @@ impl CompiledLu {
     ) -> Result<(), PivotFailed> {
         perturbed.clear();
         let a = &mut self.a[..self.slots];
-        a.fill(0.0);
-        for (&s, &v) in self.scatter.iter().zip(values) {
-            a[s as usize] = v;
-        }
+        let (given, fill) = a.split_at_mut(self.values);
+        given.copy_from_slice(&values[..self.values]);
+        fill.fill(0.0);
         let mut t = 0usize;
         for (k, (&ps, inv_k)) in self.pivot.iter().zip(pivot_inv.iter_mut()).enumerate() {
             if ps == u32::MAX {
@@ -453,13 +462,26 @@ impl CompiledLu {
             let inv = p.recip();
             *inv_k = inv;
             let w = us.len();
-            for &s in ls {
+            let updates = &self.updates[t..t + ls.len() * w];
+            t += updates.len();
+            if w == 0 {
+                for &s in ls {
+                    a[s as usize] *= inv;
+                }
+                continue;
+            }
+            // `U`'s row `k` read once: the updates of pivot `k` target
+            // rows below it only.
+            let u_row = &mut self.u_row[..w];
+            for (x, &s) in u_row.iter_mut().zip(us) {
+                *x = a[s as usize];
+            }
+            for (&s, targets) in ls.iter().zip(updates.chunks_exact(w)) {
                 let l = a[s as usize] * inv;
                 a[s as usize] = l;
-                for (&u, &d) in us.iter().zip(&self.updates[t..t + w]) {
-                    a[d as usize] -= l * a[u as usize];
+                for (&d, &u) in targets.iter().zip(u_row.iter()) {
+                    a[d as usize] -= l * u;
                 }
-                t += w;
             }
         }
         Ok(())

@@ -797,15 +797,49 @@ impl Factors {
         w: &mut [f64],
         c: usize,
     ) {
-        for &(i, j, v) in lower.iter().chain(upper) {
-            let (i, j) = (i as usize * c, j as usize * c);
-            for t in 0..c {
-                w[i + t] -= v * w[j + t];
+        // `c` is the number of perturbed pivots plus one: a fixed width
+        // per call, so that each entry's row update is unrolled.
+        match c {
+            1 => Self::sweep_rows::<1>(lower, upper, w),
+            2 => Self::sweep_rows::<2>(lower, upper, w),
+            3 => Self::sweep_rows::<3>(lower, upper, w),
+            4 => Self::sweep_rows::<4>(lower, upper, w),
+            5 => Self::sweep_rows::<5>(lower, upper, w),
+            6 => Self::sweep_rows::<6>(lower, upper, w),
+            7 => Self::sweep_rows::<7>(lower, upper, w),
+            8 => Self::sweep_rows::<8>(lower, upper, w),
+            9 => Self::sweep_rows::<9>(lower, upper, w),
+            _ => {
+                for &(i, j, v) in lower.iter().chain(upper) {
+                    let (i, j) = (i as usize * c, j as usize * c);
+                    for t in 0..c {
+                        w[i + t] -= v * w[j + t];
+                    }
+                }
             }
         }
         for (row, &p) in w.chunks_exact_mut(c).zip(pivot_inv) {
             for x in row {
                 *x *= p;
+            }
+        }
+    }
+
+    /// The sweeps of [`Self::sweep_many`] for `C` right-hand sides: the
+    /// same operations, row `j`'s `C` values read before row `i`'s update
+    /// (`i ≠ j`).
+    fn sweep_rows<const C: usize>(
+        lower: &[(u32, u32, f64)],
+        upper: &[(u32, u32, f64)],
+        w: &mut [f64],
+    ) {
+        let (rows, _) = w.as_chunks_mut::<C>();
+        for stream in [lower, upper] {
+            for &(i, j, v) in stream {
+                let src = rows[j as usize];
+                for (x, s) in rows[i as usize].iter_mut().zip(src) {
+                    *x -= v * s;
+                }
             }
         }
     }

@@ -71,6 +71,8 @@
 //! 10 fallbacks avoided, the sweep's wall time 14 s → 12 s; the hexapod
 //! walk of `bench/peer`, 932 M → 869 M instructions.
 
+use crate::lu::Stream;
+
 /// The threshold of the pivot check: a pivot at least a hundredth of the
 /// largest entry of its column, which bounds `L`'s entries by 100. Measured
 /// (fallbacks / factorisations, `bench/peer`): the moving planar flight
@@ -119,12 +121,11 @@ pub(crate) struct CompiledLu {
     u_row: Vec<f64>,
     /// The pivot row order: reduced row of pivot position `i`.
     pub(crate) row_perm: Vec<usize>,
-    /// The forward sweep's stream `(row, column, slot)`, `L`'s columns in
-    /// order.
-    pub(crate) lower: Vec<(u32, u32, u32)>,
-    /// The backward sweep's stream `(row, column, slot)`, `U`'s columns
-    /// last first, entries above the diagonal.
-    pub(crate) upper: Vec<(u32, u32, u32)>,
+    /// The forward sweep's stream of slots, `L`'s columns in order.
+    pub(crate) lower: Stream<u32>,
+    /// The backward sweep's stream of slots, `U`'s columns last first,
+    /// entries above the diagonal.
+    pub(crate) upper: Stream<u32>,
     /// Scratch of [`Self::compile`] and [`Self::choose_rows`], released
     /// after the compilation.
     scratch: Scratch,
@@ -215,9 +216,11 @@ impl CompiledLu {
             let dense = m * m;
             self.a.reserve(2 * n_slots.min(dense));
             self.l_slots.reserve(2 * n_l.min(dense));
-            self.lower.reserve(2 * n_l.min(dense));
+            self.lower.entries.reserve(2 * n_l.min(dense));
+            self.lower.runs.reserve(m);
             self.u_slots.reserve(2 * n_u.min(dense));
-            self.upper.reserve(2 * n_u.min(dense));
+            self.upper.entries.reserve(2 * n_u.min(dense));
+            self.upper.runs.reserve(m);
             self.updates.reserve(2 * n_upd.min(dense * m));
             self.pivot.reserve(m);
             self.l_ptr.reserve(m + 1);
@@ -226,8 +229,8 @@ impl CompiledLu {
             self.row_perm.reserve(m);
         } else if !grow
             && (n_slots > self.a.capacity()
-                || n_l > self.l_slots.capacity().min(self.lower.capacity())
-                || n_u > self.u_slots.capacity().min(self.upper.capacity())
+                || n_l > self.l_slots.capacity().min(self.lower.entries.capacity())
+                || n_u > self.u_slots.capacity().min(self.upper.entries.capacity())
                 || n_upd > self.updates.capacity())
         {
             return false;
@@ -284,7 +287,7 @@ impl CompiledLu {
         for k in 0..m {
             for i in k + 1..m {
                 if nz[i * m + k] {
-                    self.lower.push((i as u32, k as u32, slot[i * m + k]));
+                    self.lower.push(i as u32, k as u32, slot[i * m + k]);
                 }
             }
         }
@@ -292,7 +295,7 @@ impl CompiledLu {
         for j in (0..m).rev() {
             for i in 0..j {
                 if nz[i * m + j] {
-                    self.upper.push((i as u32, j as u32, slot[i * m + j]));
+                    self.upper.push(i as u32, j as u32, slot[i * m + j]);
                 }
             }
         }

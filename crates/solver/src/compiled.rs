@@ -23,7 +23,7 @@
 //!   `a_ij −= l_ik·u_kj` of every `(i, j)` of `L`'s column `k` times `U`'s
 //!   row `k`, whose target slots are one precomputed stream.
 //!
-//! The result is copied into the `(row, column, value)` streams of the
+//! The result is copied into the column-run streams of the
 //! triangular sweeps ([`crate::lu::Factors`]), whose entries are fixed at
 //! compile time too.
 //!

@@ -140,6 +140,9 @@ struct Scratch {
     slot: Vec<u32>,
     rows: Vec<usize>,
     cols: Vec<usize>,
+    /// [`CompiledLu::compile`]: the ends of each pivot's rows of `L` and
+    /// columns of `U` in `rows` and `cols` (all pivots').
+    ends: Vec<(usize, usize)>,
     /// [`CompiledLu::choose_rows`]: the dense elimination, the rows
     /// taken, the order.
     dense: Vec<f64>,
@@ -195,21 +198,26 @@ impl CompiledLu {
                 nz[sc.row_pos[r] * m + sc.col_pos[j]] = true;
             }
         }
-        let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
+        let mut n_upd = 0;
+        // Each pivot's rows and columns are final when it is reached
+        // (only earlier pivots fill them): kept for the program below.
+        sc.rows.clear();
+        sc.cols.clear();
+        sc.ends.clear();
         for k in 0..m {
-            sc.rows.clear();
+            let (r0, c0) = (sc.rows.len(), sc.cols.len());
             sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
-            sc.cols.clear();
             sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
-            for &i in &sc.rows {
-                for &j in &sc.cols {
+            let (rows, cols) = (&sc.rows[r0..], &sc.cols[c0..]);
+            for &i in rows {
+                for &j in cols {
                     nz[i * m + j] = true;
                 }
             }
-            n_l += sc.rows.len();
-            n_u += sc.cols.len();
-            n_upd += sc.rows.len() * sc.cols.len();
+            n_upd += rows.len() * cols.len();
+            sc.ends.push((sc.rows.len(), sc.cols.len()));
         }
+        let (n_l, n_u) = (sc.rows.len(), sc.cols.len());
         let n_slots = nz.iter().filter(|&&z| z).count();
         if first {
             // Room for a later row order's program of up to twice the size.
@@ -264,32 +272,22 @@ impl CompiledLu {
         self.updates.clear();
         self.l_ptr.push(0);
         self.u_ptr.push(0);
-        for k in 0..m {
+        self.lower.clear();
+        let (mut r0, mut c0) = (0, 0);
+        for (k, &(r1, c1)) in sc.ends.iter().enumerate() {
             // A structurally zero pivot gets no slot: it never verifies,
             // faer reports the singularity.
             self.pivot.push(slot[k * m + k]);
-            sc.rows.clear();
-            sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
-            sc.cols.clear();
-            sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
-            self.l_slots
-                .extend(sc.rows.iter().map(|&i| slot[i * m + k]));
-            self.u_slots
-                .extend(sc.cols.iter().map(|&j| slot[k * m + j]));
-            for &i in &sc.rows {
-                self.updates
-                    .extend(sc.cols.iter().map(|&j| slot[i * m + j]));
+            let (rows, cols) = (&sc.rows[r0..r1], &sc.cols[c0..c1]);
+            (r0, c0) = (r1, c1);
+            self.l_slots.extend(rows.iter().map(|&i| slot[i * m + k]));
+            self.u_slots.extend(cols.iter().map(|&j| slot[k * m + j]));
+            for &i in rows {
+                self.updates.extend(cols.iter().map(|&j| slot[i * m + j]));
+                self.lower.push(i as u32, k as u32, slot[i * m + k]);
             }
             self.l_ptr.push(self.l_slots.len() as u32);
             self.u_ptr.push(self.u_slots.len() as u32);
-        }
-        self.lower.clear();
-        for k in 0..m {
-            for i in k + 1..m {
-                if nz[i * m + k] {
-                    self.lower.push(i as u32, k as u32, slot[i * m + k]);
-                }
-            }
         }
         self.upper.clear();
         for j in (0..m).rev() {

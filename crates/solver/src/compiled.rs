@@ -477,10 +477,25 @@ impl CompiledLu {
             for (x, &s) in u_row.iter_mut().zip(us) {
                 *x = a[s as usize];
             }
-            for (&s, targets) in ls.iter().zip(updates.chunks_exact(w)) {
+            // Two rows of `L` at a time, each value of the row of `U` read
+            // once for both (their targets differ: other rows).
+            let (pairs, last) = ls.as_chunks::<2>();
+            let (pair_updates, last_updates) = updates.split_at(pairs.len() * 2 * w);
+            for (&[s1, s2], targets) in pairs.iter().zip(pair_updates.chunks_exact(2 * w)) {
+                let l1 = a[s1 as usize] * inv;
+                a[s1 as usize] = l1;
+                let l2 = a[s2 as usize] * inv;
+                a[s2 as usize] = l2;
+                let (t1, t2) = targets.split_at(w);
+                for ((&d1, &d2), &u) in t1.iter().zip(t2).zip(u_row.iter()) {
+                    a[d1 as usize] -= l1 * u;
+                    a[d2 as usize] -= l2 * u;
+                }
+            }
+            if let [s] = *last {
                 let l = a[s as usize] * inv;
                 a[s as usize] = l;
-                for (&d, &u) in targets.iter().zip(u_row.iter()) {
+                for (&d, &u) in last_updates.iter().zip(u_row.iter()) {
                     a[d as usize] -= l * u;
                 }
             }

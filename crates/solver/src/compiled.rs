@@ -477,8 +477,31 @@ impl CompiledLu {
             for (x, &s) in u_row.iter_mut().zip(us) {
                 *x = a[s as usize];
             }
-            // Two rows of `L` at a time, each value of the row of `U` read
-            // once for both (their targets differ: other rows).
+            // Four, then two rows of `L` at a time, each value of the row
+            // of `U` read once for all (their targets differ: other rows).
+            let (quads, ls) = ls.as_chunks::<4>();
+            let (quad_updates, updates) = updates.split_at(quads.len() * 4 * w);
+            for (&[s1, s2, s3, s4], targets) in quads.iter().zip(quad_updates.chunks_exact(4 * w)) {
+                let l1 = a[s1 as usize] * inv;
+                a[s1 as usize] = l1;
+                let l2 = a[s2 as usize] * inv;
+                a[s2 as usize] = l2;
+                let l3 = a[s3 as usize] * inv;
+                a[s3 as usize] = l3;
+                let l4 = a[s4 as usize] * inv;
+                a[s4 as usize] = l4;
+                let (t1, t) = targets.split_at(w);
+                let (t2, t) = t.split_at(w);
+                let (t3, t4) = t.split_at(w);
+                for ((((&d1, &d2), &d3), &d4), &u) in
+                    t1.iter().zip(t2).zip(t3).zip(t4).zip(u_row.iter())
+                {
+                    a[d1 as usize] -= l1 * u;
+                    a[d2 as usize] -= l2 * u;
+                    a[d3 as usize] -= l3 * u;
+                    a[d4 as usize] -= l4 * u;
+                }
+            }
             let (pairs, last) = ls.as_chunks::<2>();
             let (pair_updates, last_updates) = updates.split_at(pairs.len() * 2 * w);
             for (&[s1, s2], targets) in pairs.iter().zip(pair_updates.chunks_exact(2 * w)) {

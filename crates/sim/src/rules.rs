@@ -212,7 +212,7 @@ pub(crate) struct Sink<'s, 'a>(pub(crate) &'s mut fbd_solver::JacobianSink<'a>);
 
 impl JacobianSink for Sink<'_, '_> {
     const ACTIVE: bool = true;
-    #[inline]
+    #[inline(always)]
     fn add(&mut self, row: usize, col: usize, v: f64) {
         self.0.add(row, col, v);
     }

@@ -16,13 +16,14 @@
 //! and `U` gets a slot in one dense-free value array, and the elimination
 //! becomes
 //!
-//! * a scatter of the Jacobian's values (CSC order) into their slots;
+//! * a copy of the Jacobian's values (CSC order) into the first slots,
+//!   in one block, and zeros into the fill-in's;
 //! * for each pivot `k`, in order: the pivot check, the scaling of `L`'s
 //!   column `k` by `1/u_kk`, and the rank-one update
 //!   `a_ij −= l_ik·u_kj` of every `(i, j)` of `L`'s column `k` times `U`'s
 //!   row `k`, whose target slots are one precomputed stream.
 //!
-//! The result is copied into the `(row, column, value)` streams of the
+//! The result is copied into the column-run streams of the
 //! triangular sweeps ([`crate::lu::Factors`]), whose entries are fixed at
 //! compile time too.
 //!
@@ -70,6 +71,8 @@
 //! 10 fallbacks avoided, the sweep's wall time 14 s → 12 s; the hexapod
 //! walk of `bench/peer`, 932 M → 869 M instructions.
 
+use crate::lu::Stream;
+
 /// The threshold of the pivot check: a pivot at least a hundredth of the
 /// largest entry of its column, which bounds `L`'s entries by 100. Measured
 /// (fallbacks / factorisations, `bench/peer`): the moving planar flight
@@ -95,8 +98,9 @@ pub const MAX_PERTURBED: usize = 8;
 pub(crate) struct CompiledLu {
     /// Dimension.
     m: usize,
-    /// Slot of each value of the reduced CSC structure.
-    scatter: Vec<u32>,
+    /// Number of values of the reduced CSC structure: value `e` has slot
+    /// `e`, the fill-in the slots after them.
+    values: usize,
     /// Slot of pivot `k`.
     pivot: Vec<u32>,
     /// `L`'s column `k` below the diagonal: `l_slots[l_ptr[k]..l_ptr[k+1]]`.
@@ -112,14 +116,16 @@ pub(crate) struct CompiledLu {
     slots: usize,
     /// The value array.
     a: Vec<f64>,
+    /// Scratch of [`Self::factor`]: `U`'s row `k` right of the diagonal,
+    /// the values (as long as the longest row).
+    u_row: Vec<f64>,
     /// The pivot row order: reduced row of pivot position `i`.
     pub(crate) row_perm: Vec<usize>,
-    /// The forward sweep's stream `(row, column, slot)`, `L`'s columns in
-    /// order.
-    pub(crate) lower: Vec<(u32, u32, u32)>,
-    /// The backward sweep's stream `(row, column, slot)`, `U`'s columns
-    /// last first, entries above the diagonal.
-    pub(crate) upper: Vec<(u32, u32, u32)>,
+    /// The forward sweep's stream of slots, `L`'s columns in order.
+    pub(crate) lower: Stream<u32>,
+    /// The backward sweep's stream of slots, `U`'s columns last first,
+    /// entries above the diagonal.
+    pub(crate) upper: Stream<u32>,
     /// Scratch of [`Self::compile`] and [`Self::choose_rows`], released
     /// after the compilation.
     scratch: Scratch,
@@ -134,6 +140,9 @@ struct Scratch {
     slot: Vec<u32>,
     rows: Vec<usize>,
     cols: Vec<usize>,
+    /// [`CompiledLu::compile`]: the ends of each pivot's rows of `L` and
+    /// columns of `U` in `rows` and `cols` (all pivots').
+    ends: Vec<(usize, usize)>,
     /// [`CompiledLu::choose_rows`]: the dense elimination, the rows
     /// taken, the order.
     dense: Vec<f64>,
@@ -189,63 +198,72 @@ impl CompiledLu {
                 nz[sc.row_pos[r] * m + sc.col_pos[j]] = true;
             }
         }
-        let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
+        let mut n_upd = 0;
+        // Each pivot's rows and columns are final when it is reached
+        // (only earlier pivots fill them): kept for the program below.
+        sc.rows.clear();
+        sc.cols.clear();
+        sc.ends.clear();
         for k in 0..m {
-            sc.rows.clear();
+            let (r0, c0) = (sc.rows.len(), sc.cols.len());
             sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
-            sc.cols.clear();
             sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
-            for &i in &sc.rows {
-                for &j in &sc.cols {
+            let (rows, cols) = (&sc.rows[r0..], &sc.cols[c0..]);
+            for &i in rows {
+                for &j in cols {
                     nz[i * m + j] = true;
                 }
             }
-            n_l += sc.rows.len();
-            n_u += sc.cols.len();
-            n_upd += sc.rows.len() * sc.cols.len();
+            n_upd += rows.len() * cols.len();
+            sc.ends.push((sc.rows.len(), sc.cols.len()));
         }
+        let (n_l, n_u) = (sc.rows.len(), sc.cols.len());
         let n_slots = nz.iter().filter(|&&z| z).count();
         if first {
             // Room for a later row order's program of up to twice the size.
             let dense = m * m;
             self.a.reserve(2 * n_slots.min(dense));
             self.l_slots.reserve(2 * n_l.min(dense));
-            self.lower.reserve(2 * n_l.min(dense));
+            self.lower.entries.reserve(2 * n_l.min(dense));
+            self.lower.runs.reserve(m);
             self.u_slots.reserve(2 * n_u.min(dense));
-            self.upper.reserve(2 * n_u.min(dense));
+            self.upper.entries.reserve(2 * n_u.min(dense));
+            self.upper.runs.reserve(m);
             self.updates.reserve(2 * n_upd.min(dense * m));
-            self.scatter.reserve(row_idx.len());
             self.pivot.reserve(m);
             self.l_ptr.reserve(m + 1);
             self.u_ptr.reserve(m + 1);
+            self.u_row.reserve(m);
             self.row_perm.reserve(m);
         } else if !grow
             && (n_slots > self.a.capacity()
-                || n_l > self.l_slots.capacity().min(self.lower.capacity())
-                || n_u > self.u_slots.capacity().min(self.upper.capacity())
+                || n_l > self.l_slots.capacity().min(self.lower.entries.capacity())
+                || n_u > self.u_slots.capacity().min(self.upper.entries.capacity())
                 || n_upd > self.updates.capacity())
         {
             return false;
         }
         self.m = m;
-        // Slots, row-major.
+        // Slots: the values' in their CSC order (a factorisation copies
+        // them in one block), then the fill-in's, row-major.
         let slot = &mut sc.slot;
+        slot.clear();
+        slot.resize(m * m, u32::MAX);
         let mut slots = 0u32;
-        for (s, &z) in slot.iter_mut().zip(nz.iter()) {
-            *s = if z {
-                slots += 1;
-                slots - 1
-            } else {
-                u32::MAX
-            };
-        }
-        self.slots = slots as usize;
-        self.scatter.clear();
         for j in 0..m {
             for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                self.scatter.push(slot[sc.row_pos[r] * m + sc.col_pos[j]]);
+                slot[sc.row_pos[r] * m + sc.col_pos[j]] = slots;
+                slots += 1;
             }
         }
+        self.values = slots as usize;
+        for (s, &z) in slot.iter_mut().zip(nz.iter()) {
+            if z && *s == u32::MAX {
+                *s = slots;
+                slots += 1;
+            }
+        }
+        self.slots = slots as usize;
         self.pivot.clear();
         self.l_ptr.clear();
         self.l_slots.clear();
@@ -254,38 +272,28 @@ impl CompiledLu {
         self.updates.clear();
         self.l_ptr.push(0);
         self.u_ptr.push(0);
-        for k in 0..m {
+        self.lower.clear();
+        let (mut r0, mut c0) = (0, 0);
+        for (k, &(r1, c1)) in sc.ends.iter().enumerate() {
             // A structurally zero pivot gets no slot: it never verifies,
             // faer reports the singularity.
             self.pivot.push(slot[k * m + k]);
-            sc.rows.clear();
-            sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
-            sc.cols.clear();
-            sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
-            self.l_slots
-                .extend(sc.rows.iter().map(|&i| slot[i * m + k]));
-            self.u_slots
-                .extend(sc.cols.iter().map(|&j| slot[k * m + j]));
-            for &i in &sc.rows {
-                self.updates
-                    .extend(sc.cols.iter().map(|&j| slot[i * m + j]));
+            let (rows, cols) = (&sc.rows[r0..r1], &sc.cols[c0..c1]);
+            (r0, c0) = (r1, c1);
+            self.l_slots.extend(rows.iter().map(|&i| slot[i * m + k]));
+            self.u_slots.extend(cols.iter().map(|&j| slot[k * m + j]));
+            for &i in rows {
+                self.updates.extend(cols.iter().map(|&j| slot[i * m + j]));
+                self.lower.push(i as u32, k as u32, slot[i * m + k]);
             }
             self.l_ptr.push(self.l_slots.len() as u32);
             self.u_ptr.push(self.u_slots.len() as u32);
-        }
-        self.lower.clear();
-        for k in 0..m {
-            for i in k + 1..m {
-                if nz[i * m + k] {
-                    self.lower.push((i as u32, k as u32, slot[i * m + k]));
-                }
-            }
         }
         self.upper.clear();
         for j in (0..m).rev() {
             for i in 0..j {
                 if nz[i * m + j] {
-                    self.upper.push((i as u32, j as u32, slot[i * m + j]));
+                    self.upper.push(i as u32, j as u32, slot[i * m + j]);
                 }
             }
         }
@@ -293,6 +301,9 @@ impl CompiledLu {
         self.row_perm.extend_from_slice(row_perm);
         self.a.clear();
         self.a.resize(self.slots, 0.0);
+        let widest = self.u_ptr.windows(2).map(|p| p[1] - p[0]).max();
+        self.u_row.clear();
+        self.u_row.resize(widest.unwrap_or(0) as usize, 0.0);
         // The scratch (dense m × m arrays) is not needed again: a pattern
         // is compiled once.
         self.scratch = Scratch::default();
@@ -413,10 +424,9 @@ impl CompiledLu {
     ) -> Result<(), PivotFailed> {
         perturbed.clear();
         let a = &mut self.a[..self.slots];
-        a.fill(0.0);
-        for (&s, &v) in self.scatter.iter().zip(values) {
-            a[s as usize] = v;
-        }
+        let (given, fill) = a.split_at_mut(self.values);
+        given.copy_from_slice(&values[..self.values]);
+        fill.fill(0.0);
         let mut t = 0usize;
         for (k, (&ps, inv_k)) in self.pivot.iter().zip(pivot_inv.iter_mut()).enumerate() {
             if ps == u32::MAX {
@@ -453,13 +463,64 @@ impl CompiledLu {
             let inv = p.recip();
             *inv_k = inv;
             let w = us.len();
-            for &s in ls {
+            let updates = &self.updates[t..t + ls.len() * w];
+            t += updates.len();
+            if w == 0 {
+                for &s in ls {
+                    a[s as usize] *= inv;
+                }
+                continue;
+            }
+            // `U`'s row `k` read once: the updates of pivot `k` target
+            // rows below it only.
+            let u_row = &mut self.u_row[..w];
+            for (x, &s) in u_row.iter_mut().zip(us) {
+                *x = a[s as usize];
+            }
+            // Four, then two rows of `L` at a time, each value of the row
+            // of `U` read once for all (their targets differ: other rows).
+            let (quads, ls) = ls.as_chunks::<4>();
+            let (quad_updates, updates) = updates.split_at(quads.len() * 4 * w);
+            for (&[s1, s2, s3, s4], targets) in quads.iter().zip(quad_updates.chunks_exact(4 * w)) {
+                let l1 = a[s1 as usize] * inv;
+                a[s1 as usize] = l1;
+                let l2 = a[s2 as usize] * inv;
+                a[s2 as usize] = l2;
+                let l3 = a[s3 as usize] * inv;
+                a[s3 as usize] = l3;
+                let l4 = a[s4 as usize] * inv;
+                a[s4 as usize] = l4;
+                let (t1, t) = targets.split_at(w);
+                let (t2, t) = t.split_at(w);
+                let (t3, t4) = t.split_at(w);
+                for ((((&d1, &d2), &d3), &d4), &u) in
+                    t1.iter().zip(t2).zip(t3).zip(t4).zip(u_row.iter())
+                {
+                    a[d1 as usize] -= l1 * u;
+                    a[d2 as usize] -= l2 * u;
+                    a[d3 as usize] -= l3 * u;
+                    a[d4 as usize] -= l4 * u;
+                }
+            }
+            let (pairs, last) = ls.as_chunks::<2>();
+            let (pair_updates, last_updates) = updates.split_at(pairs.len() * 2 * w);
+            for (&[s1, s2], targets) in pairs.iter().zip(pair_updates.chunks_exact(2 * w)) {
+                let l1 = a[s1 as usize] * inv;
+                a[s1 as usize] = l1;
+                let l2 = a[s2 as usize] * inv;
+                a[s2 as usize] = l2;
+                let (t1, t2) = targets.split_at(w);
+                for ((&d1, &d2), &u) in t1.iter().zip(t2).zip(u_row.iter()) {
+                    a[d1 as usize] -= l1 * u;
+                    a[d2 as usize] -= l2 * u;
+                }
+            }
+            if let [s] = *last {
                 let l = a[s as usize] * inv;
                 a[s as usize] = l;
-                for (&u, &d) in us.iter().zip(&self.updates[t..t + w]) {
-                    a[d as usize] -= l * a[u as usize];
+                for (&d, &u) in last_updates.iter().zip(u_row.iter()) {
+                    a[d as usize] -= l * u;
                 }
-                t += w;
             }
         }
         Ok(())

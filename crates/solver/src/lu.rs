@@ -50,17 +50,19 @@
 //!   [`simplicial::factorize_simplicial_numeric_lu`], called on a
 //!   [`SimplicialLu`] owned here, so that its `L` and `U` factors are at
 //!   hand. After each factorisation both factors are copied once into two
-//!   streams of `(row, column, value)` entries, `L`'s below its unit
-//!   diagonal column after column and `U`'s above its diagonal, divided by
-//!   their column's pivot, last column first ([`Factors::factor`]). The
-//!   Newton step `J Δx = −r` is then the row permutation, one pass
-//!   `w[i] −= v·w[j]` over each stream, and the column permutation with the
-//!   reciprocal pivots ([`Factors::solve`]) — the arithmetic of faer's
+//!   streams of `(row, value)` entries in column runs ([`Stream`]), `L`'s
+//!   below its unit diagonal column after column and `U`'s above its
+//!   diagonal, divided by their column's pivot, last column first
+//!   ([`Factors::factor`]). The Newton step `J Δx = −r` is then the row
+//!   permutation, one pass `w[i] −= v·w[j]` over each stream (`w[j]` read
+//!   once per column run), and the column permutation with the reciprocal
+//!   pivots ([`Factors::solve`]) — the arithmetic of faer's
 //!   `solve_in_place_with_conj` in the same order, without its per-column
 //!   and generic multi-column machinery, which cost about twice as much on
-//!   these sizes; a single stream per sweep has no per-column loop either
-//!   (a chord step's solve of the moving flight's 15 unknowns: 2.5 k → 2.2 k
-//!   instructions, for about 1.7 k more per factorisation).
+//!   these sizes (a chord step's solve of the moving flight's 15 unknowns
+//!   with one `(row, column, value)` stream per sweep: 2.5 k → 2.2 k
+//!   instructions, for about 1.7 k more per factorisation; the column runs
+//!   then saved another 3.5 % of the 3D drop's solve instructions).
 //!   It matters because a chord step (a step with a kept factorisation) is
 //!   one residual and one solve, and most steps are chord steps.
 //! * The pattern's structure is kept as faer's checked
@@ -189,12 +191,27 @@ pub(crate) const MAX_PROGRAMS: usize = 8;
 /// 3D drop of `bench/peer`, 830 of the 831 factorisations that left the
 /// compiled program had other zeros than the values it was compiled on.
 fn zero_signature(values: &[f64]) -> u64 {
+    let mix = |h: u64, i: usize| {
+        (h ^ (i as u64 + 1))
+            .wrapping_mul(0x0100_0000_01B3)
+            .rotate_left(17)
+    };
     let mut h = 0x9E37_79B9_7F4A_7C15u64;
-    for (i, &v) in values.iter().enumerate() {
+    // Most values are not zero: a block of eight without one is passed
+    // by one test.
+    let (blocks, rest) = values.as_chunks::<8>();
+    for (b, block) in blocks.iter().enumerate() {
+        if block.iter().fold(false, |z, &v| z | (v == 0.0)) {
+            for (k, &v) in block.iter().enumerate() {
+                if v == 0.0 {
+                    h = mix(h, 8 * b + k);
+                }
+            }
+        }
+    }
+    for (k, &v) in rest.iter().enumerate() {
         if v == 0.0 {
-            h = (h ^ (i as u64 + 1))
-                .wrapping_mul(0x0100_0000_01B3)
-                .rotate_left(17);
+            h = mix(h, 8 * blocks.len() + k);
         }
     }
     h
@@ -365,6 +382,44 @@ impl Pattern {
     }
 }
 
+/// A triangular sweep's entries `(row i, value v)` column after column in
+/// the sweep's order, each column's a run: the sweep is `w[i] −= v·w[j]`
+/// for every entry of column `j`'s run, `w[j]` read once per run (it is
+/// final then: no entry of its run has row `j`).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Stream<T> {
+    /// `(column j, end)` of each run: column `j`'s entries are
+    /// `entries[end of the previous run..end]`; non-empty columns only.
+    pub(crate) runs: Vec<(u32, u32)>,
+    pub(crate) entries: Vec<(u32, T)>,
+}
+
+impl<T> Stream<T> {
+    /// Room for `columns` runs of `entries` entries in all.
+    pub(crate) fn with_capacity(columns: usize, entries: usize) -> Self {
+        Self {
+            runs: Vec::with_capacity(columns),
+            entries: Vec::with_capacity(entries),
+        }
+    }
+
+    pub(crate) fn clear(&mut self) {
+        self.runs.clear();
+        self.entries.clear();
+    }
+
+    /// Appends entry `(i, v)` of column `j`: to the last run when it is
+    /// column `j`'s (a column's entries must be pushed together).
+    pub(crate) fn push(&mut self, i: u32, j: u32, v: T) {
+        self.entries.push((i, v));
+        let end = self.entries.len() as u32;
+        match self.runs.last_mut() {
+            Some((c, e)) if *c == j => *e = end,
+            _ => self.runs.push((j, end)),
+        }
+    }
+}
+
 /// Numeric LU storage for the reduced patterns of one dimension: faer's
 /// simplicial `L`, `U` and row pivoting of the last factorisation, `U`
 /// scaled for the solves, and the scratch of the solves.
@@ -379,13 +434,12 @@ pub(crate) struct Factors {
     row_src: Vec<usize>,
     /// `1 / U[j, j]` of the last factorisation.
     pivot_inv: Vec<f64>,
-    /// `L`'s entries below its unit diagonal as `(row, column, value)`,
-    /// column after column: the forward sweep in one stream.
-    lower: Vec<(u32, u32, f64)>,
+    /// `L`'s entries below its unit diagonal, column after column: the
+    /// forward sweep in one stream.
+    lower: Stream<f64>,
     /// `U`'s entries above its diagonal divided by their column's pivot,
-    /// as `(row, column, value)`, last column first: the backward sweep in
-    /// one stream.
-    upper: Vec<(u32, u32, f64)>,
+    /// last column first: the backward sweep in one stream.
+    upper: Stream<f64>,
     /// Scratch of [`Self::solve`].
     work: Vec<f64>,
     /// The compiled factorisation's perturbed pivots `(position, δ)`
@@ -434,8 +488,8 @@ impl Factors {
             row_perm_inv: vec![0; n],
             row_src: vec![0; n],
             pivot_inv: vec![0.0; n],
-            lower: Vec::with_capacity(n * n.saturating_sub(1) / 2),
-            upper: Vec::with_capacity(n * n.saturating_sub(1) / 2),
+            lower: Stream::with_capacity(n, n * n.saturating_sub(1) / 2),
+            upper: Stream::with_capacity(n, n * n.saturating_sub(1) / 2),
             work: vec![0.0; n],
             perturbed: Vec::with_capacity(MAX_PERTURBED),
             wood_w: Vec::with_capacity((MAX_PERTURBED + 1) * n),
@@ -582,20 +636,26 @@ impl Factors {
                 // The sweeps' streams: fixed entries, this factorisation's
                 // values (`U`'s divided by their column's pivot).
                 self.lower.clear();
-                self.lower.extend(
+                self.lower.runs.extend_from_slice(&program.lower.runs);
+                self.lower.entries.extend(
                     program
                         .lower
+                        .entries
                         .iter()
-                        .map(|&(i, j, s)| (i, j, program.value(s))),
+                        .map(|&(i, s)| (i, program.value(s))),
                 );
                 self.upper.clear();
-                let pivot_inv = &self.pivot_inv;
-                self.upper.extend(
-                    program
-                        .upper
-                        .iter()
-                        .map(|&(i, j, s)| (i, j, program.value(s) * pivot_inv[j as usize])),
-                );
+                self.upper.runs.extend_from_slice(&program.upper.runs);
+                let mut start = 0;
+                for &(j, end) in &program.upper.runs {
+                    let p = self.pivot_inv[j as usize];
+                    self.upper.entries.extend(
+                        program.upper.entries[start..end as usize]
+                            .iter()
+                            .map(|&(i, s)| (i, program.value(s) * p)),
+                    );
+                    start = end as usize;
+                }
                 let fwd = pattern.col_perm.arrays().0;
                 let ok = self.perturbed.is_empty()
                     || self.woodbury(
@@ -658,7 +718,7 @@ impl Factors {
             for j in 0..n {
                 let (start, end) = (l_ptr[j] + 1, l_ptr[j + 1]);
                 for (&i, &v) in l_row[start..end].iter().zip(&l_val[start..end]) {
-                    self.lower.push((i as u32, j as u32, v));
+                    self.lower.push(i as u32, j as u32, v);
                 }
                 self.pivot_inv[j] = u_val[u_ptr[j + 1] - 1].recip();
             }
@@ -666,7 +726,7 @@ impl Factors {
                 let (start, diag) = (u_ptr[j], u_ptr[j + 1] - 1);
                 let pivot_inv = self.pivot_inv[j];
                 for (&i, &v) in u_row[start..diag].iter().zip(&u_val[start..diag]) {
-                    self.upper.push((i as u32, j as u32, v * pivot_inv));
+                    self.upper.push(i as u32, j as u32, v * pivot_inv);
                 }
             }
             // A set of zeros gets its program at its second fallback: most
@@ -764,12 +824,7 @@ impl Factors {
     /// start, they come from the columns before it), then `U D⁻¹`, last
     /// column first (`w[j]` is final, unscaled, when column `j`'s updates
     /// start), then the reciprocal pivots.
-    fn sweep(
-        lower: &[(u32, u32, f64)],
-        upper: &[(u32, u32, f64)],
-        pivot_inv: &[f64],
-        w: &mut [f64],
-    ) {
+    fn sweep(lower: &Stream<f64>, upper: &Stream<f64>, pivot_inv: &[f64], w: &mut [f64]) {
         Self::sweep_unscaled(lower, upper, w);
         for (wj, &p) in w.iter_mut().zip(pivot_inv) {
             *wj *= p;
@@ -778,12 +833,17 @@ impl Factors {
 
     /// [`Self::sweep`] without the reciprocal pivots: `w ← U⁻¹·L⁻¹·w`
     /// scaled by the pivots, `(D·M⁻¹)·w`.
-    fn sweep_unscaled(lower: &[(u32, u32, f64)], upper: &[(u32, u32, f64)], w: &mut [f64]) {
-        for &(i, j, v) in lower {
-            w[i as usize] -= v * w[j as usize];
-        }
-        for &(i, j, v) in upper {
-            w[i as usize] -= v * w[j as usize];
+    fn sweep_unscaled(lower: &Stream<f64>, upper: &Stream<f64>, w: &mut [f64]) {
+        for stream in [lower, upper] {
+            let mut start = 0;
+            for &(j, end) in &stream.runs {
+                // Final when column `j`'s updates start (see `Self::sweep`).
+                let wj = w[j as usize];
+                for &(i, v) in &stream.entries[start..end as usize] {
+                    w[i as usize] -= v * wj;
+                }
+                start = end as usize;
+            }
         }
     }
 
@@ -791,21 +851,62 @@ impl Factors {
     /// (`w[position·c + column]`): [`Self::sweep`] with each stream entry
     /// read once for all of them.
     fn sweep_many(
-        lower: &[(u32, u32, f64)],
-        upper: &[(u32, u32, f64)],
+        lower: &Stream<f64>,
+        upper: &Stream<f64>,
         pivot_inv: &[f64],
         w: &mut [f64],
         c: usize,
     ) {
-        for &(i, j, v) in lower.iter().chain(upper) {
-            let (i, j) = (i as usize * c, j as usize * c);
-            for t in 0..c {
-                w[i + t] -= v * w[j + t];
+        // `c` is the number of perturbed pivots plus one: a fixed width
+        // per call, so that each entry's row update is unrolled.
+        match c {
+            1 => Self::sweep_rows::<1>(lower, upper, w),
+            2 => Self::sweep_rows::<2>(lower, upper, w),
+            3 => Self::sweep_rows::<3>(lower, upper, w),
+            4 => Self::sweep_rows::<4>(lower, upper, w),
+            5 => Self::sweep_rows::<5>(lower, upper, w),
+            6 => Self::sweep_rows::<6>(lower, upper, w),
+            7 => Self::sweep_rows::<7>(lower, upper, w),
+            8 => Self::sweep_rows::<8>(lower, upper, w),
+            9 => Self::sweep_rows::<9>(lower, upper, w),
+            _ => {
+                for stream in [lower, upper] {
+                    let mut start = 0;
+                    for &(j, end) in &stream.runs {
+                        let j = j as usize * c;
+                        for &(i, v) in &stream.entries[start..end as usize] {
+                            let i = i as usize * c;
+                            for t in 0..c {
+                                w[i + t] -= v * w[j + t];
+                            }
+                        }
+                        start = end as usize;
+                    }
+                }
             }
         }
         for (row, &p) in w.chunks_exact_mut(c).zip(pivot_inv) {
             for x in row {
                 *x *= p;
+            }
+        }
+    }
+
+    /// The sweeps of [`Self::sweep_many`] for `C` right-hand sides: the
+    /// same operations, column `j`'s `C` values read once for its run
+    /// (final then, see [`Self::sweep`]).
+    fn sweep_rows<const C: usize>(lower: &Stream<f64>, upper: &Stream<f64>, w: &mut [f64]) {
+        let (rows, _) = w.as_chunks_mut::<C>();
+        for stream in [lower, upper] {
+            let mut start = 0;
+            for &(j, end) in &stream.runs {
+                let src = rows[j as usize];
+                for &(i, v) in &stream.entries[start..end as usize] {
+                    for (x, s) in rows[i as usize].iter_mut().zip(src) {
+                        *x -= v * s;
+                    }
+                }
+                start = end as usize;
             }
         }
     }

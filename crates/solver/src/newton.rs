@@ -351,6 +351,8 @@ impl NewtonSolver {
         assert!(x.len() == n && r.len() == n, "x and r must have length {n}");
         let mut entries = Vec::new();
         sys.pattern(&mut entries);
+        // Slots below `u32::MAX`, the mark of an entry outside the pattern.
+        assert!(n * n < u32::MAX as usize, "dimension {n} too large");
         let mut slot = vec![u32::MAX; n * n];
         for &(row, col) in &entries {
             assert!(

@@ -49,13 +49,21 @@ impl JacobianSink<'_> {
     ///
     /// # Panics
     /// If `(row, col)` is not in the pattern (a bug in the system).
-    #[inline]
+    #[inline(always)]
     pub fn add(&mut self, row: usize, col: usize, v: f64) {
         let s = self.slot[row * self.n + col];
-        assert!(
-            s != u32::MAX,
-            "Jacobian entry ({row}, {col}) is not in the declared pattern"
-        );
-        self.values[s as usize] += v;
+        // One check for both failures: an entry outside the pattern has
+        // slot `u32::MAX`, beyond the values (fewer than `u32::MAX`: see
+        // `Pattern::build` and `NewtonSolver::dense_jacobian`).
+        match self.values.get_mut(s as usize) {
+            Some(x) => *x += v,
+            None => not_in_pattern(row, col),
+        }
     }
+}
+
+#[cold]
+#[inline(never)]
+fn not_in_pattern(row: usize, col: usize) -> ! {
+    panic!("Jacobian entry ({row}, {col}) is not in the declared pattern")
 }

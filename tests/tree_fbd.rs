@@ -22,25 +22,15 @@ use std::path::Path;
 
 use fbd_contact::spatial::frame;
 use fbd_contact::{SpatialState, Surface, Terrain};
+use fbd_dynamics::check::{check_step, dense_jacobian};
 use fbd_dynamics::spatial::{SpatialContactEquation, SpatialMechanism};
 use fbd_dynamics::tree::assemble as tree;
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism, contacts_by_kind};
 use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
 use fbd_kinematics::LimitSide;
-use fbd_kinematics::fd::{FdTolerance, check_jacobian, check_pattern};
+use fbd_kinematics::fd::FdTolerance;
 use fbd_robot::{ContactChoice, RobotModel, Up};
 use fbd_sim::spatial::SpatialParams;
-
-struct Dense<'a> {
-    n: usize,
-    m: &'a mut [f64],
-}
-impl JacobianSink for Dense<'_> {
-    const ACTIVE: bool = true;
-    fn add(&mut self, r: usize, c: usize, v: f64) {
-        self.m[r * self.n + c] += v;
-    }
-}
 
 /// A small deterministic generator (uniform in [−1, 1)).
 struct Rng(u64);
@@ -218,30 +208,20 @@ fn check_lab(first_step: bool, contact: bool, complementarity: bool, limits_at: 
             z[dims.contact_force(c, 1)] = 1e5 * (1.0 + rng.next().abs());
         }
     }
-    let mut r = vec![0.0; n];
-    let mut jac = vec![0.0; n * n];
-    fbd_dynamics::eval(
-        &mech,
-        &surface,
-        &mut data,
-        &z,
-        &mut r,
-        &mut Dense { n, m: &mut jac },
-    );
-    let mut entries = Vec::new();
-    fbd_dynamics::pattern(&mech, &surface, &data, &mut entries);
-    check_pattern(n, n, &entries, |i, j| jac[i * n + j]).unwrap_or_else(|e| panic!("{e}"));
+    let jac = dense_jacobian(&mech, &surface, &mut data, &z);
     // Every body row has its q[k+1] columns: the dynamics are coupled.
     for b in 0..dims.bodies {
         let row = dims.body_row(b);
         assert!((0..nq).any(|j| jac[row * n + j] != 0.0), "body {b}");
     }
-    let mut work = data.clone();
-    check_jacobian(
+    // The declared pattern covers every entry, each equal to the residual's
+    // central differences.
+    check_step(
+        &mech,
+        &surface,
+        &data,
         &z,
-        n,
-        |x, out| fbd_dynamics::eval(&mech, &surface, &mut work, x, out, &mut NoJacobian),
-        |i, j| jac[i * n + j],
+        &jac,
         FdTolerance {
             step: 1e-6,
             rel: 1e-6,

@@ -60,6 +60,7 @@
 pub mod assemble;
 pub mod assembly;
 pub mod body;
+pub mod check;
 pub mod mechanism;
 pub mod rows;
 pub mod space;

@@ -10,26 +10,15 @@
 
 use fbd_contact::spatial::frame;
 use fbd_contact::{SpatialState, Surface, Terrain};
+use fbd_dynamics::check::{check_step, dense_jacobian};
 use fbd_dynamics::spatial::SpatialContactEquation;
 use fbd_dynamics::tree::assemble::{prepare_step, set_configuration, set_previous};
 use fbd_dynamics::tree::{TreeFbdData, TreeMechanism, contacts_by_kind};
-use fbd_dynamics::{History, JacobianSink, LimitEquation, LimitState, NoJacobian};
-use fbd_dynamics::{eval, pattern};
-use fbd_kinematics::fd::{FdTolerance, check_jacobian, check_pattern};
+use fbd_dynamics::{History, LimitEquation, LimitState};
+use fbd_kinematics::fd::FdTolerance;
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::{Joint, JointLimits, LimitSide};
 use fbd_robot::dh::{HexapodLayout, HexapodMasses, hexapod};
-
-struct Dense<'a> {
-    n: usize,
-    m: &'a mut [f64],
-}
-impl JacobianSink for Dense<'_> {
-    const ACTIVE: bool = true;
-    fn add(&mut self, r: usize, c: usize, v: f64) {
-        self.m[r * self.n + c] += v;
-    }
-}
 
 /// The hexapod of `legs` with every contact point (tips, knees, hips, in
 /// the simulator's order) and the default joint limits.
@@ -156,16 +145,7 @@ fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementar
             z[lay.contact_force(c, 1)] = 2e6 * (1.0 + 0.1 * c as f64);
         }
     }
-    let mut r = vec![0.0; n];
-    let mut jac = vec![0.0; n * n];
-    eval(
-        &mech,
-        surface,
-        &mut data,
-        &z,
-        &mut r,
-        &mut Dense { n, m: &mut jac },
-    );
+    let jac = dense_jacobian(&mech, surface, &mut data, &z);
     if complementarity && limits_at {
         // Both branches of the stops: held and unloaded.
         let at: Vec<bool> = (0..data.limit.len())
@@ -189,16 +169,14 @@ fn check_rows(surface: &Surface, first_step: bool, limits_at: bool, complementar
             assert!(b.iter().any(want), "a branch is not visited: {b:?}");
         }
     }
-    // The declared pattern covers every non-zero entry.
-    let mut entries = Vec::new();
-    pattern(&mech, surface, &data, &mut entries);
-    check_pattern(n, n, &entries, |i, j| jac[i * n + j]).unwrap_or_else(|e| panic!("{e}"));
-    let mut work = data.clone();
-    check_jacobian(
+    // The declared pattern covers every non-zero entry, each equal to the
+    // residual's central differences.
+    check_step(
+        &mech,
+        surface,
+        &data,
         &z,
-        n,
-        |x, out| eval(&mech, surface, &mut work, x, out, &mut NoJacobian),
-        |i, j| jac[i * n + j],
+        &jac,
         FdTolerance {
             step: 1e-6,
             rel: 1e-6,

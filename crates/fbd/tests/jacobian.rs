@@ -5,24 +5,14 @@
 //! and the contact frames tilt with the ground).
 
 use fbd_contact::{ContactState, Terrain};
+use fbd_dynamics::check::{check_step, dense_jacobian};
 use fbd_dynamics::mechanism::ContactPoints;
 use fbd_dynamics::{
-    ContactEquation, FbdData, History, JacobianSink, LimitEquation, LimitState, Mechanism,
-    NoJacobian, TwoLegInertia, eval, pattern, prepare_step, set_configuration,
+    ContactEquation, FbdData, History, LimitEquation, LimitState, Mechanism, TwoLegInertia,
+    pattern, prepare_step, set_configuration,
 };
-use fbd_kinematics::fd::{FdTolerance, check_jacobian, check_pattern};
+use fbd_kinematics::fd::FdTolerance;
 use fbd_kinematics::planar::PlanarGeometry;
-
-struct Dense<'a> {
-    n: usize,
-    m: &'a mut [f64],
-}
-impl JacobianSink for Dense<'_> {
-    const ACTIVE: bool = true;
-    fn add(&mut self, r: usize, c: usize, v: f64) {
-        self.m[r * self.n + c] += v;
-    }
-}
 
 fn mechanism() -> Mechanism {
     let inertia = TwoLegInertia {
@@ -116,26 +106,15 @@ fn check_with_limits(
             }
         })
         .collect();
-    let mut r = vec![0.0; n];
-    let mut jm = vec![0.0; n * n];
-    eval(
+    // Every entry written must be in the declared pattern, and equal the
+    // residual's central differences.
+    let jm = dense_jacobian(&mech, terrain, &mut data, &z);
+    check_step(
         &mech,
         terrain,
-        &mut data,
+        &data,
         &z,
-        &mut r,
-        &mut Dense { n, m: &mut jm },
-    );
-    // Every entry written must be in the declared pattern.
-    let mut entries = Vec::new();
-    pattern(&mech, &Terrain::None, &data, &mut entries);
-    check_pattern(n, n, &entries, |i, j| jm[i * n + j]).unwrap_or_else(|e| panic!("{e}"));
-    let mut work = data.clone();
-    check_jacobian(
-        &z,
-        n,
-        |x, out| eval(&mech, terrain, &mut work, x, out, &mut NoJacobian),
-        |i, j| jm[i * n + j],
+        &jm,
         FdTolerance {
             rel: 1e-6,
             abs: 1e-4,

@@ -362,6 +362,8 @@ struct PathJoint {
 #[derive(Clone, Debug, PartialEq)]
 struct Leg {
     name: String,
+    /// Its foot: the index of the contact point in the model.
+    contact: usize,
     radius: f64,
     /// The contact point in its body's frame.
     local: Vector3<f64>,
@@ -691,6 +693,7 @@ impl GaitPlan {
             start.y = contact.radius;
             legs.push(Leg {
                 name: contact.name.clone(),
+                contact: f,
                 radius: contact.radius,
                 local: contact.position,
                 path,
@@ -754,6 +757,15 @@ impl GaitPlan {
     /// Number of legs (feet).
     pub fn leg_count(&self) -> usize {
         self.legs.len()
+    }
+
+    /// Leg `leg`'s foot: the index of its contact point in the model
+    /// (`feet[leg]` of [`GaitPlan::new`]).
+    ///
+    /// # Panics
+    /// For a leg index out of range.
+    pub fn foot_contact(&self, leg: usize) -> usize {
+        self.legs[leg].contact
     }
 
     /// The standing pose's joint angles `q0`.

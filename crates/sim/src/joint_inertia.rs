@@ -484,3 +484,55 @@ pub fn tree_modes_slower_than(
     let k = 0.5 * (k + k.transpose());
     Some(k.cholesky().is_some())
 }
+
+/// A set of poses of a robot for the stability rule of its joint
+/// controller: `poses(visit)` calls `visit(q, standing)` on each pose in
+/// order (the coordinates; the contact points standing on the ground,
+/// indices into `robot.contacts`) until `visit` returns `false`.
+pub type Poses<'a> = dyn Fn(&mut dyn FnMut(&[f64], &[usize]) -> bool) + 'a;
+
+/// Whether every pose of `poses` has every joint mode slower than a joint
+/// of inertia `inertia` ([`tree_modes_slower_than`]): `Some(false)` at
+/// the first pose with a faster one, `None` when a pose is undecided
+/// (a standing limb that is not a chain of three joints, or singular).
+pub fn poses_slower_than(robot: &RobotModel, poses: &Poses<'_>, inertia: f64) -> Option<bool> {
+    let mut work = ModeWork::new(robot);
+    let mut verdict = Some(true);
+    poses(
+        &mut |q, standing| match tree_modes_slower_than(robot, &mut work, q, standing, inertia) {
+            Some(true) => true,
+            Some(false) => {
+                verdict = Some(false);
+                false
+            }
+            None => {
+                verdict = None;
+                true
+            }
+        },
+    );
+    verdict
+}
+
+/// The smallest effective joint inertia over the poses of `poses` and its
+/// joint (an index into `robot.joints`), from the eigenvalues of each pose
+/// ([`fastest_mode`] on [`crate::robot::mass_matrix`] under
+/// [`tree_feet_jacobian`]); `(∞, 0)` without poses.
+pub fn fastest_mode_over(robot: &RobotModel, poses: &Poses<'_>) -> (f64, usize) {
+    let joints: Vec<usize> = (0..robot.joints.len())
+        .map(|j| fbd_dynamics::tree::kin::BASE_DOF + j)
+        .collect();
+    let (mut inertia, mut joint) = (f64::INFINITY, 0);
+    poses(&mut |q, standing| {
+        let mode = fastest_mode(
+            &crate::robot::mass_matrix(robot, q),
+            &tree_feet_jacobian(robot, standing, q),
+            &joints,
+        );
+        if mode.inertia < inertia {
+            (inertia, joint) = (mode.inertia, mode.joint);
+        }
+        true
+    });
+    (inertia, joint)
+}

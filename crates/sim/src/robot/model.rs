@@ -259,12 +259,24 @@ pub fn mass_matrix(robot: &RobotModel, q: &[f64]) -> DMatrix<f64> {
     m
 }
 
+/// Most gait times at which [`pd_stability`] evaluates the effective
+/// inertia (evenly spread over the run), as for the hexapod.
+const GAIT_POSES: usize = 200;
+
 /// The stability rule of the explicit joint torques
-/// ([`crate::rules::pd_stability`]) for a robot: the largest `kp` and `kd`
-/// of any joint must be stable on the smallest effective joint inertia of
-/// the free robot at `q0` ([`crate::joint_inertia::fastest_mode`]): a foot
-/// in the air swings on it. Errors name `control.kd` (or `control.kp`)
-/// with the largest stable value and the joint that moves most.
+/// ([`crate::rules::pd_stability`]) for a robot, the hexapod's rule: the
+/// largest `kp` and `kd` of any joint must be stable on the smallest
+/// effective joint inertia at the commanded poses ([`for_each_pose`]:
+/// the initial one and every target, each knot of a trajectory, with
+/// every contact point on the ground; a gait's joint targets along the
+/// run with its stance feet on the ground; without ground the free
+/// robot's). [`crate::joint_inertia::poses_slower_than`] decides it
+/// without eigenvalues where every standing limb is a chain of three
+/// joints; otherwise, or when it fails, the eigenvalues of every pose
+/// ([`crate::joint_inertia::fastest_mode_over`]) give the verdict and
+/// the error's inertia and joint. Errors name `control.kd` (or
+/// `control.kp`) with the largest stable value and the joint that moves
+/// most.
 fn pd_stability(robot: &RobotModel, p: &RobotParams) -> Result<(), SimError> {
     let (kp, kd) = match &p.control {
         RobotControl::None => return Ok(()),
@@ -277,14 +289,83 @@ fn pd_stability(robot: &RobotModel, p: &RobotParams) -> Result<(), SimError> {
     if robot.joints.is_empty() || (kp == 0.0 && kd == 0.0) {
         return Ok(());
     }
-    let m = mass_matrix(robot, &p.q0);
-    let joints: Vec<usize> = (BASE_DOF..BASE_DOF + robot.joints.len()).collect();
-    let mode = crate::joint_inertia::fastest_mode(&m, &DMatrix::zeros(0, m.ncols()), &joints);
+    let poses = |visit: &mut dyn FnMut(&[f64], &[usize]) -> bool| for_each_pose(robot, p, visit);
+    // A pose within round-off of the limit is left to the eigenvalues.
+    let limit = crate::rules::pd_inertia_limit(kp, kd, p.dt) * (1.0 + 1e-6);
+    if crate::joint_inertia::poses_slower_than(robot, &poses, limit) == Some(true) {
+        return Ok(());
+    }
+    let (inertia, joint) = crate::joint_inertia::fastest_mode_over(robot, &poses);
     crate::rules::pd_stability(
         kp,
         kd,
-        mode.inertia,
+        inertia,
         p.dt,
-        &format!("joint {}", robot.joints[mode.joint].name),
+        &format!("joint {}", robot.joints[joint].name),
     )
+}
+
+/// Calls `visit(q, standing)` on every pose of [`pd_stability`] in order
+/// (the coordinates; the contact points standing, indices into
+/// `robot.contacts`) until it returns `false`. Every pose keeps the root
+/// of `q0` (a rigid motion of the whole robot leaves its modes as they
+/// are).
+fn for_each_pose(
+    robot: &RobotModel,
+    p: &RobotParams,
+    visit: &mut dyn FnMut(&[f64], &[usize]) -> bool,
+) {
+    let ground = p.terrain.is_some();
+    let all: Vec<usize> = if ground {
+        (0..robot.contacts.len()).collect()
+    } else {
+        Vec::new()
+    };
+    let mut q = p.q0.clone();
+    if !visit(&q, &all) {
+        return;
+    }
+    match &p.control {
+        RobotControl::None => {}
+        RobotControl::Pd { target, .. } => {
+            q[BASE_DOF..].copy_from_slice(target);
+            visit(&q, &all);
+        }
+        RobotControl::Trajectory { trajectory, .. } => {
+            for angles in &trajectory.angles {
+                q[BASE_DOF..].copy_from_slice(angles);
+                if !visit(&q, &all) {
+                    return;
+                }
+            }
+        }
+        RobotControl::Gait { plan, .. } => {
+            let mut plan = (**plan).clone();
+            let n = robot.joints.len();
+            let (mut target, mut rate) = (vec![0.0; n], vec![0.0; n]);
+            let steps = (p.duration / p.dt).round() as usize + 1;
+            let stride = steps / GAIT_POSES + 1;
+            let mut standing = Vec::with_capacity(plan.leg_count());
+            for k in (0..steps).step_by(stride) {
+                let t = k as f64 * p.dt;
+                // A foot out of reach fails at that step of the run, with
+                // its own error.
+                if plan.targets(t, &mut target, &mut rate).is_err() {
+                    return;
+                }
+                standing.clear();
+                if ground {
+                    standing.extend(
+                        (0..plan.leg_count())
+                            .filter(|&l| plan.stance(l, t))
+                            .map(|l| plan.foot_contact(l)),
+                    );
+                }
+                q[BASE_DOF..].copy_from_slice(&target);
+                if !visit(&q, &standing) {
+                    return;
+                }
+            }
+        }
+    }
 }

@@ -2,7 +2,6 @@
 
 use super::params::{SpatialControl, SpatialParams};
 use crate::SimError;
-use crate::joint_inertia::{ModeWork, fastest_mode, tree_feet_jacobian, tree_modes_slower_than};
 use crate::rules::{check, positive};
 use fbd_contact::SpatialState;
 use fbd_dynamics::spatial::{SpatialInertia, SpatialMechanism, q_joint};
@@ -439,22 +438,7 @@ fn pd_stability(p: &SpatialParams, robot: &RobotModel) -> Result<(), SimError> {
 /// [`SpatialParams::robot_model`]): `Some(false)` at the first pose that
 /// has a faster one, `None` when a pose is undecided.
 pub fn modes_slower_than(p: &SpatialParams, robot: &RobotModel, inertia: f64) -> Option<bool> {
-    let mut work = ModeWork::new(robot);
-    let mut verdict = Some(true);
-    for_each_pose(p, robot, |q, standing| {
-        match tree_modes_slower_than(robot, &mut work, q, standing, inertia) {
-            Some(true) => true,
-            Some(false) => {
-                verdict = Some(false);
-                false
-            }
-            None => {
-                verdict = None;
-                true
-            }
-        }
-    });
-    verdict
+    crate::joint_inertia::poses_slower_than(robot, &|visit| for_each_pose(p, robot, visit), inertia)
 }
 
 /// Results of [`fastest_mode_over_poses`] kept in this process, keyed by
@@ -533,20 +517,7 @@ fn keep<T>(cache: &std::sync::Mutex<Vec<(SpatialParams, T)>>, key: SpatialParams
 /// eigenvalues of each pose ([`fastest_mode`] on the mass matrix of
 /// `robot`, the D-H instance of `p`).
 pub fn fastest_mode_over_poses(p: &SpatialParams, robot: &RobotModel) -> (f64, usize) {
-    let joints: Vec<usize> = (0..robot.joints.len()).map(|j| 6 + j).collect();
-    let (mut inertia, mut joint) = (f64::INFINITY, 0);
-    for_each_pose(p, robot, |q, standing| {
-        let mode = fastest_mode(
-            &crate::robot::mass_matrix(robot, q),
-            &tree_feet_jacobian(robot, standing, q),
-            &joints,
-        );
-        if mode.inertia < inertia {
-            (inertia, joint) = (mode.inertia, mode.joint);
-        }
-        true
-    });
-    (inertia, joint)
+    crate::joint_inertia::fastest_mode_over(robot, &|visit| for_each_pose(p, robot, visit))
 }
 
 /// Calls `visit(q, standing)` on every pose of [`pd_stability`] (the
@@ -556,7 +527,7 @@ pub fn fastest_mode_over_poses(p: &SpatialParams, robot: &RobotModel) -> (f64, u
 fn for_each_pose(
     p: &SpatialParams,
     robot: &RobotModel,
-    mut visit: impl FnMut(&[f64], &[usize]) -> bool,
+    visit: &mut dyn FnMut(&[f64], &[usize]) -> bool,
 ) {
     let nlegs = p.legs.len();
     // Each slot's foot among the contact points.

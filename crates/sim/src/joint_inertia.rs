@@ -536,3 +536,35 @@ pub fn fastest_mode_over(robot: &RobotModel, poses: &Poses<'_>) -> (f64, usize) 
     });
     (inertia, joint)
 }
+
+/// Most times of a gait at which the stability rule evaluates the
+/// effective inertia (evenly spread over the run).
+pub(crate) const GAIT_POSES: usize = 200;
+
+/// The stability rule of the explicit joint controller
+/// ([`crate::rules::pd_stability`]) at the commanded poses `poses` of any
+/// model on the tree equations: gains `kp`, `kd` (the largest of any
+/// joint) must be stable at step `dt` on the smallest effective joint
+/// inertia of every pose. [`poses_slower_than`] decides it without an
+/// eigenvalue, its limit raised by a relative 1e-6 so that a pose within
+/// round-off of it is left to the eigenvalues; when it does not pass,
+/// `fastest` gives the smallest inertia and its joint (an index into
+/// `robot.joints`: [`fastest_mode_over`], or a cached value of it), and
+/// `name` names that joint in the error.
+pub(crate) fn check_gains(
+    robot: &RobotModel,
+    poses: &Poses<'_>,
+    (kp, kd, dt): (f64, f64, f64),
+    fastest: impl FnOnce() -> (f64, usize),
+    name: impl FnOnce(usize) -> String,
+) -> Result<(), crate::SimError> {
+    if robot.joints.is_empty() || (kp == 0.0 && kd == 0.0) {
+        return Ok(());
+    }
+    let limit = crate::rules::pd_inertia_limit(kp, kd, dt) * (1.0 + 1e-6);
+    if poses_slower_than(robot, poses, limit) == Some(true) {
+        return Ok(());
+    }
+    let (inertia, joint) = fastest();
+    crate::rules::pd_stability(kp, kd, inertia, dt, &name(joint))
+}

@@ -168,13 +168,7 @@ impl PlanarParams {
             p.friction.mu_dynamic,
             &format!("0 ≤ mu_dynamic ≤ {}", p.friction.mu_static),
         )?;
-        check(
-            p.stride >= 1,
-            "output.stride",
-            "must be at least 1",
-            p.stride,
-            "an integer ≥ 1",
-        )?;
+        crate::rules::stride(p.stride)?;
         Ok(())
     }
 }
@@ -247,13 +241,7 @@ impl Model {
         let mech = Mechanism::in_plane(&robot, &contacts, p.gravity)
             .expect("the planar model lies in the plane");
         let index = two_leg_index(&mech);
-        check(
-            p.joint_limits.is_valid(),
-            "leg.theta2_deg",
-            "joint limits must be ranges [min, max] with min < max",
-            format!("{:?}", p.joint_limits),
-            "min < max",
-        )?;
+        crate::rules::joint_ranges(p.joint_limits.is_valid(), "leg.theta2_deg", &p.joint_limits)?;
         // Every joint whose range has a finite end gets a stop; the initial
         // angles must lie in the ranges.
         let mut limited = Vec::new();

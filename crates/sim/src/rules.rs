@@ -107,6 +107,46 @@ pub(crate) fn positive(key: &str, v: f64) -> Result<(), SimError> {
     )
 }
 
+/// A controller gain `key` (`control.kp`, `control.kd`): finite and not
+/// negative.
+pub(crate) fn gain(key: &str, v: f64) -> Result<(), SimError> {
+    check(
+        v.is_finite() && v >= 0.0,
+        key,
+        "must be finite and not negative",
+        v,
+        "a finite value ≥ 0",
+    )
+}
+
+/// `[output] stride` of every model: at least 1.
+pub(crate) fn stride(stride: usize) -> Result<(), SimError> {
+    check(
+        stride >= 1,
+        "output.stride",
+        "must be at least 1",
+        stride,
+        "an integer ≥ 1",
+    )
+}
+
+/// The joint limits of the paper's models (`limits`: whether each range
+/// `[min, max]` has `min < max`, and the ranges as written), named by
+/// `key`.
+pub(crate) fn joint_ranges(
+    valid: bool,
+    key: &str,
+    limits: &impl std::fmt::Debug,
+) -> Result<(), SimError> {
+    check(
+        valid,
+        key,
+        "joint limits must be ranges [min, max] with min < max",
+        format!("{limits:?}"),
+        "min < max",
+    )
+}
+
 /// Coulomb friction's domain, `0 ≤ μD ≤ μS` (the 3D models' rule; the
 /// error names `terrain.mu_dynamic`).
 pub(crate) fn friction(f: &fbd_contact::Friction) -> Result<(), SimError> {

@@ -74,13 +74,7 @@ impl RobotSim {
             p.gravity,
             "a finite value",
         )?;
-        check(
-            p.stride >= 1,
-            "output.stride",
-            "must be at least 1",
-            p.stride,
-            "≥ 1",
-        )?;
+        crate::rules::stride(p.stride)?;
         assert_eq!(p.q0.len(), nq, "q0: 6 base coordinates + one per joint");
         assert_eq!(p.qdot0.len(), nq, "qdot0: the layout of q0");
         crate::rules::friction(&p.friction)?;
@@ -91,13 +85,7 @@ impl RobotSim {
                 .map(|&v| ("control.kp", v))
                 .chain(kd.iter().map(|&v| ("control.kd", v)))
             {
-                check(
-                    v.is_finite() && v >= 0.0,
-                    key,
-                    "must be finite and not negative",
-                    v,
-                    "a finite value ≥ 0",
-                )?;
+                crate::rules::gain(key, v)?;
             }
             Ok(())
         };
@@ -259,10 +247,6 @@ pub fn mass_matrix(robot: &RobotModel, q: &[f64]) -> DMatrix<f64> {
     m
 }
 
-/// Most gait times at which [`pd_stability`] evaluates the effective
-/// inertia (evenly spread over the run), as for the hexapod.
-const GAIT_POSES: usize = 200;
-
 /// The stability rule of the explicit joint torques
 /// ([`crate::rules::pd_stability`]) for a robot, the hexapod's rule: the
 /// largest `kp` and `kd` of any joint must be stable on the smallest
@@ -285,23 +269,13 @@ fn pd_stability(robot: &RobotModel, p: &RobotParams) -> Result<(), SimError> {
         | RobotControl::Gait { kp, kd, .. } => (kp, kd),
     };
     let max = |v: &[f64]| v.iter().copied().fold(0.0, f64::max);
-    let (kp, kd) = (max(kp), max(kd));
-    if robot.joints.is_empty() || (kp == 0.0 && kd == 0.0) {
-        return Ok(());
-    }
     let poses = |visit: &mut dyn FnMut(&[f64], &[usize]) -> bool| for_each_pose(robot, p, visit);
-    // A pose within round-off of the limit is left to the eigenvalues.
-    let limit = crate::rules::pd_inertia_limit(kp, kd, p.dt) * (1.0 + 1e-6);
-    if crate::joint_inertia::poses_slower_than(robot, &poses, limit) == Some(true) {
-        return Ok(());
-    }
-    let (inertia, joint) = crate::joint_inertia::fastest_mode_over(robot, &poses);
-    crate::rules::pd_stability(
-        kp,
-        kd,
-        inertia,
-        p.dt,
-        &format!("joint {}", robot.joints[joint].name),
+    crate::joint_inertia::check_gains(
+        robot,
+        &poses,
+        (max(kp), max(kd), p.dt),
+        || crate::joint_inertia::fastest_mode_over(robot, &poses),
+        |joint| format!("joint {}", robot.joints[joint].name),
     )
 }
 
@@ -344,7 +318,7 @@ fn for_each_pose(
             let n = robot.joints.len();
             let (mut target, mut rate) = (vec![0.0; n], vec![0.0; n]);
             let steps = (p.duration / p.dt).round() as usize + 1;
-            let stride = steps / GAIT_POSES + 1;
+            let stride = steps / crate::joint_inertia::GAIT_POSES + 1;
             let mut standing = Vec::with_capacity(plan.leg_count());
             for k in (0..steps).step_by(stride) {
                 let t = k as f64 * p.dt;

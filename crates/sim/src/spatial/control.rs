@@ -36,29 +36,9 @@ pub fn joint_torques(model: &SpatialModel, data: &mut SpatialData) -> Result<(),
     }
     let dt = model.dt();
     let t = data.k as f64 * dt;
-    let (kp, kd, limit) = match &model.params.control {
-        SpatialControl::None => {
-            data.fbd.torque.fill(0.0);
-            return Ok(());
-        }
-        SpatialControl::Pd {
-            kp,
-            kd,
-            torque_limit,
-            ..
-        }
-        | SpatialControl::Trajectory {
-            kp,
-            kd,
-            torque_limit,
-            ..
-        }
-        | SpatialControl::Gait {
-            kp,
-            kd,
-            torque_limit,
-            ..
-        } => (*kp, *kd, *torque_limit),
+    let Some((kp, kd, limit)) = model.params.control.gains() else {
+        data.fbd.torque.fill(0.0);
+        return Ok(());
     };
     if let (SpatialControl::Gait { gait, .. }, Some(g)) = (&model.params.control, &mut data.control)
     {

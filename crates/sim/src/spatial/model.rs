@@ -161,50 +161,19 @@ impl SpatialParams {
             "|φz| away from 90°",
         )?;
         crate::rules::friction(&p.friction)?;
-        check(
-            p.joint_limits.is_valid(),
-            "leg.theta1_deg",
-            "joint limits must be ranges [min, max] with min < max",
-            format!("{:?}", p.joint_limits),
-            "min < max",
-        )?;
-        check(
-            p.stride >= 1,
-            "output.stride",
-            "must be at least 1",
-            p.stride,
-            "≥ 1",
-        )?;
-        let (kp, kd, limit, nlegs) = match &p.control {
-            SpatialControl::None => return Ok(()),
-            SpatialControl::Pd {
-                kp,
-                kd,
-                torque_limit,
-                target,
-            } => (*kp, *kd, *torque_limit, target.len()),
-            SpatialControl::Trajectory {
-                kp,
-                kd,
-                torque_limit,
-                legs,
-            } => (*kp, *kd, *torque_limit, legs.len()),
-            SpatialControl::Gait {
-                kp,
-                kd,
-                torque_limit,
-                ..
-            } => (*kp, *kd, *torque_limit, p.legs.len()),
+        crate::rules::joint_ranges(p.joint_limits.is_valid(), "leg.theta1_deg", &p.joint_limits)?;
+        crate::rules::stride(p.stride)?;
+        let Some((kp, kd, limit)) = p.control.gains() else {
+            return Ok(());
+        };
+        let nlegs = match &p.control {
+            SpatialControl::Pd { target, .. } => target.len(),
+            SpatialControl::Trajectory { legs, .. } => legs.len(),
+            _ => p.legs.len(),
         };
         assert_eq!(nlegs, p.legs.len(), "one control entry per leg");
         for (key, v) in [("control.kp", kp), ("control.kd", kd)] {
-            check(
-                v.is_finite() && v >= 0.0,
-                key,
-                "must be finite and not negative",
-                v,
-                "a finite value ≥ 0",
-            )?;
+            crate::rules::gain(key, v)?;
         }
         if let Some(l) = limit {
             positive("control.torque_limit", l)?;
@@ -377,21 +346,18 @@ pub fn closed_form(p: &SpatialParams) -> SpatialMechanism {
     )
 }
 
-/// Most gait steps at which [`pd_stability`] evaluates the effective
-/// inertia (evenly spread over the run).
-const GAIT_POSES: usize = 200;
-
 /// The stability rule of the explicit joint controller
 /// ([`crate::rules::pd_stability`]) on the smallest effective joint
 /// inertia ([`crate::joint_inertia`]) at the commanded poses: the initial
 /// one and every target (each knot of a trajectory) with every foot on
 /// the ground; for the gait, its joint angles along the run (at most
-/// [`GAIT_POSES`] steps) with its stance feet on the ground. Without
-/// ground, the free robot's.
+/// [`crate::joint_inertia::GAIT_POSES`] steps) with its stance feet on
+/// the ground. Without ground, the free robot's
+/// ([`crate::joint_inertia::check_gains`], as for any robot).
 ///
 /// The rule holds when every pose's modes are slower than the inertia
 /// limit of the gains ([`crate::rules::pd_inertia_limit`]), which
-/// [`tree_modes_slower_than`] decides along the hexapod's D-H instance
+/// [`crate::joint_inertia::tree_modes_slower_than`] decides along the hexapod's D-H instance
 /// (the generic robot model, as for any robot) from some 100 flops per
 /// joint and a 6×6 Cholesky factorisation per pose. Only
 /// when that fails (or is undecided at a singular standing leg) the
@@ -402,39 +368,30 @@ const GAIT_POSES: usize = 200;
 /// is left to the eigenvalues: both paths give the same verdict
 /// (`tests/pd_stability.rs` compares them over a grid of gains and steps).
 fn pd_stability(p: &SpatialParams, robot: &RobotModel) -> Result<(), SimError> {
-    let (kp, kd) = match &p.control {
-        SpatialControl::None => return Ok(()),
-        SpatialControl::Pd { kp, kd, .. }
-        | SpatialControl::Trajectory { kp, kd, .. }
-        | SpatialControl::Gait { kp, kd, .. } => (*kp, *kd),
+    let Some((kp, kd, _)) = p.control.gains() else {
+        return Ok(());
     };
-    if kp == 0.0 && kd == 0.0 {
-        return Ok(());
-    }
-    let limit = crate::rules::pd_inertia_limit(kp, kd, p.dt) * (1.0 + 1e-6);
-    if modes_slower_than(p, robot, limit) == Some(true) {
-        return Ok(());
-    }
-    // Only now the parameters are cloned for the cache's key: a passing
-    // check costs less than cloning a large terrain.
-    let key = cache_key(p);
-    let (inertia, joint) = cached(&MODES, &key).unwrap_or_else(|| {
-        let mode = fastest_mode_over_poses(p, robot);
-        keep(&MODES, key, mode);
-        mode
-    });
-    crate::rules::pd_stability(
-        kp,
-        kd,
-        inertia,
-        p.dt,
-        &format!("leg {} theta{}", p.legs[joint / 3], joint % 3 + 1),
+    crate::joint_inertia::check_gains(
+        robot,
+        &|visit| for_each_pose(p, robot, visit),
+        (kp, kd, p.dt),
+        || {
+            // Only now the parameters are cloned for the cache's key: a
+            // passing check costs less than cloning a large terrain.
+            let key = cache_key(p);
+            cached(&MODES, &key).unwrap_or_else(|| {
+                let mode = fastest_mode_over_poses(p, robot);
+                keep(&MODES, key, mode);
+                mode
+            })
+        },
+        |joint| format!("leg {} theta{}", p.legs[joint / 3], joint % 3 + 1),
     )
 }
 
 /// Whether every pose of [`pd_stability`] has every joint mode slower
 /// than a joint of inertia `inertia` (kg·m²,
-/// [`tree_modes_slower_than`] on `robot`, the D-H instance of `p`,
+/// [`crate::joint_inertia::tree_modes_slower_than`] on `robot`, the D-H instance of `p`,
 /// [`SpatialParams::robot_model`]): `Some(false)` at the first pose that
 /// has a faster one, `None` when a pose is undecided.
 pub fn modes_slower_than(p: &SpatialParams, robot: &RobotModel, inertia: f64) -> Option<bool> {
@@ -514,7 +471,7 @@ fn keep<T>(cache: &std::sync::Mutex<Vec<(SpatialParams, T)>>, key: SpatialParams
 
 /// The smallest effective joint inertia over the poses of
 /// [`pd_stability`] and its joint (index `3·slot + j`), from the
-/// eigenvalues of each pose ([`fastest_mode`] on the mass matrix of
+/// eigenvalues of each pose ([`crate::joint_inertia::fastest_mode`] on the mass matrix of
 /// `robot`, the D-H instance of `p`).
 pub fn fastest_mode_over_poses(p: &SpatialParams, robot: &RobotModel) -> (f64, usize) {
     crate::joint_inertia::fastest_mode_over(robot, &|visit| for_each_pose(p, robot, visit))
@@ -574,7 +531,7 @@ fn for_each_pose(
         }
         SpatialControl::Gait { gait, .. } => {
             let mut g = crate::gait::GaitData::new(gait);
-            let stride = gait.steps / GAIT_POSES + 1;
+            let stride = gait.steps / crate::joint_inertia::GAIT_POSES + 1;
             let mut standing = Vec::with_capacity(nlegs);
             // Only the sampled steps: the gait's closed-form inverse
             // kinematics needs the previous angles only to stay on their

@@ -58,6 +58,34 @@ pub enum SpatialControl {
     },
 }
 
+impl SpatialControl {
+    /// The controller's gains and torque limit, `(kp, kd, torque_limit)`;
+    /// `None` for passive joints.
+    pub fn gains(&self) -> Option<(f64, f64, Option<f64>)> {
+        match self {
+            SpatialControl::None => None,
+            SpatialControl::Pd {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            }
+            | SpatialControl::Trajectory {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            }
+            | SpatialControl::Gait {
+                kp,
+                kd,
+                torque_limit,
+                ..
+            } => Some((*kp, *kd, *torque_limit)),
+        }
+    }
+}
+
 /// Everything that defines a spatial (3D) simulation of the hexapod.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpatialParams {

@@ -357,3 +357,253 @@ fn sigint_stops_a_flight_and_writes_every_file() {
     assert_eq!(rows.len(), (steps - 1) / 1000 + 1);
     assert!(out.join("config.toml").is_file() && out.join("events.csv").is_file());
 }
+
+/// The lab hexapod dropped onto flat ground (examples/robots/
+/// lab_hexapod_drop.toml) with `extra` appended, run into `out`.
+fn drop_run(dir: &Path, name: &str, extra: &str) -> std::path::PathBuf {
+    let text = std::fs::read_to_string(example("robots/lab_hexapod_drop.toml"))
+        .unwrap()
+        .replace(
+            "urdf = \"lab_hexapod.urdf\"",
+            &format!("urdf = \"{}\"", example("robots/lab_hexapod.urdf")),
+        );
+    let cfg = write(dir, &format!("{name}.toml"), &format!("{text}{extra}"));
+    let out = dir.join(name);
+    run_ok(s(&cfg), &out);
+    out
+}
+
+/// The header and the rows of a trajectory with contact states (as NaN).
+fn table_with_states(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = read(&dir.join("trajectory.csv"));
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
+/// The largest value of `f(row)` over the rows.
+fn peak(rows: &[Vec<f64>], f: impl Fn(&Vec<f64>) -> f64) -> f64 {
+    rows.iter().map(f).fold(0.0, f64::max)
+}
+
+#[test]
+fn a_landing_robots_summary_has_every_figure_of_the_trajectory_and_events() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = drop_run(dir.path(), "drop", "");
+    let sm = summary(&out);
+    let (header, rows) = table_with_states(&out);
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name}"))
+    };
+    // The keys a robot's summary has always had.
+    for key in [
+        "status",
+        "error",
+        "model",
+        "robot",
+        "dt",
+        "duration",
+        "steps",
+        "steps_planned",
+        "stride",
+        "rows_written",
+        "contact_points",
+        "distance",
+        "final_height",
+        "peak_torque_max",
+        "peak_normal_force",
+        "first_touchdown",
+        "newton_iterations",
+        "newton_iterations_per_step",
+        "wall_seconds",
+        "steps_per_second",
+        "symbolic_factorizations",
+        "events",
+        "retried_steps",
+        "substeps",
+        "resolved_cycles",
+        "max_law_violation",
+    ] {
+        assert!(sm.get(key).is_some(), "no {key} in {sm}");
+    }
+    // The hexapod's own keys are not a robot's.
+    for key in ["legs", "run", "control", "stability_check_seconds"] {
+        assert!(sm.get(key).is_none(), "{key} in a robot's summary");
+    }
+    assert_eq!(sm["status"], "ok");
+    assert_eq!(sm["rows_written"].as_u64().unwrap() as usize, rows.len());
+    assert_eq!(sm["steps"], 601);
+
+    // Per contact point: the peak normal force is the largest of its `_n`
+    // column, the tangential peak that of |f − n·ŷ| on flat ground.
+    let points: Vec<String> = sm["contact_points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p.as_str().unwrap().to_owned())
+        .collect();
+    assert!(!points.is_empty());
+    let mut all_n: f64 = 0.0;
+    for p in &points {
+        let [fx, fy, fz, n] = ["fx", "fy", "fz", "n"].map(|a| col(&format!("{p}_{a}")));
+        let want_n = peak(&rows, |r| r[n].abs());
+        let want_fa = peak(&rows, |r| {
+            (r[fx] * r[fx] + (r[fy] - r[n]) * (r[fy] - r[n]) + r[fz] * r[fz]).sqrt()
+        });
+        let got = &sm["peak_contact_force"][p];
+        assert_eq!(got["n"].as_f64().unwrap(), want_n, "{p}");
+        assert!(
+            (got["fa"].as_f64().unwrap() - want_fa).abs() <= 1e-12 * want_n,
+            "{p}"
+        );
+        // Coulomb: the tangential force never beats μs times the normal.
+        assert!(want_fa <= 0.5 * want_n + 1e-4, "{p}");
+        all_n = all_n.max(want_n);
+    }
+    assert!(all_n > 10.0, "the robot lands: peak normal {all_n} N");
+    assert_eq!(sm["peak_normal_force"].as_f64().unwrap(), all_n);
+
+    // First touchdown and first slip per point: events.csv's first ST1 →
+    // ST2/ST3 and first → ST3 of that point.
+    let events = read(&out.join("events.csv"));
+    let first = |p: &str, pred: &dyn Fn(&str, &str) -> bool| -> Option<f64> {
+        events.lines().skip(1).find_map(|l| {
+            let f: Vec<&str> = l.split(',').collect();
+            (f[1] == p && pred(f[2], f[3])).then(|| f[0].parse().unwrap())
+        })
+    };
+    let mut touched = 0;
+    for p in &points {
+        let down = first(p, &|from, to| from == "ST1" && (to == "ST2" || to == "ST3"));
+        let slip = first(p, &|_, to| to == "ST3");
+        assert_eq!(sm["first_touchdown"][p].as_f64(), down, "{p}");
+        assert_eq!(sm["first_slip"][p].as_f64(), slip, "{p}");
+        touched += usize::from(down.is_some());
+    }
+    assert!(touched > 0);
+
+    // Per reaction (named by its joint, as its columns): the largest force
+    // magnitude; per joint the largest |τ| and |τ·θ̇|, θ̇ the backward
+    // difference of the rows (the joints start at rest).
+    let reactions = sm["peak_joint_force"].as_object().unwrap();
+    assert!(!reactions.is_empty());
+    let mut all_f: f64 = 0.0;
+    for (joint, got) in reactions {
+        let [fx, fy, fz] = ["fx", "fy", "fz"].map(|a| col(&format!("{joint}_{a}")));
+        let want = peak(&rows, |r| {
+            (r[fx] * r[fx] + r[fy] * r[fy] + r[fz] * r[fz]).sqrt()
+        });
+        assert_eq!(got.as_f64().unwrap(), want, "{joint}");
+        all_f = all_f.max(want);
+    }
+    assert_eq!(sm["peak_joint_force_max"].as_f64().unwrap(), all_f);
+    let dt = sm["dt"].as_f64().unwrap();
+    let (mut all_tau, mut all_p): (f64, f64) = (0.0, 0.0);
+    let joints = sm["peak_actuation"].as_array().unwrap();
+    assert_eq!(
+        joints.len(),
+        header.iter().filter(|h| h.starts_with("tau_")).count()
+    );
+    for j in joints {
+        assert!(j.get("leg").is_none());
+        let name = j["joint"].as_str().unwrap();
+        let (tau, q) = (col(&format!("tau_{name}")), col(name));
+        let want_tau = peak(&rows, |r| r[tau].abs());
+        let want_p = (1..rows.len())
+            .map(|k| (rows[k][tau] * ((rows[k][q] - rows[k - 1][q]) / dt)).abs())
+            .fold(0.0, f64::max);
+        assert_eq!(j["torque"].as_f64().unwrap(), want_tau, "{name}");
+        let got_p = j["power"].as_f64().unwrap();
+        assert!(
+            (got_p - want_p).abs() <= 1e-9 * want_p.max(1.0),
+            "{name}: {got_p} {want_p}"
+        );
+        all_tau = all_tau.max(want_tau);
+        all_p = all_p.max(got_p);
+    }
+    assert!(all_tau > 0.0 && all_p > 0.0);
+    assert_eq!(sm["peak_torque_max"].as_f64().unwrap(), all_tau);
+    assert_eq!(sm["peak_power_max"].as_f64().unwrap(), all_p);
+    let per_step = &sm["newton_iterations_per_step"];
+    let iterations = col("newton_iterations");
+    assert_eq!(
+        per_step["max"].as_f64().unwrap(),
+        peak(&rows, |r| r[iterations])
+    );
+    assert_eq!(
+        sm["chord_iterations"].as_u64().unwrap() + sm["full_newton_iterations"].as_u64().unwrap(),
+        sm["newton_iterations"].as_u64().unwrap()
+    );
+
+    // The root: from the first row to after the last step (one step past
+    // the last row); the path over every row and that last stretch.
+    let xyz = |v: &serde_json::Value| -> [f64; 3] {
+        let a = v.as_array().unwrap();
+        std::array::from_fn(|i| a[i].as_f64().unwrap())
+    };
+    let (rx, ry, rz) = (col("rx"), col("ry"), col("rz"));
+    let start = xyz(&sm["initial_position"]);
+    assert_eq!(start, [rows[0][rx], rows[0][ry], rows[0][rz]]);
+    let end = xyz(&sm["final_position"]);
+    let last = rows.last().unwrap();
+    let from_last = (end[0] - last[rx]).hypot(end[2] - last[rz]);
+    assert!(from_last < 0.01 && (end[1] - last[ry]).abs() < 0.01);
+    let d = xyz(&sm["displacement"]);
+    for a in 0..3 {
+        assert_eq!(d[a], end[a] - start[a]);
+    }
+    assert_eq!(sm["distance"].as_f64().unwrap(), d[0].hypot(d[2]));
+    assert_eq!(sm["final_height"].as_f64().unwrap(), end[1]);
+    let path = (1..rows.len())
+        .map(|k| (rows[k][rx] - rows[k - 1][rx]).hypot(rows[k][rz] - rows[k - 1][rz]))
+        .sum::<f64>()
+        + from_last;
+    let got_path = sm["path_length"].as_f64().unwrap();
+    assert!((got_path - path).abs() < 1e-12, "{got_path} {path}");
+    assert!(got_path >= sm["distance"].as_f64().unwrap() - 1e-12);
+    let energy = &sm["final_energy"];
+    assert_eq!(energy["t"].as_f64().unwrap(), last[0]);
+    let (ek, ep) = (col("kinetic"), col("potential"));
+    assert_eq!(energy["kinetic"].as_f64().unwrap(), last[ek]);
+    assert_eq!(energy["potential"].as_f64().unwrap(), last[ep]);
+    assert_eq!(energy["total"].as_f64().unwrap(), last[ek] + last[ep]);
+
+    // Every third row, without the plots (which make the run record every
+    // step): the peaks are those of the written rows, the events and the
+    // end of the run those of every step.
+    let strided = drop_run(
+        dir.path(),
+        "strided",
+        "\n[output]\nstride = 3\nplots = false\n",
+    );
+    let ss = summary(&strided);
+    let (_, rows3) = table_with_states(&strided);
+    assert_eq!(ss["rows_written"].as_u64().unwrap() as usize, rows3.len());
+    for key in ["first_touchdown", "first_slip", "final_position", "events"] {
+        assert_eq!(ss[key], sm[key], "{key}");
+    }
+    let mut n3: f64 = 0.0;
+    for p in &points {
+        let n = col(&format!("{p}_n"));
+        let want = peak(&rows3, |r| r[n].abs());
+        assert_eq!(ss["peak_contact_force"][p]["n"].as_f64().unwrap(), want);
+        n3 = n3.max(want);
+    }
+    assert_eq!(ss["peak_normal_force"].as_f64().unwrap(), n3);
+    assert!(n3 <= all_n);
+}

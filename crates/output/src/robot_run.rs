@@ -16,16 +16,16 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 use fbd_sim::robot::{RobotRecord, RobotSim};
-
 use serde::Serialize;
 
 use crate::OutputError;
 use crate::config::robot::{LoadedRobot, MOTION_BASE_COLUMNS, RobotRun};
 use crate::driver::{self, Recording, RunFiles, RunOutput, Stepper};
-use crate::output::{self, Ending, IterationsPerStep};
+use crate::output::{self, Ending};
 use crate::plot::{EventMark, PALETTE};
 use crate::steptime::StepTimes;
 use crate::tree::plots::{self, Curve, PlotPlan};
+use crate::tree::summary::{Collector, Facts, Keys, TreeSummary};
 use crate::tree::{Plan, Source};
 
 /// The files of a robot's run, in the order they are written (the plots
@@ -62,65 +62,41 @@ pub struct RobotEvent {
     pub to: String,
 }
 
-/// `summary.json` of a robot's run.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RobotSummary {
-    /// `"ok"`, `"error"` or `"interrupted"`.
-    pub status: &'static str,
-    /// The error message, or null.
-    pub error: Option<String>,
-    /// `"robot"`.
-    pub model: &'static str,
-    /// The robot's name (from its description).
-    pub robot: String,
-    /// Time step (s).
-    pub dt: f64,
-    /// Simulated time asked for (s).
-    pub duration: f64,
-    /// Steps solved.
-    pub steps: usize,
-    /// Steps planned (`round(duration/Δt) + 1`).
-    pub steps_planned: usize,
-    /// `[output] stride`.
-    pub stride: usize,
-    /// Rows of `trajectory.csv`.
-    pub rows_written: usize,
-    /// The contact points, in the order of their columns (none in flight).
-    pub contact_points: Vec<String>,
-    /// The root's horizontal distance from its start after the last step
-    /// (m).
-    pub distance: f64,
-    /// The root's height `ry` after the last step (m).
-    pub final_height: f64,
-    /// The largest `|τ|` of any joint over the written rows (N·m).
-    pub peak_torque_max: f64,
-    /// The largest normal force of any contact point over the written
-    /// rows (N).
-    pub peak_normal_force: f64,
-    /// Per contact point, the time of its first touchdown (`ST1` → `ST2`
-    /// or `ST3`; null if it never touched or started in contact).
-    pub first_touchdown: std::collections::BTreeMap<String, Option<f64>>,
-    /// Newton iterations over the run.
-    pub newton_iterations: usize,
-    /// Mean and largest Newton iterations of one step.
-    pub newton_iterations_per_step: IterationsPerStep,
-    /// Time in the stepping loop (s).
-    pub wall_seconds: f64,
-    /// `steps / wall_seconds` (null when not measurable).
-    pub steps_per_second: Option<f64>,
-    /// Symbolic LU analyses (one per contact-state pattern).
-    pub symbolic_factorizations: usize,
-    /// Contact, joint-limit and retried-step events, as `events.csv`.
-    pub events: Vec<RobotEvent>,
-    /// Steps solved again in substeps.
-    pub retried_steps: usize,
-    /// Substeps solved over all retries.
-    pub substeps: usize,
-    /// State searches closed by their least inconsistent combination.
-    pub resolved_cycles: usize,
-    /// The largest violation of a contact or limit law over the accepted
-    /// solutions (N; at most the cycle tolerance, 1e-7 of the weight).
-    pub max_law_violation: f64,
+/// `summary.json` of a robot's run: the summary of every model on the
+/// tree equations ([`crate::tree::summary`]) in the robot's names (its
+/// contact points, its joints, each reaction by its first joint; the feet
+/// of `first_touchdown` and `first_slip` are the contact points), with
+/// `robot` (its name), `peak_normal_force`, and its events by point
+/// ([`RobotEvent`]). Its peaks, path and final energy are over the written
+/// rows; its final position is after the last solved step.
+pub type RobotSummary = TreeSummary<RobotEvent>;
+
+/// The robot's keys of its figures (run by `sim`): every contact point by
+/// its name (its own foot in `first_touchdown`), every reaction by its
+/// first joint's name, every joint by its name.
+pub fn keys(robot: &LoadedRobot, sim: &RobotSim) -> Keys {
+    let joints = &robot.model.joints;
+    let contacts: Vec<String> = sim.mech.contacts.iter().map(|c| c.name.clone()).collect();
+    Keys {
+        feet: contacts
+            .iter()
+            .enumerate()
+            .map(|(c, name)| (name.clone(), Some(c)))
+            .collect(),
+        contacts,
+        reactions: sim
+            .mech
+            .reactions
+            .iter()
+            .enumerate()
+            .map(|(i, r)| (joints[r.joints[0]].name.clone(), Some(i)))
+            .collect(),
+        joints: joints
+            .iter()
+            .enumerate()
+            .map(|(j, joint)| (None, joint.name.clone(), Some(j)))
+            .collect(),
+    }
 }
 
 /// What [`simulate`] did: how the run ended, `summary.json`'s content,
@@ -319,8 +295,7 @@ struct RobotFiles<'a> {
     frames: Option<crate::viewer::robot::RobotFrames>,
     states: Vec<u8>,
     forces: Vec<[f64; 3]>,
-    peak_torque: f64,
-    peak_normal: f64,
+    collect: Option<Collector>,
     events_csv: String,
 }
 
@@ -334,11 +309,10 @@ impl RunFiles for RobotFiles<'_> {
     }
 
     fn written(&mut self, r: &RobotRecord) {
-        for c in &r.contacts {
-            self.peak_normal = self.peak_normal.max(c.normal);
-        }
-        for t in &r.torque {
-            self.peak_torque = self.peak_torque.max(t.abs());
+        // The summary's figures are over the written rows (the same with
+        // or without the plots, which make the run record every step).
+        if let Some(c) = self.collect.as_mut() {
+            c.push(r);
         }
         let contacts = self.states.len();
         if let Some(f) = self.frames.as_mut() {
@@ -369,52 +343,27 @@ impl RunFiles for RobotFiles<'_> {
         self.events_csv = output::events_table(EVENTS_HEADER, &events, &times, |e| {
             format!("{},{},{}", e.point, e.from, e.to)
         });
-        RobotSummary {
-            status: output::run_status(s),
-            error: match (&s.error, s.interrupted) {
-                (Some(e), _) => Some(e.to_string()),
-                (None, true) => Some(output::interrupted_after(s, run.steps_planned, dt)),
-                (None, false) => None,
-            },
+        let mut collect = self.collect.take().expect("summarised once");
+        collect.end_at(&run.final_q);
+        let facts = Facts {
             model: crate::config::robot::MODEL,
-            robot: robot.model.name.clone(),
+            robot: Some(robot.model.name.clone()),
+            hexapod: None,
             dt,
             duration: robot.config.time.duration,
-            steps: s.steps,
             steps_planned: run.steps_planned,
             stride: robot.config.output.stride,
-            rows_written: rows,
             contact_points: sim.mech.contacts.iter().map(|c| c.name.clone()).collect(),
-            distance: (run.final_q[0] - robot.params().q0[0])
-                .hypot(run.final_q[2] - robot.params().q0[2]),
-            final_height: run.final_q[1],
-            peak_torque_max: self.peak_torque,
-            peak_normal_force: self.peak_normal,
-            first_touchdown: sim
-                .mech
-                .contacts
-                .iter()
-                .enumerate()
-                .map(|(c, tc)| {
-                    let t = s
-                        .events
-                        .iter()
-                        .find(|e| e.contact == c && e.from == fbd_contact::StateCode::St1)
-                        .map(|e| times.value(e.step, e.t));
-                    (tc.name.clone(), t)
-                })
-                .collect(),
-            newton_iterations: s.newton_iterations,
-            newton_iterations_per_step: IterationsPerStep::of(s),
-            wall_seconds: s.wall_seconds,
-            steps_per_second: output::steps_per_second(s),
-            symbolic_factorizations: s.symbolic_factorizations,
-            events: events.into_iter().map(|(_, _, e)| e).collect(),
-            retried_steps: s.retries.len(),
-            substeps: s.substeps,
-            resolved_cycles: s.resolved_cycles,
-            max_law_violation: s.max_law_violation,
+            stability_check_seconds: None,
+            peak_normal_force: true,
+        };
+        let events = events.into_iter().map(|(_, _, e)| e).collect();
+        let mut summary = collect.finish(facts, s, rows, events);
+        if s.error.is_none() && s.interrupted {
+            // A robot's run names the time it stopped at.
+            summary.head.error = Some(output::interrupted_after(s, run.steps_planned, dt));
         }
+        summary
     }
 
     fn events_csv(&self, _: &RobotRun) -> String {
@@ -486,8 +435,7 @@ pub fn simulate(
             .then(|| crate::viewer::robot::RobotFrames::new(&robot.model, contacts > 0)),
         states: vec![0u8; contacts],
         forces: vec![[0.0; 3]; contacts],
-        peak_torque: 0.0,
-        peak_normal: 0.0,
+        collect: Some(Collector::new(keys(robot, &sim), &surface)),
         events_csv: String::new(),
     };
     let stepper = RobotStepper { robot, sim: &sim };

@@ -249,7 +249,7 @@ pub struct Outputs {
     output: OutputConfig,
     plot: Option<plots::Recorder>,
     view: Option<HexapodScene>,
-    collect: Option<summary::Collector>,
+    collect: Option<crate::tree::summary::Collector>,
     feet: Feet,
     slots: csv::Slots,
     /// The model's start-up stability check (s), for `summary.json`.
@@ -297,7 +297,7 @@ impl Outputs {
         let t_end = (steps.max(1) - 1) as f64 * params.dt;
         let files = Self {
             stability_check_seconds: 0.0,
-            collect: Some(summary::Collector::new(&layout, &params.terrain)),
+            collect: Some(summary::collector(&layout, &slots, params)),
             plot: out_dir.filter(|_| output.plots).map(|_| {
                 plots::Recorder::new(plot_plan(&layout, &slots), t_end)
                     .with_surface(&params.terrain)
@@ -341,7 +341,7 @@ impl RunFiles for Outputs {
 
     fn observe(&mut self, r: &RobotRecord) {
         if let Some(c) = self.collect.as_mut() {
-            c.push(r, &self.slots);
+            c.push(r);
         }
         if let Some(p) = self.plot.as_mut() {
             p.push(r);
@@ -350,9 +350,15 @@ impl RunFiles for Outputs {
 
     fn summary(&mut self, run: &RunSummary, rows: usize) -> SpatialSummary {
         let collect = self.collect.take().expect("summarised once");
-        let mut s = collect.finish(&self.params, self.steps, &self.layout, run, rows);
-        s.stability_check_seconds = self.stability_check_seconds;
-        s
+        summary::finish(
+            collect,
+            &self.params,
+            self.steps,
+            &self.layout,
+            run,
+            rows,
+            self.stability_check_seconds,
+        )
     }
 
     fn events_csv(&self, run: &RunSummary) -> String {
@@ -532,10 +538,17 @@ mod tests {
         let run = RunSummary {
             steps,
             newton_iterations: 30,
+            // The most of one step, as the records say (2 + k % 3).
+            max_newton_iterations: 4,
             events: vec![Event {
                 t: 0.005,
                 step: 5,
-                contact: 3,
+                contact: p
+                    .record_index()
+                    .contacts
+                    .iter()
+                    .position(|&c| c == (4, PointKind::Tip))
+                    .unwrap(),
                 point: PointKind::Tip,
                 leg: 4,
                 from: StateCode::St1,
@@ -574,7 +587,7 @@ mod tests {
         assert_eq!(s.first_touchdown["leg4"], Some(0.005));
         assert_eq!(s.first_touchdown["leg3"], None);
         let peak = &s.peak_actuation[5];
-        assert_eq!((peak.leg, peak.joint), (4, "theta3"));
+        assert_eq!((peak.leg, peak.joint.as_str()), (Some(4), "theta3"));
         assert_eq!((peak.torque, peak.power), (3.0, 3.0));
         assert_eq!(s.peak_torque_max, 3.0);
         assert_eq!(s.peak_power_max, 4.0);

@@ -10,6 +10,7 @@
 //! [`plots`].
 
 pub mod plots;
+pub mod summary;
 
 use fbd_contact::StateCode;
 use fbd_sim::robot::RobotRecord;

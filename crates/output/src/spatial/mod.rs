@@ -27,7 +27,7 @@ use crate::output::{self, Ending};
 use crate::plot::EventMark;
 use crate::steptime::StepTimes;
 use crate::tree::plots::{self, Curve, PlotPlan, leg_color};
-use crate::viewer::hexapod::{HexDynamics, HexFrame, HexapodScene};
+use crate::viewer::hexapod::{HexapodView, LegValues};
 
 pub use csv::columns;
 pub use summary::SpatialSummary;
@@ -200,40 +200,40 @@ pub fn plot_plan(layout: &Layout, slots: &csv::Slots) -> PlotPlan {
     }
 }
 
-/// The viewer frame of a record.
-fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &RobotRecord) -> HexFrame {
-    feet.update(&r.q);
-    let mut d = HexDynamics::default();
-    for (i, &n) in layout.legs.iter().enumerate() {
-        if let Some(c) = slots.tips[i] {
-            d.state[n - 1] = r.contacts[c].state;
-            d.foot_force[n - 1] = r.contacts[c].force;
-            d.normal[n - 1] = r.contacts[c].normal;
-        }
-        for (k, kind) in [PointKind::Knee, PointKind::Hip].into_iter().enumerate() {
-            let c = layout
-                .extra_points
-                .iter()
-                .position(|p| *p == (n, kind))
-                .and_then(|e| slots.extras[e]);
-            if let Some(c) = c {
-                d.points[n - 1][k] = (r.contacts[c].state, r.contacts[c].force);
-            }
-        }
-        if let Some(l) = slots.leg(r, i) {
-            d.hip_force[n - 1] = l.hip_force;
-            d.knee_force[n - 1] = l.knee_force;
-            d.torque[n - 1] = l.torque;
-        }
-    }
-    HexFrame {
-        t: r.t,
-        q: *feet.q(),
-        stance: d.state.map(|s| s != fbd_contact::StateCode::St1),
-        com: feet.com(),
-        margin: None,
-        dynamics: Some(d),
-    }
+/// Adds a record to the viewer: the model's `q`, each contact point's
+/// state and ground force, each leg's forces and torques.
+fn push_view(view: &mut HexapodView, layout: &Layout, slots: &csv::Slots, r: &RobotRecord) {
+    let contacts: Vec<(fbd_contact::StateCode, [f64; 3])> = view
+        .contacts()
+        .iter()
+        .map(|&point| {
+            let c = slots.contacts.iter().position(|&p| p == point);
+            c.map_or((fbd_contact::StateCode::St1, [0.0; 3]), |c| {
+                (r.contacts[c].state, r.contacts[c].force)
+            })
+        })
+        .collect();
+    let legs: Vec<LegValues> = layout
+        .legs
+        .iter()
+        .enumerate()
+        .map(|(i, _)| {
+            let normal = slots.tips[i].map_or(0.0, |c| r.contacts[c].normal);
+            slots.leg(r, i).map_or(
+                LegValues {
+                    normal,
+                    ..LegValues::default()
+                },
+                |l| LegValues {
+                    normal,
+                    hip_force: l.hip_force,
+                    knee_force: l.knee_force,
+                    torque: l.torque,
+                },
+            )
+        })
+        .collect();
+    view.push_dynamic(r.t, &r.q, &contacts, &legs);
 }
 
 /// What a dynamic hexapod run produced.
@@ -248,7 +248,7 @@ pub struct Outputs {
     plan: crate::tree::Plan,
     output: OutputConfig,
     plot: Option<plots::Recorder>,
-    view: Option<HexapodScene>,
+    view: Option<HexapodView>,
     collect: Option<summary::Collector>,
     feet: Feet,
     slots: csv::Slots,
@@ -303,12 +303,8 @@ impl Outputs {
                     .with_surface(&params.terrain)
             }),
             view: out_dir.filter(|_| output.viewer).map(|_| {
-                HexapodScene::dynamic(
-                    params.kinematic_model(),
-                    params.terrain.clone(),
-                    &layout.legs,
-                    &layout.extra_points,
-                    steps.div_ceil(stride),
+                HexapodView::dynamic(
+                    params,
                     &crate::viewer::title_of(source, "hexapod, 3D dynamics"),
                 )
             }),
@@ -335,7 +331,7 @@ impl RunFiles for Outputs {
 
     fn written(&mut self, r: &RobotRecord) {
         if let Some(v) = self.view.as_mut() {
-            v.push(&frame(&mut self.feet, &self.layout, &self.slots, r));
+            push_view(v, &self.layout, &self.slots, r);
         }
     }
 
@@ -369,10 +365,9 @@ impl RunFiles for Outputs {
             let plot = plot.finish(run.events.iter().map(EventMark::of).collect());
             plots::write(dir, &plot, keep);
         }
-        if let Some(view) = self.view {
-            let mut scene = view.finish();
-            scene.event_rows = output::run_events(run, &StepTimes::new(self.params.dt)).len();
-            keep.keep(crate::viewer::write(dir, &scene));
+        if let Some(mut view) = self.view {
+            view.set_event_rows(output::run_events(run, &StepTimes::new(self.params.dt)).len());
+            keep.keep(view.write(dir));
         }
         output::selected(output::files_as(&FILES, self.output.format), &self.output)
     }
@@ -585,8 +580,9 @@ mod tests {
         assert_eq!(s.final_height, Some(0.6 - fall));
         let page = std::fs::read_to_string(dir.path().join("viewer.html")).unwrap();
         assert!(page.contains("\"dynamic\":true"));
-        assert!(page.contains("\"foot4\""));
-        assert!(!page.contains("\"foot1\""));
+        assert!(page.contains("\"model\":\"robot\""));
+        assert!(page.contains("\"tip4\""));
+        assert!(!page.contains("\"tip1\""));
         for f in ["feet.svg", "torques.svg", "body.svg", "energy.svg"] {
             let svg = std::fs::read_to_string(dir.path().join(f)).unwrap();
             assert!(

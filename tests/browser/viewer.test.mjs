@@ -164,7 +164,11 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
         await page.evaluate(() => window.fbdViewer.annotations(false));
         await snap(page, 'frame');
         await page.evaluate(() => window.fbdViewer.annotations(true));
-        const marked = s.screen.filter((p) => dark.includes(p.name));
+        // (each dark point not hidden behind another drawn point's sphere
+        // nearer to the camera: one that reaches the 7×7 pixels around it)
+        const hidden = (p) => s.screen.some((q) => !dark.includes(q.name) && q.depth < p.depth && Math.hypot(q.x - p.x, q.y - p.y) < q.r + 5);
+        const marked = s.screen.filter((p) => dark.includes(p.name) && !hidden(p));
+        assert.ok(marked.length >= Math.min(dark.length, 3), `frame ${i}: only ${marked.length} of ${dark.join(', ')} in view`);
         const luma = await darkest(page, 'frame', marked);
         marked.forEach((p, k) => {
           assert.ok(luma[k] < 110, `frame ${i}: nothing dark drawn at ${p.name} (${p.x.toFixed(1)}, ${p.y.toFixed(1)}), darkest luma ${luma[k].toFixed(0)}`);

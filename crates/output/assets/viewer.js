@@ -671,9 +671,13 @@
   }
   function screenPoints() {
     const w = canvas.clientWidth, h = canvas.clientHeight;
-    return worldPoints().map((p) => {
-      const v = new THREE.Vector3(p.x, p.y, p.z).project(camera);
-      return { name: p.name, x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h };
+    // The camera's up direction: a drawn sphere's radius on screen.
+    const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
+    return worldPoints().map((p, i) => {
+      const c = new THREE.Vector3(p.x, p.y, p.z);
+      const v = c.clone().project(camera);
+      const e = c.addScaledVector(up, dots[i].scale.x).project(camera);
+      return { name: p.name, x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h, depth: v.z, r: Math.hypot((e.x - v.x) / 2 * w, (e.y - v.y) / 2 * h) };
     });
   }
   window.fbdViewer = {

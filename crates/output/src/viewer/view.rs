@@ -284,7 +284,8 @@ pub fn spatial_rows(
     };
     // Per leg: the foot's normal force, the hip and knee forces, the
     // torques.
-    let leg_cols: Vec<(Option<usize>, [usize; 3], [usize; 3], [usize; 3])> = legs
+    type LegColumns = (Option<usize>, [usize; 3], [usize; 3], [usize; 3]);
+    let leg_cols: Vec<LegColumns> = legs
         .iter()
         .map(|n| {
             Ok((

@@ -406,6 +406,7 @@ pub fn simulate(
         HexapodView::gait(
             &model.kin,
             model.surface.clone(),
+            model.steps.div_ceil(stride),
             &crate::viewer::title_of(source, "hexapod, kinematic gait"),
         )
     });

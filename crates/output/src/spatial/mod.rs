@@ -200,26 +200,43 @@ pub fn plot_plan(layout: &Layout, slots: &csv::Slots) -> PlotPlan {
     }
 }
 
-/// Adds a record to the viewer: the model's `q`, each contact point's
-/// state and ground force, each leg's forces and torques.
-fn push_view(view: &mut HexapodView, layout: &Layout, slots: &csv::Slots, r: &RobotRecord) {
-    let contacts: Vec<(fbd_contact::StateCode, [f64; 3])> = view
-        .contacts()
-        .iter()
-        .map(|&point| {
-            let c = slots.contacts.iter().position(|&p| p == point);
+/// The viewer of a run and its row buffers.
+struct View {
+    view: HexapodView,
+    /// Per contact point of the scene, its row in the records.
+    rows: Vec<Option<usize>>,
+    contacts: Vec<(fbd_contact::StateCode, [f64; 3])>,
+    legs: Vec<LegValues>,
+}
+
+impl View {
+    fn new(view: HexapodView, slots: &csv::Slots) -> Self {
+        let rows = view
+            .contacts()
+            .iter()
+            .map(|&point| slots.contacts.iter().position(|&p| p == point))
+            .collect();
+        let n = view.legs().len();
+        Self {
+            view,
+            rows,
+            contacts: Vec::new(),
+            legs: vec![LegValues::default(); n],
+        }
+    }
+
+    /// Adds a record: the model's `q`, each contact point's state and
+    /// ground force, each leg's forces and torques.
+    fn push(&mut self, slots: &csv::Slots, r: &RobotRecord) {
+        self.contacts.clear();
+        self.contacts.extend(self.rows.iter().map(|c| {
             c.map_or((fbd_contact::StateCode::St1, [0.0; 3]), |c| {
                 (r.contacts[c].state, r.contacts[c].force)
             })
-        })
-        .collect();
-    let legs: Vec<LegValues> = layout
-        .legs
-        .iter()
-        .enumerate()
-        .map(|(i, _)| {
+        }));
+        for (i, l) in self.legs.iter_mut().enumerate() {
             let normal = slots.tips[i].map_or(0.0, |c| r.contacts[c].normal);
-            slots.leg(r, i).map_or(
+            *l = slots.leg(r, i).map_or(
                 LegValues {
                     normal,
                     ..LegValues::default()
@@ -230,10 +247,11 @@ fn push_view(view: &mut HexapodView, layout: &Layout, slots: &csv::Slots, r: &Ro
                     knee_force: l.knee_force,
                     torque: l.torque,
                 },
-            )
-        })
-        .collect();
-    view.push_dynamic(r.t, &r.q, &contacts, &legs);
+            );
+        }
+        self.view
+            .push_dynamic(r.t, &r.q, &self.contacts, &self.legs);
+    }
 }
 
 /// What a dynamic hexapod run produced.
@@ -248,7 +266,7 @@ pub struct Outputs {
     plan: crate::tree::Plan,
     output: OutputConfig,
     plot: Option<plots::Recorder>,
-    view: Option<HexapodView>,
+    view: Option<View>,
     collect: Option<summary::Collector>,
     feet: Feet,
     slots: csv::Slots,
@@ -303,10 +321,12 @@ impl Outputs {
                     .with_surface(&params.terrain)
             }),
             view: out_dir.filter(|_| output.viewer).map(|_| {
-                HexapodView::dynamic(
+                let view = HexapodView::dynamic(
                     params,
+                    steps.div_ceil(stride),
                     &crate::viewer::title_of(source, "hexapod, 3D dynamics"),
-                )
+                );
+                View::new(view, &slots)
             }),
             feet: Feet::new(params),
             params: params.clone(),
@@ -331,7 +351,7 @@ impl RunFiles for Outputs {
 
     fn written(&mut self, r: &RobotRecord) {
         if let Some(v) = self.view.as_mut() {
-            push_view(v, &self.layout, &self.slots, r);
+            v.push(&self.slots, r);
         }
     }
 
@@ -365,7 +385,7 @@ impl RunFiles for Outputs {
             let plot = plot.finish(run.events.iter().map(EventMark::of).collect());
             plots::write(dir, &plot, keep);
         }
-        if let Some(mut view) = self.view {
+        if let Some(View { mut view, .. }) = self.view {
             view.set_event_rows(output::run_events(run, &StepTimes::new(self.params.dt)).len());
             keep.keep(view.write(dir));
         }

@@ -86,8 +86,9 @@ fn point_of(name: &str) -> Option<(usize, PointKind)> {
 
 impl HexapodView {
     /// The viewer of a kinematic gait run of the hexapod `kin` (all six
-    /// legs) over `surface`.
-    pub fn gait(kin: &HexapodModel, surface: Surface, title: &str) -> Self {
+    /// legs) over `surface`, of `rows` rows (decimated as they come,
+    /// [`RobotFrames::with_rows_planned`]).
+    pub fn gait(kin: &HexapodModel, surface: Surface, rows: usize, title: &str) -> Self {
         let layout = HexapodLayout {
             tips: true,
             knees: false,
@@ -95,17 +96,17 @@ impl HexapodView {
             ..HexapodLayout::default()
         };
         let model = fbd_robot::dh::hexapod(kin, &HexapodMasses::default(), &layout);
-        Self::of(model, kin, surface, title, false)
+        Self::of(model, kin, surface, (rows, title), false)
     }
 
-    /// The viewer of a dynamic (3D FBD) run of `params`: the model of
-    /// [`SpatialParams::robot_model`], its terrain.
-    pub fn dynamic(params: &SpatialParams, title: &str) -> Self {
+    /// The viewer of a dynamic (3D FBD) run of `params`, of `rows` rows:
+    /// the model of [`SpatialParams::robot_model`], its terrain.
+    pub fn dynamic(params: &SpatialParams, rows: usize, title: &str) -> Self {
         Self::of(
             params.robot_model(),
             &params.kinematic_model(),
             params.terrain.clone(),
-            title,
+            (rows, title),
             true,
         )
     }
@@ -114,7 +115,7 @@ impl HexapodView {
         mut model: RobotModel,
         kin: &HexapodModel,
         surface: Surface,
-        title: &str,
+        (rows, title): (usize, &str),
         dynamic: bool,
     ) -> Self {
         // The contact points in the scene's order: the feet, then leg by
@@ -130,10 +131,9 @@ impl HexapodView {
             .iter()
             .map(|c| point_of(&c.name).unwrap_or((0, PointKind::Tip)))
             .collect();
-        let mut legs: Vec<usize> = (1..=LEG_COUNT)
+        let legs: Vec<usize> = (1..=LEG_COUNT)
             .filter(|n| model.joint_index(&format!("theta1_{n}")).is_some())
             .collect();
-        legs.dedup();
         let joint = |name: String| model.joint_index(&name).unwrap_or(0);
         // The body hexagon, by mounting angle.
         let mut by_angle: Vec<usize> = (0..LEG_COUNT).collect();
@@ -249,7 +249,9 @@ impl HexapodView {
             panels: Some(panels),
             values: if dynamic { 2 * nl } else { 1 },
         };
-        let mut frames = RobotFrames::with_decor(&model, true, decor).with_title(title);
+        let mut frames = RobotFrames::with_decor(&model, true, decor)
+            .with_title(title)
+            .with_rows_planned(rows);
         if surface.exists() {
             frames = frames.with_surface(surface);
         }
@@ -382,7 +384,7 @@ mod tests {
     #[test]
     fn the_gait_scene_is_the_robot_scene_of_the_dh_model_with_the_hexapod_decor() {
         let kin = HexapodModel::default();
-        let mut v = HexapodView::gait(&kin, Surface::default(), "hexapod");
+        let mut v = HexapodView::gait(&kin, Surface::default(), 2, "hexapod");
         let mut q = vec![0.0; 24];
         q[1] = 0.5;
         for leg in 0..6 {
@@ -434,7 +436,7 @@ mod tests {
             legs: vec![3, 4],
             ..SpatialParams::default()
         };
-        let v = HexapodView::dynamic(&p, "hexapod");
+        let v = HexapodView::dynamic(&p, 1, "hexapod");
         assert_eq!(v.legs(), [3, 4]);
         assert_eq!(
             v.contacts(),
@@ -448,7 +450,7 @@ mod tests {
             ]
         );
         p.contact_points.tips = false;
-        let mut v = HexapodView::dynamic(&p, "hexapod");
+        let mut v = HexapodView::dynamic(&p, 1, "hexapod");
         assert!(v.contacts().iter().all(|c| c.1 != PointKind::Tip));
         let mut q = vec![0.0, 0.6, 0.0, 0.0, 0.0, 0.0];
         q.extend([0.0, 0.0, 4.3, 0.0, 0.0, 4.3]);

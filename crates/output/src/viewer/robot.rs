@@ -1,10 +1,15 @@
-//! The scene of an imported robot (URDF/MJCF, [`fbd_robot::RobotModel`]):
-//! every body drawn as capsules from joint to joint, computed frame by
-//! frame with `fbd_robot`'s forward kinematics; the contact points
-//! coloured by state (ST1/ST2/ST3) with their ground forces as arrows, the
-//! whole robot's centre of mass; panels of the base and centre-of-mass
-//! heights, the joint angles and, with contacts, the vertical ground
-//! forces.
+//! The one 3D scene, of every 3D model: a robot ([`fbd_robot::RobotModel`]:
+//! an imported URDF/MJCF robot, or the hexapod built from its D-H
+//! parameters, [`super::hexapod`]), every body drawn as capsules from joint
+//! to joint, computed frame by frame with `fbd_robot`'s forward kinematics;
+//! the contact points coloured by state (ST1/ST2/ST3) with their ground
+//! forces as arrows, the whole robot's centre of mass; panels of the base
+//! and centre-of-mass heights, the joint angles and, with contacts, the
+//! vertical ground forces. What a model adds to that drawing is data of
+//! the scene ([`Decor`], all optional): points fixed in bodies, the root's
+//! outline, labels beside points, a heading arrow, the feet's trails and
+//! support polygon, joint-force arrows, the names of the contact points in
+//! events and of their states, the limbs' colours and its own panels.
 //!
 //! The drawn points ([`Scene::points`]), in this order:
 //!
@@ -12,19 +17,22 @@
 //! * one per joint, named by the joint: its origin (the child body's
 //!   origin), inertial;
 //! * one per contact point, named by the point: the sphere's centre;
+//! * one per point fixed in a body ([`Decor::fixed`]), named by it;
 //! * `<body>_com`: the centre of mass of each leaf body (no child joint)
-//!   without contact points, when it is off the body's origin.
+//!   without contact or fixed points, when it is off the body's origin.
 //!
 //! The capsules ([`Scene::lines`], one colour per limb, the root's grey):
 //!
-//! * the root, with three or more child joints: a ring through their
+//! * the root, with an outline ([`Decor::outline`]): a ring through its
+//!   points; else, with three or more child joints: a ring through their
 //!   origins in the order of their angle about the root's `+y` axis (a
-//!   hexapod's body outline; the page fills it with a translucent plate
-//!   fanned from `base`); with fewer, from `base` to each child joint's
-//!   origin (a star); and from `base` to each of its own contact points;
+//!   hexapod's body outline); either ring is filled with a translucent
+//!   plate fanned from `base` ([`RobotScene::plate`]); with fewer, from
+//!   `base` to each child joint's origin (a star); and, without an outline,
+//!   from `base` to each of its own contact points;
 //! * every other body: from its joint's origin to each child joint's
-//!   origin; a leaf body from its joint's origin to each of its contact
-//!   points, or to its centre of mass when it has none;
+//!   origin; a leaf body from its joint's origin to each of its contact and
+//!   fixed points, or to its centre of mass when it has none;
 //! * segments of zero length (a massless frame between two joints at one
 //!   point) are left out: a segment's ends are fixed in one body, so its
 //!   length never changes.
@@ -34,12 +42,15 @@
 //! pose (1 cm for a robot of no size). Points are written to 1e-10 m (the
 //! test compares them with forward kinematics to 1e-9), forces to 1e-6 N.
 //!
-//! Use: [`RobotFrames::new`], [`RobotFrames::push`] for every row of
+//! Use: [`RobotFrames::new`] (or [`RobotFrames::with_decor`]),
+//! [`RobotFrames::push`] (or [`RobotFrames::push_row`]) for every row of
 //! `trajectory.csv`, then [`RobotFrames::write`]. The rows are kept until
 //! then (8 bytes per coordinate, contact state and force value, e.g.
 //! 0.4 MB per 1000 rows of an 18-joint robot with 6 contact points), since
 //! the decimation ([`super::Decimator`]) needs their count: every k-th
-//! row, the last one, and the rows at which a contact state changes.
+//! row, the last one, and the rows at which a contact state changes; a run
+//! that knows its count at the start ([`RobotFrames::with_rows_planned`])
+//! keeps only the frames (at most [`super::MAX_FRAMES`] rows).
 //!
 //! `fbd view DIR` ([`super::view`]) pushes the rows of `trajectory.csv`,
 //! gives [`RobotFrames::with_surface`] the configuration's terrain when
@@ -260,8 +271,26 @@ pub struct RobotFrames {
     com: Vec<[f64; 3]>,
     /// [`Decor::values`] per row.
     values: Vec<f64>,
+    /// The run's row of each row kept.
+    index: Vec<usize>,
+    /// Rows pushed.
+    seen: usize,
+    /// Decimation while the rows come ([`RobotFrames::with_rows_planned`]).
+    stream: Option<Stream>,
     /// The first malformed row, reported by [`RobotFrames::write`].
     error: Option<String>,
+}
+
+/// The decimation of a run whose row count is known at its start: rows
+/// that are not frames are dropped as they come (the last one pushed is
+/// kept until the next, to end the run).
+#[derive(Clone, Debug)]
+struct Stream {
+    decimator: Decimator,
+    planned: usize,
+    last_state: Option<String>,
+    /// Whether the last row kept is not a frame.
+    pending: bool,
 }
 
 impl RobotFrames {
@@ -429,6 +458,9 @@ impl RobotFrames {
             joint_force: Vec::new(),
             com: Vec::new(),
             values: Vec::new(),
+            index: Vec::new(),
+            seen: 0,
+            stream: None,
             error: None,
         };
         // The radius: a share of the size at the zero pose.
@@ -470,9 +502,24 @@ impl RobotFrames {
         self.event_rows = Some(rows);
     }
 
+    /// Decimates the rows as they come, for a run of `rows` rows: keeps
+    /// only the frames ([`super::Decimator`]: every k-th row, the rows at
+    /// which a contact state changes, the last one pushed) instead of every
+    /// row until [`RobotFrames::finish`]. The page is the same when the run
+    /// pushes `rows` rows.
+    pub fn with_rows_planned(mut self, rows: usize) -> Self {
+        self.stream = Some(Stream {
+            decimator: Decimator::new(rows),
+            planned: rows,
+            last_state: None,
+            pending: false,
+        });
+        self
+    }
+
     /// Rows pushed so far.
     pub fn rows(&self) -> usize {
-        self.t.len()
+        self.seen
     }
 
     /// The capsules' radius (m).
@@ -507,7 +554,7 @@ impl RobotFrames {
         if self.error.is_some() {
             return;
         }
-        let r = self.t.len();
+        let r = self.seen;
         if row.q.len() != nq {
             self.error = Some(format!(
                 "viewer.html: row {r}: {} coordinates for a robot of {nq}",
@@ -529,23 +576,45 @@ impl RobotFrames {
             ));
             return;
         }
+        let contacts = match row.contacts {
+            Some((state, force)) if self.contacts && (state.len() != nc || force.len() != nc) => {
+                self.error = Some(format!(
+                    "viewer.html: row {r}: {} contact states and {} forces for {nc} contact points",
+                    state.len(),
+                    force.len()
+                ));
+                return;
+            }
+            c if self.contacts => c,
+            _ => None,
+        };
+        if let Some(stream) = self.stream.as_mut() {
+            // The row before, when it is not a frame, is dropped.
+            if stream.pending {
+                let n = self.t.len() - 1;
+                self.t.truncate(n);
+                self.index.truncate(n);
+                self.q.truncate(n * nq);
+                self.state.truncate(n * if self.contacts { nc } else { 0 });
+                self.force
+                    .truncate(3 * n * if self.contacts { nc } else { 0 });
+                self.joint_force.truncate(3 * n * nf);
+                self.com.truncate(n);
+                self.values.truncate(n * nv);
+            }
+            let state: String = match contacts {
+                Some((state, _)) => state.iter().map(|&s| char::from(b'0' + code(s))).collect(),
+                None => "1".repeat(nc),
+            };
+            let changed = stream.last_state.as_ref().is_some_and(|s| *s != state);
+            stream.last_state = Some(state);
+            stream.pending = !stream.decimator.keep(r, changed, r + 1 >= stream.planned);
+        }
         if self.contacts {
-            match row.contacts {
-                Some((state, force)) if state.len() == nc && force.len() == nc => {
-                    self.state.extend(
-                        state
-                            .iter()
-                            .map(|&s| if (1..=3).contains(&s) { s } else { 1 }),
-                    );
-                    self.force.extend(force.iter().flatten());
-                }
+            match contacts {
                 Some((state, force)) => {
-                    self.error = Some(format!(
-                        "viewer.html: row {r}: {} contact states and {} forces for {nc} contact points",
-                        state.len(),
-                        force.len()
-                    ));
-                    return;
+                    self.state.extend(state.iter().map(|&s| code(s)));
+                    self.force.extend(force.iter().flatten());
                 }
                 None => {
                     self.state.extend(std::iter::repeat_n(1, nc));
@@ -553,6 +622,8 @@ impl RobotFrames {
                 }
             }
         }
+        self.seen += 1;
+        self.index.push(r);
         self.t.push(row.t);
         self.q.extend_from_slice(row.q);
         if row.joint_forces.is_empty() {
@@ -648,7 +719,8 @@ impl RobotFrames {
         let (nj, nc) = (self.model.joints.len(), self.model.contacts.len());
         let nq = 6 + nj;
         let (nf, nv) = (self.decor.joint_forces.len(), self.decor.values);
-        let rows = self.t.len();
+        let rows = self.seen;
+        let stored = self.t.len();
         let forces = self.forces();
         let names = |names: &[String]| -> Vec<usize> {
             names.iter().filter_map(|n| self.point(n)).collect()
@@ -700,12 +772,14 @@ impl RobotFrames {
             .map(|p| vec![Vec::new(); p.curves.len()])
             .collect();
         let mut data = RobotData::new(&self.model);
-        let mut decimator = Decimator::new(rows);
+        // Every row kept (decimated as they came) or every k-th row, the
+        // rows at which a state changes and the last row.
+        let mut decimator = Decimator::new(stored);
         let mut last_state: Option<String> = None;
-        for r in 0..rows {
+        for r in 0..stored {
             let state = self.states(r);
             let changed = last_state.as_ref().is_some_and(|s| *s != state);
-            let keep = decimator.keep(r, changed, r + 1 == rows);
+            let keep = self.stream.is_some() || decimator.keep(r, changed, r + 1 == stored);
             last_state = Some(state);
             if !keep {
                 continue;
@@ -717,7 +791,7 @@ impl RobotFrames {
             for &s in &self.sources {
                 p.extend(self.position(&data, s).iter().map(|&x| fine(x)));
             }
-            scene.row.push(r);
+            scene.row.push(self.index[r]);
             scene.t.push(round_time(self.t[r]));
             scene.p.push(p);
             scene.state.push(last_state.clone().unwrap_or_default());
@@ -852,6 +926,11 @@ impl Decor {
     }
 }
 
+/// A contact state code 1, 2 or 3 (ST1 for any other).
+fn code(s: u8) -> u8 {
+    if (1..=3).contains(&s) { s } else { 1 }
+}
+
 /// A coordinate rounded to 1e-10 m (see the module docs).
 fn fine(x: f64) -> f64 {
     if x.is_finite() {
@@ -975,6 +1054,27 @@ mod tests {
         let foot = &p[12..15];
         assert!((foot[2] + 0.4).abs() < 1e-9, "{foot:?}");
         assert_eq!(s.fc[1], [0.0, 9.81, 0.0]);
+    }
+
+    #[test]
+    fn rows_decimated_as_they_come_make_the_same_scene() {
+        let m = model();
+        let rows = 3 * crate::viewer::MAX_FRAMES + 7;
+        let mut all = RobotFrames::new(&m, true);
+        let mut stream = RobotFrames::new(&m, true).with_rows_planned(rows);
+        for r in 0..rows {
+            let q = [0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 1e-4 * r as f64, 0.0, 0.0];
+            // The foot touches down and lifts off at rows off the grid.
+            let state = [if (r / 777) % 2 == 1 { 2 } else { 1 }];
+            let force = [[0.0, r as f64, 0.0]];
+            for f in [&mut all, &mut stream] {
+                f.push(0.001 * r as f64, &q, Some((&state, &force)));
+            }
+        }
+        assert!(stream.t.len() <= crate::viewer::MAX_FRAMES);
+        let (a, b) = (all.finish().unwrap(), stream.finish().unwrap());
+        assert!(a.scene.row.contains(&777) && a.scene.row.contains(&1554));
+        assert_eq!(a, b);
     }
 
     #[test]

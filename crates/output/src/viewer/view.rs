@@ -195,11 +195,11 @@ fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, OutputError> 
     Ok(out)
 }
 
-/// Pushes the rows of a hexapod gait run's `trajectory.csv` to `view`:
+/// Pushes the rows of a hexapod gait run's `trajectory.csv` (`table`) to
+/// `view`:
 /// `t, rx, ry, rz, phi_x, phi_y, phi_z, theta{j}_{n}, stance{n}` and, when
 /// present, `com_x/y/z` and `margin`.
-pub fn hexapod_rows(table_file: &Path, view: &mut HexapodView) -> Result<(), OutputError> {
-    let table = Table::read(table_file)?;
+fn hexapod_rows(table: &Table, view: &mut HexapodView) -> Result<(), OutputError> {
     let t_col = table.column("t")?;
     let mut q_cols = Vec::with_capacity(6 + 3 * LEG_COUNT);
     for c in ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"] {
@@ -258,12 +258,11 @@ pub fn hexapod_rows(table_file: &Path, view: &mut HexapodView) -> Result<(), Out
 /// for the model of `params` to `view`: pose, joint angles, each contact
 /// point's state and ground force, each leg's foot normal force, hip and
 /// knee forces and torques.
-pub fn spatial_rows(
-    table_file: &Path,
+fn spatial_rows(
+    table: &Table,
     params: &fbd_sim::spatial::SpatialParams,
     view: &mut HexapodView,
 ) -> Result<(), OutputError> {
-    let table = Table::read(table_file)?;
     let legs = view.legs().to_vec();
     let t_col = table.column("t")?;
     let mut q_cols = Vec::with_capacity(6 + 3 * legs.len());
@@ -405,14 +404,16 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, OutputError> {
         }
         Config::Hexapod(c) if c.is_dynamic() => {
             let params = c.spatial_params(&source)?;
-            let mut view = HexapodView::dynamic(&params, &title);
-            spatial_rows(&traj, &params, &mut view)?;
+            let table = Table::read(&traj)?;
+            let mut view = HexapodView::dynamic(&params, table.rows.len(), &title);
+            spatial_rows(&table, &params, &mut view)?;
             view
         }
         Config::Hexapod(c) => {
             let model = c.gait_model(&source)?;
-            let mut view = HexapodView::gait(&model.kin, model.surface, &title);
-            hexapod_rows(&traj, &mut view)?;
+            let table = Table::read(&traj)?;
+            let mut view = HexapodView::gait(&model.kin, model.surface, table.rows.len(), &title);
+            hexapod_rows(&table, &mut view)?;
             view
         }
     };

@@ -164,7 +164,11 @@ async function checkRun(t, dir, { expect, dark, screenshot, shotFrame }) {
         await page.evaluate(() => window.fbdViewer.annotations(false));
         await snap(page, 'frame');
         await page.evaluate(() => window.fbdViewer.annotations(true));
-        const marked = s.screen.filter((p) => dark.includes(p.name));
+        // (each dark point not hidden behind another drawn point's sphere
+        // nearer to the camera: one that reaches the 7×7 pixels around it)
+        const hidden = (p) => s.screen.some((q) => !dark.includes(q.name) && q.depth < p.depth && Math.hypot(q.x - p.x, q.y - p.y) < q.r + 5);
+        const marked = s.screen.filter((p) => dark.includes(p.name) && !hidden(p));
+        assert.ok(marked.length >= Math.min(dark.length, 3), `frame ${i}: only ${marked.length} of ${dark.join(', ')} in view`);
         const luma = await darkest(page, 'frame', marked);
         marked.forEach((p, k) => {
           assert.ok(luma[k] < 110, `frame ${i}: nothing dark drawn at ${p.name} (${p.x.toFixed(1)}, ${p.y.toFixed(1)}), darkest luma ${luma[k].toFixed(0)}`);
@@ -342,19 +346,21 @@ test('hexapod run', async (t) => {
   assert.ok(dir, 'FBD_HEXAPOD_DIR is not set (run scripts/test-browser.sh)');
   await checkRun(t, dir, {
     expect: (row, csv) => {
-      const e = { body: [num(row, csv, 'rx'), num(row, csv, 'ry'), num(row, csv, 'rz')] };
-      for (let n = 1; n <= 6; n++) e[`foot${n}`] = ['x', 'y', 'z'].map((a) => num(row, csv, `foot${n}_${a}`));
+      const e = { base: [num(row, csv, 'rx'), num(row, csv, 'ry'), num(row, csv, 'rz')] };
+      for (let n = 1; n <= 6; n++) e[`tip${n}`] = ['x', 'y', 'z'].map((a) => num(row, csv, `foot${n}_${a}`));
       return e;
     },
-    dark: ['knee1', 'knee2', 'knee3', 'knee4', 'knee5', 'knee6'],
+    // The knees (the joints θ3, drawn in the body's colour).
+    dark: [1, 2, 3, 4, 5, 6].map((n) => `theta3_${n}`),
     screenshot: shots && join(shots, 'viewer_hexapod.png'),
     shotFrame: (v) => Math.floor(v.n / 3),
   });
   await checkLegsAndHeading(t, dir);
+  await checkCapsules(t, dir);
 });
 
-/** Leg numbers beside the hips and a heading arrow towards the body's
- *  front vertex (corner2, between legs 1 and 2). */
+/** Leg numbers beside the hips (the joints θ1) and a heading arrow
+ *  towards the body's front vertex (corner2, between legs 1 and 2). */
 async function checkLegsAndHeading(t, dir) {
   const { page, context } = await open(dir);
   try {
@@ -366,14 +372,15 @@ async function checkLegsAndHeading(t, dir) {
           v.seek(i);
           return { labels: v.legLabels(), screen: v.screenPoints(), world: v.worldPoints(), heading: v.heading() };
         }, i);
-        const hips = s.screen.filter((p) => /^hip\d$/.test(p.name));
+        const hips = s.screen.filter((p) => /^theta1_\d$/.test(p.name));
         assert.equal(s.labels.length, hips.length, `frame ${i}: ${s.labels.length} labels for ${hips.length} hips`);
         for (const l of s.labels) {
-          const h = hips.find((p) => p.name === `hip${l.leg}`);
-          assert.ok(Math.hypot(l.x - h.x, l.y - h.y) < 60, `frame ${i}: label ${l.leg} ${Math.hypot(l.x - h.x, l.y - h.y).toFixed(0)} px from its hip`);
+          assert.equal(l.point, `theta1_${l.text}`, `label ${l.text} beside ${l.point}`);
+          const h = hips.find((p) => p.name === l.point);
+          assert.ok(Math.hypot(l.x - h.x, l.y - h.y) < 60, `frame ${i}: label ${l.text} ${Math.hypot(l.x - h.x, l.y - h.y).toFixed(0)} px from its hip`);
         }
         const w = new Map(s.world.map((p) => [p.name, p]));
-        const b = w.get('body'), c = w.get('corner2');
+        const b = w.get('base'), c = w.get('corner2');
         const d = [c.x - b.x, c.y - b.y, c.z - b.z];
         const len = Math.hypot(...d);
         assert.ok(s.heading, 'no heading arrow');
@@ -381,6 +388,49 @@ async function checkLegsAndHeading(t, dir) {
         assert.ok(dot > 0.9999, `frame ${i}: heading arrow off the body's front (cos ${dot})`);
       }
     });
+  } finally {
+    await context.close();
+  }
+}
+
+/** The one 3D scene of every robot: a `robot` scene whose capsules (their
+ *  radius, between the drawn points) are all drawn on screen, at the first,
+ *  middle and last frames. */
+async function checkCapsules(t, dir) {
+  const { page, context, errors } = await open(dir);
+  try {
+    const v = await page.evaluate(() => ({ n: window.fbdViewer.frameCount, model: window.fbdViewer.model, radius: window.fbdViewer.radius, lines: window.fbdViewer.lines.length }));
+    await t.test('drawn by the one 3D scene: a robot scene of capsules', () => {
+      assert.equal(v.model, 'robot');
+      assert.ok(v.lines > 0, 'no capsules');
+      assert.ok(v.radius > 0, `capsule radius ${v.radius}`);
+    });
+    for (const i of [...new Set([0, Math.floor(v.n / 2), v.n - 1])]) {
+      await t.test(`frame ${i}: every capsule drawn on screen, at its points`, async () => {
+        const s = await page.evaluate((i) => {
+          const w = window.fbdViewer;
+          w.seek(i);
+          w.annotations(false);
+          return { world: w.worldPoints(), screen: w.screenPoints(), lines: w.lines, capsules: w.capsules() };
+        }, i);
+        // Each capsule runs between its two drawn points.
+        s.lines.forEach((l, k) => {
+          for (const [end, p] of [[0, s.world[l.a]], [1, s.world[l.b]]]) {
+            const c = s.capsules[k][end];
+            assert.ok(Math.hypot(c[0] - p.x, c[1] - p.y, c[2] - p.z) < 1e-9, `frame ${i}: capsule ${k} off ${p.name}`);
+          }
+        });
+        await snap(page, 'capsules');
+        await page.evaluate(() => window.fbdViewer.annotations(true));
+        const mids = s.lines.map((l) => ({ x: 0.5 * (s.screen[l.a].x + s.screen[l.b].x), y: 0.5 * (s.screen[l.a].y + s.screen[l.b].y) }));
+        const luma = await darkest(page, 'capsules', mids);
+        luma.forEach((l, k) => {
+          const { a, b } = s.lines[k];
+          assert.ok(l < 230, `frame ${i}: capsule ${s.screen[a].name}–${s.screen[b].name} not drawn (lightest ${l.toFixed(0)})`);
+        });
+      });
+    }
+    await t.test('no console error', () => assert.deepEqual(errors, []));
   } finally {
     await context.close();
   }
@@ -394,8 +444,8 @@ test('dynamic hexapod run (3D FBD)', async (t) => {
   const legs = [1, 2, 3, 4, 5, 6].filter((n) => csv.header.includes(`state${n}`));
   await checkRun(t, dir, {
     expect: (row, csv) => {
-      const e = { body: [num(row, csv, 'rx'), num(row, csv, 'ry'), num(row, csv, 'rz')] };
-      for (const n of legs) e[`foot${n}`] = ['x', 'y', 'z'].map((a) => num(row, csv, `foot${n}_${a}`));
+      const e = { base: [num(row, csv, 'rx'), num(row, csv, 'ry'), num(row, csv, 'rz')] };
+      for (const n of legs) e[`tip${n}`] = ['x', 'y', 'z'].map((a) => num(row, csv, `foot${n}_${a}`));
       return e;
     },
     // The body's corners (the knees are contact points, coloured by state).
@@ -404,6 +454,7 @@ test('dynamic hexapod run (3D FBD)', async (t) => {
     shotFrame: (v) => Math.floor(v.n / 3),
   });
   await checkLegsAndHeading(t, dir);
+  await checkCapsules(t, dir);
   await t.test('the slope of the ground is drawn and named', async () => {
     const { page, context } = await open(dir);
     try {

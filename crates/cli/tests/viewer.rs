@@ -169,6 +169,71 @@ fn fbd_view_rebuilds_the_same_page_from_the_files() {
     }
 }
 
+/// The names of the scene's capsules, `a–b`, sorted.
+fn capsules(sc: &serde_json::Value) -> Vec<String> {
+    let names = sc["points"].as_array().unwrap();
+    let mut out: Vec<String> = sc["lines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| {
+            let name = |k: &str| names[l[k].as_u64().unwrap() as usize].as_str().unwrap();
+            format!("{}–{}", name("a"), name("b"))
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// The hexapod's page is the one 3D scene of every robot: the generic
+/// robot fields (capsules of a radius, the plate, the labels, the heading)
+/// of its D-H model, the drawn points where `trajectory.csv` puts them.
+fn check_hexapod_scene(sc: &serde_json::Value, legs: &[usize]) {
+    assert_eq!(sc["model"], "robot");
+    let radius = f(&sc["radius"]);
+    assert!(radius > 0.0 && radius < 0.05, "capsule radius {radius} m");
+    // The body hexagon as the root's outline, filled.
+    let plate: Vec<usize> = sc["plate"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap() as usize)
+        .collect();
+    let corners: Vec<usize> = (1..=6).map(|k| point(sc, &format!("corner{k}"))).collect();
+    assert_eq!(plate, corners);
+    assert_eq!(sc["heading"].as_u64(), Some(point(sc, "corner2") as u64));
+    assert_eq!(point(sc, "base"), 0);
+    // A leg number beside each hip (the joint θ1 of the leg).
+    let labels: Vec<(String, usize)> = sc["labels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| {
+            (
+                l["text"].as_str().unwrap().to_owned(),
+                l["point"].as_u64().unwrap() as usize,
+            )
+        })
+        .collect();
+    let want: Vec<(String, usize)> = legs
+        .iter()
+        .map(|n| (n.to_string(), point(sc, &format!("theta1_{n}"))))
+        .collect();
+    assert_eq!(labels, want);
+    // The capsules: the hexagon, and per leg the upper link (θ2's origin,
+    // the hip, to θ3's, the knee) and the lower link (knee to foot); the
+    // coxa (θ1 to θ2, one point) has no length.
+    let mut want: Vec<String> = (1..=6)
+        .map(|k| format!("corner{k}–corner{}", k % 6 + 1))
+        .collect();
+    for n in legs {
+        want.push(format!("theta2_{n}–theta3_{n}"));
+        want.push(format!("theta3_{n}–tip{n}"));
+    }
+    want.sort();
+    assert_eq!(capsules(sc), want);
+}
+
 #[test]
 fn hexapod_page_draws_the_feet_where_the_csv_has_them() {
     let dir = tempfile::tempdir().unwrap();
@@ -176,13 +241,32 @@ fn hexapod_page_draws_the_feet_where_the_csv_has_them() {
     let o = fbd(&["run", &example("hexapod_tripod.toml"), "--out", s(&out)]);
     assert!(o.status.success(), "{}", stderr(&o));
     let sc = scene(&out);
+    check_hexapod_scene(&sc, &[1, 2, 3, 4, 5, 6]);
+    // A kinematic gait: swing and stance, no forces.
+    assert_eq!(sc["state_names"], serde_json::json!(["swing", "stance"]));
+    assert!(sc.get("dynamic").is_none());
     let (h, rows) = csv(&out);
     let n = sc["t"].as_array().unwrap().len();
     assert_eq!(n, rows.len());
     let col = |row: &[String], name: &str| -> f64 { row[h[name]].parse().unwrap() };
-    let feet: Vec<usize> = (1..=6).map(|l| point(&sc, &format!("foot{l}"))).collect();
+    let feet: Vec<usize> = (1..=6).map(|l| point(&sc, &format!("tip{l}"))).collect();
+    let contacts: Vec<usize> = sc["contacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["point"].as_u64().unwrap() as usize)
+        .collect();
+    assert_eq!(contacts, feet);
     for k in 0..n {
         let row = &rows[k];
+        let base = at(&sc, k, 0);
+        for (a, c) in ["rx", "ry", "rz"].iter().enumerate() {
+            assert!((base[a] - col(row, c)).abs() < 1e-9, "frame {k}: base {c}");
+        }
+        let com = &sc["com"][k];
+        for (a, c) in ["com_x", "com_y", "com_z"].iter().enumerate() {
+            assert!((f(&com[a]) - col(row, c)).abs() < 1e-9, "frame {k}: {c}");
+        }
         for (l, &p) in feet.iter().enumerate() {
             let d = at(&sc, k, p);
             for (a, axis) in ["x", "y", "z"].iter().enumerate() {
@@ -199,6 +283,110 @@ fn hexapod_page_draws_the_feet_where_the_csv_has_them() {
             assert_eq!(stance, drawn, "frame {k}: stance of leg {}", l + 1);
         }
     }
+    let panels: Vec<&str> = sc["panels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["title"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        panels,
+        [
+            "Body height Ry (m)",
+            "Hip-lift angles θ2 (°)",
+            "Knee angles θ3 (°)",
+            "Stability margin (m)"
+        ]
+    );
+}
+
+/// A dynamic hexapod configuration of legs 3 and 4 dropped onto the
+/// ground, feet, knees and hips contact points.
+const DROP: &str = "model = \"hexapod\"\nlegs = [3, 4]\n[time]\ndt = 0.001\nduration = 0.15\n\
+[initial]\nposition = [0.0, 0.4, 0.0]\n[initial.leg3]\ntheta_deg = [0.0, 0.0, 250.0]\n\
+[initial.leg4]\ntheta_deg = [0.0, 0.0, 250.0]\n";
+
+#[test]
+fn dynamic_hexapod_page_is_the_robot_scene_of_its_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = write(dir.path(), "drop.toml", DROP);
+    let out = dir.path().join("drop");
+    let o = fbd(&["run", s(&cfg), "--out", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let page = std::fs::read(out.join("viewer.html")).unwrap();
+    let sc = scene(&out);
+    check_hexapod_scene(&sc, &[3, 4]);
+    assert_eq!(sc["dynamic"], true);
+    assert!(sc.get("state_names").is_none());
+    // The contact points: the feet, then leg by leg the knee and the hip.
+    let names: Vec<&str> = sc["contacts"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["tip3", "tip4", "knee3", "hip3", "knee4", "hip4"]);
+    let joints: Vec<&str> = sc["joints"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|c| c["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(joints, ["hip3", "knee3", "hip4", "knee4"]);
+    let (h, rows) = csv(&out);
+    let n = sc["t"].as_array().unwrap().len();
+    assert_eq!(n, rows.len());
+    let col = |row: &[String], name: &str| -> f64 { row[h[name]].parse().unwrap() };
+    let columns = [
+        ("tip3", "state3", "foot3"),
+        ("tip4", "state4", "foot4"),
+        ("knee3", "kneepoint3_state", "kneepoint3"),
+        ("hip3", "hippoint3_state", "hippoint3"),
+        ("knee4", "kneepoint4_state", "kneepoint4"),
+        ("hip4", "hippoint4_state", "hippoint4"),
+    ];
+    let mut touched = 0;
+    for k in 0..n {
+        let row = &rows[k];
+        let state = sc["state"][k].as_str().unwrap().as_bytes();
+        for (c, (name, st, force)) in columns.iter().enumerate() {
+            assert_eq!(
+                row[h[*st]],
+                format!("ST{}", state[c] as char),
+                "frame {k}: {name}"
+            );
+            for (a, axis) in ["fx", "fy", "fz"].iter().enumerate() {
+                let want = col(row, &format!("{force}_{axis}"));
+                let drawn = f(&sc["fc"][k][3 * c + a]);
+                assert!((drawn - want).abs() < 1e-6, "frame {k}: {name} {axis}");
+            }
+        }
+        touched += state.iter().filter(|&&s| s != b'1').count();
+        for (l, leg) in [3, 4].iter().enumerate() {
+            let d = at(&sc, k, point(&sc, &format!("tip{leg}")));
+            for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+                let want = col(row, &format!("foot{leg}_{axis}"));
+                assert!((d[a] - want).abs() < 1e-6, "frame {k}: foot {leg} {axis}");
+            }
+            // The joint-force arrows: the hip's and the knee's forces.
+            for (j, joint) in ["hip", "knee"].iter().enumerate() {
+                for (a, axis) in ["fx", "fy", "fz"].iter().enumerate() {
+                    let want = col(row, &format!("{joint}{leg}_{axis}"));
+                    let drawn = f(&sc["fj"][k][3 * (2 * l + j) + a]);
+                    assert!(
+                        (drawn - want).abs() < 1e-6,
+                        "frame {k}: {joint}{leg} {axis}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(touched > 0, "no contact point touched the ground");
+    // `fbd view` writes the same page from the files.
+    std::fs::remove_file(out.join("viewer.html")).unwrap();
+    let o = fbd(&["view", s(&out)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::read(out.join("viewer.html")).unwrap() == page);
 }
 
 #[test]

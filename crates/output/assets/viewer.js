@@ -10,14 +10,15 @@
   const S = JSON.parse(document.getElementById('fbd-scene').textContent);
   const N = S.t.length;
   const planar = S.model === 'planar';
-  // An imported robot (URDF/MJCF): its bodies as capsules of radius
-  // S.radius between the points (joint origins, contact points, centres of
-  // mass), one colour per limb.
-  const robotKind = S.model === 'robot';
-  const hexapod = S.model === 'hexapod';
-  // Contact states ST1/ST2/ST3 and force arrows: the planar model, a
-  // dynamic hexapod run (a kinematic gait has only swing and stance) and
-  // a robot's run with contacts.
+  // Every 3D model (an imported URDF/MJCF robot, the hexapod) is one kind
+  // of scene: its bodies as capsules of radius S.radius between the points
+  // (joint origins, contact points, points fixed in bodies, centres of
+  // mass), one colour per limb; what a model adds is data of the scene
+  // (S.plate, S.labels, S.heading, S.ring, S.joints, S.state_names).
+  const robotKind = !planar;
+  // Contact states ST1/ST2/ST3 and force arrows: the planar model and a
+  // 3D run with contacts (a kinematic gait has only swing and stance:
+  // S.state_names).
   const forces = planar || !!S.dynamic;
   const NP = S.points.length;
 
@@ -128,28 +129,15 @@
     scene.add(m);
     return m;
   });
-  // Hexapod: a translucent body plate (fan from the centre to the corners).
+  // The root's outline (S.plate, point indices in order: a hexapod's body
+  // hexagon, a robot's ring of hips) filled with a translucent plate
+  // fanned from `base` (point 0).
   let plate = null;
-  if (hexapod) {
-    const corners = S.points.map((n, i) => [n, i]).filter(([n]) => /^corner/.test(n)).map(([, i]) => i);
+  if (robotKind && S.plate && S.plate.length >= 3) {
     const g = new THREE.BufferGeometry();
-    g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(corners.length * 9), 3));
+    g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(S.plate.length * 9), 3));
     plate = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ color: 0x90a4ae, transparent: true, opacity: 0.55, side: THREE.DoubleSide }));
-    plate.userData.corners = corners;
     scene.add(plate);
-  }
-  // Robot: the root's ring (its capsules not at `base`, point 0) filled
-  // with a translucent plate fanned from `base`.
-  let rootPlate = null;
-  if (robotKind) {
-    const ring = S.lines.filter((l) => l.group === 0 && l.a !== 0 && l.b !== 0);
-    if (ring.length >= 3) {
-      const g = new THREE.BufferGeometry();
-      g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(ring.length * 9), 3));
-      rootPlate = new THREE.Mesh(g, new THREE.MeshBasicMaterial({ color: 0x90a4ae, transparent: true, opacity: 0.55, side: THREE.DoubleSide }));
-      rootPlate.userData.ring = ring;
-      scene.add(rootPlate);
-    }
   }
   // Centre of mass and its vertical line to the ground.
   const com = new THREE.Mesh(sphereGeo, mat(0x000000));
@@ -158,9 +146,9 @@
   const comLine = new THREE.Line(new THREE.BufferGeometry().setFromPoints([new THREE.Vector3(), new THREE.Vector3()]),
     new THREE.LineDashedMaterial({ color: 0x000000, dashSize: 0.02, gapSize: 0.015 }));
   scene.add(comLine);
-  // Support polygon of the stance feet (hexapod).
+  // Support polygon of the stance feet (S.ring: a hexapod's feet).
   const support = new THREE.LineLoop(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0x2e7d32 }));
-  support.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * 6), 3));
+  support.geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(3 * Math.max(S.ring.length, 1)), 3));
   scene.add(support);
   // Force arrows.
   // Drawn over the robot (no depth test) so that short arrows stay visible.
@@ -178,14 +166,14 @@
     for (let f = 0; f < N; f++) for (let a = 0; a < 3; a++) pos[3 * f + a] = S.p[f][3 * pi + a];
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    // Hexapod: the colour of the leg whose link ends at the trail's point.
+    // 3D: the colour of the limb whose capsule ends at the trail's point.
     const leg = S.lines.find((l) => l.b === pi && l.group > 0);
     const c = planar || !leg ? LEGS[k % LEGS.length] : LEGS[(leg.group - 1) % LEGS.length];
     const line = new THREE.Line(g, new THREE.LineBasicMaterial({ color: c, transparent: true, opacity: 0.6 }));
     scene.add(line);
     return line;
   });
-  // Terrain: the heights y = ϱ(x, z) on a grid (hexapod), or the profile
+  // Terrain: the heights y = ϱ(x, z) on a grid (3D), or the profile
   // y = ϱ(x), drawn as a line with a shaded area below (planar) or extruded
   // along Z.
   if (S.terrain.kind === 'grid') {
@@ -341,13 +329,13 @@
     clipped = [];
     S.contacts.forEach((c, k) => {
       dots[c.point].material.color.setHex(STATE[st[k]] || STATE['1']);
-      setArrow(contactArrows[k], P(f, c.point), S.fc[f], k, showContact.checked, S.points[c.point]);
+      setArrow(contactArrows[k], P(f, c.point), S.fc[f], k, showContact.checked, c.name);
     });
-    S.joints.forEach((j, k) => setArrow(jointArrows[k], P(f, j.point), S.fj[f], k, showJoint.checked, S.points[j.point] + ' joint'));
+    S.joints.forEach((j, k) => setArrow(jointArrows[k], P(f, j.point), S.fj[f], k, showJoint.checked, j.name + ' joint'));
     updateLabels(f);
     if (plate) {
       const a = plate.geometry.attributes.position;
-      const cs = plate.userData.corners;
+      const cs = S.plate;
       const c0 = P(f, 0);
       cs.forEach((ci, k) => {
         const p1 = P(f, ci), p2 = P(f, cs[(k + 1) % cs.length]);
@@ -355,16 +343,6 @@
       });
       a.needsUpdate = true;
       plate.geometry.computeBoundingSphere();
-    }
-    if (rootPlate) {
-      const a = rootPlate.geometry.attributes.position;
-      const c0 = P(f, 0);
-      rootPlate.userData.ring.forEach((l, k) => {
-        const p1 = P(f, l.a), p2 = P(f, l.b);
-        a.setXYZ(3 * k, c0.x, c0.y, c0.z); a.setXYZ(3 * k + 1, p1.x, p1.y, p1.z); a.setXYZ(3 * k + 2, p2.x, p2.y, p2.z);
-      });
-      a.needsUpdate = true;
-      rootPlate.geometry.computeBoundingSphere();
     }
     const c = new THREE.Vector3(S.com[f][0], S.com[f][1], S.com[f][2]);
     com.position.copy(c);
@@ -399,47 +377,41 @@
     return xy[xy.length - 1];
   }
 
-  // ---- hexapod: leg numbers and the heading arrow ---------------------------
-  // A number beside each hip (sprites that face the camera), and an arrow
-  // from the body centre towards the front vertex of the body hexagon
-  // (corner2, between legs 1 and 2: the body's forward −z).
-  const pointIndex = new Map(S.points.map((n, i) => [n, i]));
+  // ---- labels (a hexapod's leg numbers) and the heading arrow -------------
+  // A label beside each of S.labels' points (sprites that face the camera,
+  // in the colour of their group), and an arrow from `base` (point 0)
+  // towards S.heading (a hexapod's front vertex, corner2).
   const legLabels = [];
   let headingArrow = null;
-  if (hexapod) {
-    for (let n = 1; n <= 6; n++) {
-      const hip = pointIndex.get('hip' + n);
-      if (hip === undefined) continue;
-      const c = document.createElement('canvas');
-      c.width = c.height = 64;
-      const g = c.getContext('2d');
-      g.fillStyle = '#ffffff'; g.beginPath(); g.arc(32, 32, 28, 0, 2 * Math.PI); g.fill();
-      g.strokeStyle = css(LEGS[(n - 1) % LEGS.length]); g.lineWidth = 6; g.stroke();
-      g.fillStyle = '#263238'; g.font = 'bold 40px sans-serif'; g.textAlign = 'center'; g.textBaseline = 'middle';
-      g.fillText(String(n), 32, 34);
-      const sp = new THREE.Sprite(new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(c), depthTest: false }));
-      sp.renderOrder = 11;
-      sp.scale.setScalar(0.07 * robot);
-      scene.add(sp);
-      legLabels.push({ leg: n, hip, sprite: sp });
-    }
-    if (pointIndex.has('corner2') && pointIndex.has('body')) {
-      headingArrow = new THREE.ArrowHelper(Y, new THREE.Vector3(), 0.1, 0xff6f00);
-      for (const part of [headingArrow.line, headingArrow.cone]) { part.material.depthTest = false; part.renderOrder = 10; }
-      scene.add(headingArrow);
-    }
+  for (const l of (robotKind && S.labels) || []) {
+    const c = document.createElement('canvas');
+    c.width = c.height = 64;
+    const g = c.getContext('2d');
+    g.fillStyle = '#ffffff'; g.beginPath(); g.arc(32, 32, 28, 0, 2 * Math.PI); g.fill();
+    g.strokeStyle = css(l.group > 0 ? LEGS[(l.group - 1) % LEGS.length] : BODY); g.lineWidth = 6; g.stroke();
+    g.fillStyle = '#263238'; g.font = 'bold ' + (l.text.length > 2 ? 24 : 40) + 'px sans-serif'; g.textAlign = 'center'; g.textBaseline = 'middle';
+    g.fillText(l.text, 32, 34);
+    const sp = new THREE.Sprite(new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(c), depthTest: false }));
+    sp.renderOrder = 11;
+    sp.scale.setScalar(0.07 * robot);
+    scene.add(sp);
+    legLabels.push({ text: l.text, point: l.point, sprite: sp });
+  }
+  if (robotKind && typeof S.heading === 'number') {
+    headingArrow = new THREE.ArrowHelper(Y, new THREE.Vector3(), 0.1, 0xff6f00);
+    for (const part of [headingArrow.line, headingArrow.cone]) { part.material.depthTest = false; part.renderOrder = 10; }
+    scene.add(headingArrow);
   }
   function updateLabels(f) {
-    // A quarter of the way from the hip to the body centre, above it:
-    // clear of the body's corners and the knees.
-    const b = P(f, pointIndex.get('body') ?? 0);
+    // A third of the way from the point to `base`, above it: clear of a
+    // hexapod's body corners and knees.
+    const b = P(f, 0);
     for (const l of legLabels) {
-      const p = P(f, l.hip).lerp(b, 0.3);
+      const p = P(f, l.point).lerp(b, 0.3);
       l.sprite.position.set(p.x, p.y + 0.1 * robot, p.z);
     }
     if (headingArrow) {
-      const b = P(f, pointIndex.get('body'));
-      const d = P(f, pointIndex.get('corner2')).sub(b);
+      const d = P(f, S.heading).sub(b);
       headingArrow.position.copy(b);
       headingArrow.setDirection(d.normalize());
       headingArrow.setLength(0.45 * robot, 0.08 * robot, 0.04 * robot);
@@ -489,7 +461,7 @@
       parts.push('<span class="bar" style="width:' + scaleBar.px.toFixed(1) + 'px"></span> ' +
         Number(metres.toPrecision(2)) + ' m', '<span class="axes">↑ Y (up) → X</span>');
     } else {
-      parts.push('<span class="axes">axes: <b style="color:#e53935">X</b> <b style="color:#43a047">Y up</b> <b style="color:#1e88e5">Z</b>' + (hexapod ? '; <b style="color:#ff6f00">→</b> heading' : '') + '</span>');
+      parts.push('<span class="axes">axes: <b style="color:#e53935">X</b> <b style="color:#43a047">Y up</b> <b style="color:#1e88e5">Z</b>' + (headingArrow ? '; <b style="color:#ff6f00">→</b> heading' : '') + '</span>');
     }
     if (slopeNote) parts.push(slopeNote);
     if (clipped.length) {
@@ -661,27 +633,28 @@
   // ---- header and legend -------------------------------------------------
   document.getElementById('title').textContent = 'fbd viewer — ' + S.title;
   const kindNote = planar ? 'planar model, side view'
-    : robotKind ? (S.dynamic ? 'robot, 3D dynamics on the ground' : 'robot, 3D') + ' · capsules ' + Number((1000 * radius).toPrecision(2)) + ' mm'
-      : S.dynamic ? 'hexapod, 3D dynamics' : 'hexapod, 3D';
+    : (S.dynamic ? '3D dynamics on the ground' : S.state_names ? '3D kinematics' : '3D') + ' · capsules ' + Number((1000 * radius).toPrecision(2)) + ' mm';
   document.getElementById('info').textContent = kindNote + ' · ' + N + ' frames of ' + S.rows + ' rows' +
     (N < S.rows ? ' (decimated, every event kept)' : '') + ' · ' + (S.event_rows || S.events.length) + ' events (events.csv' +
     (S.event_rows > S.events.length ? '; ' + S.events.length + ' contact changes marked' : '') + ')' +
     (forceScale > 0 ? ' · arrows: ' + Number((0.1 / forceScale).toPrecision(2)) + ' N per 0.1 m' : '');
   const legend = document.getElementById('legend');
-  const states = forces ? ['1', '2', '3'] : robotKind ? ['1'] : ['1', '2'];
-  for (const s of states) {
+  // The contact states: named by the scene (a kinematic gait: swing,
+  // stance), else ST1–ST3 (ST1 only without forces).
+  const states = S.state_names ? S.state_names.map((name, i) => [String(i + 1), name])
+    : (forces ? ['1', '2', '3'] : ['1']).map((s) => [s, STATE_NAME[s]]);
+  for (const [s, name] of states) {
     const sw = document.createElement('span');
     sw.className = 'sw';
-    sw.style.background = css(STATE[s]);
-    legend.append(sw, document.createTextNode(forces || robotKind ? STATE_NAME[s] : s === '1' ? 'swing' : 'stance'));
+    sw.style.background = css(STATE[s] || STATE['1']);
+    legend.append(sw, document.createTextNode(name));
   }
   const keys = planar
     ? [[CONTACT_FORCE, 'contact force'], [JOINT_FORCE, 'joint force'], [0x000000, 'centre of mass']]
-    : robotKind
-      ? (forces ? [[CONTACT_FORCE, 'ground force on the contact point']] : []).concat([[BODY, 'root body'], [0x000000, 'centre of mass']])
-      : forces
-      ? [[CONTACT_FORCE, 'ground force on the foot'], [JOINT_FORCE, 'hip and knee forces'], [0x000000, 'centre of mass'], [0x2e7d32, 'support polygon']]
-      : [[0x000000, 'centre of mass'], [0x2e7d32, 'support polygon']];
+    : (forces && S.contacts.length ? [[CONTACT_FORCE, 'ground force on the contact points']] : [])
+      .concat(S.joints.length ? [[JOINT_FORCE, 'joint forces (parent on child): ' + S.joints.map((j) => j.name.replace(/\d+$/, '')).filter((n, i, a) => a.indexOf(n) === i).join(', ')]] : [])
+      .concat([[BODY, 'root body'], [0x000000, 'centre of mass']])
+      .concat(S.ring.length ? [[0x2e7d32, 'support polygon']] : []);
   for (const [c, label] of keys) {
     const sw = document.createElement('span');
     sw.className = 'sw';
@@ -689,7 +662,7 @@
     legend.append(sw, document.createTextNode(label));
   }
   if (!forces) { showJoint.parentElement.style.display = 'none'; showContact.parentElement.style.display = 'none'; }
-  if (robotKind && S.joints.length === 0) showJoint.parentElement.style.display = 'none';
+  if (S.joints.length === 0) showJoint.parentElement.style.display = 'none';
 
   // ---- the test interface -------------------------------------------------
   function worldPoints() {
@@ -698,9 +671,13 @@
   }
   function screenPoints() {
     const w = canvas.clientWidth, h = canvas.clientHeight;
-    return worldPoints().map((p) => {
-      const v = new THREE.Vector3(p.x, p.y, p.z).project(camera);
-      return { name: p.name, x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h };
+    // The camera's up direction: a drawn sphere's radius on screen.
+    const up = new THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
+    return worldPoints().map((p, i) => {
+      const c = new THREE.Vector3(p.x, p.y, p.z);
+      const v = c.clone().project(camera);
+      const e = c.addScaledVector(up, dots[i].scale.x).project(camera);
+      return { name: p.name, x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h, depth: v.z, r: Math.hypot((e.x - v.x) / 2 * w, (e.y - v.y) / 2 * h) };
     });
   }
   window.fbdViewer = {
@@ -745,12 +722,13 @@
     },
     scaleBar() { return Object.assign({}, scaleBar); },
     slopeNote,
-    /** Leg numbers: leg and screen position of each label. */
+    /** Labels (a hexapod's leg numbers): text, the point's name and the
+     *  label's screen position. */
     legLabels() {
       const w = canvas.clientWidth, h = canvas.clientHeight;
       return legLabels.map((l) => {
         const v = l.sprite.position.clone().project(camera);
-        return { leg: l.leg, x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h, visible: l.sprite.visible };
+        return { text: l.text, point: S.points[l.point], x: (v.x + 1) / 2 * w, y: (1 - v.y) / 2 * h, visible: l.sprite.visible };
       });
     },
     /** The heading arrow's direction (world), or null. */

@@ -17,7 +17,7 @@ use crate::OutputError;
 use crate::config::{Config, HexapodConfig};
 use crate::driver::{Recording, RunFiles, RunOutput};
 use crate::output::{self, Ending};
-use crate::viewer::hexapod::{HexFrame, HexapodScene};
+use crate::viewer::hexapod::HexapodView;
 
 pub use plots::{GaitPlotData, footprints_svg, gait_svg, joints_svg};
 
@@ -308,7 +308,7 @@ struct GaitFiles {
     model: GaitModel,
     output: fbd_scenario::OutputConfig,
     plot: Option<GaitPlotData>,
-    view: Option<HexapodScene>,
+    view: Option<HexapodView>,
 }
 
 impl RunFiles for GaitFiles {
@@ -322,7 +322,7 @@ impl RunFiles for GaitFiles {
 
     fn written(&mut self, d: &GaitData) {
         if let Some(v) = self.view.as_mut() {
-            v.push(&HexFrame::of_gait(d));
+            v.push_gait_data(d);
         }
     }
 
@@ -357,10 +357,9 @@ impl RunFiles for GaitFiles {
                 keep,
             );
         }
-        if let Some(view) = self.view {
-            let mut scene = view.finish();
-            scene.event_rows = run.events.len();
-            keep.keep(crate::viewer::write(dir, &scene));
+        if let Some(mut view) = self.view {
+            view.set_event_rows(run.events.len());
+            keep.keep(view.write(dir));
         }
         output::selected(output::files_as(&FILES, self.output.format), &self.output)
     }
@@ -404,8 +403,8 @@ pub fn simulate(
         .map(|_| GaitPlotData::new(&model));
     // viewer.html: one frame per trajectory row (decimated when long).
     let view = out_dir.filter(|_| h.output.viewer).map(|_| {
-        HexapodScene::new(
-            model.kin.clone(),
+        HexapodView::gait(
+            &model.kin,
             model.surface.clone(),
             model.steps.div_ceil(stride),
             &crate::viewer::title_of(source, "hexapod, kinematic gait"),

@@ -27,7 +27,7 @@ use crate::output::{self, Ending};
 use crate::plot::EventMark;
 use crate::steptime::StepTimes;
 use crate::tree::plots::{self, Curve, PlotPlan, leg_color};
-use crate::viewer::hexapod::{HexDynamics, HexFrame, HexapodScene};
+use crate::viewer::hexapod::{HexapodView, LegValues};
 
 pub use csv::columns;
 pub use summary::SpatialSummary;
@@ -200,39 +200,57 @@ pub fn plot_plan(layout: &Layout, slots: &csv::Slots) -> PlotPlan {
     }
 }
 
-/// The viewer frame of a record.
-fn frame(feet: &mut Feet, layout: &Layout, slots: &csv::Slots, r: &RobotRecord) -> HexFrame {
-    feet.update(&r.q);
-    let mut d = HexDynamics::default();
-    for (i, &n) in layout.legs.iter().enumerate() {
-        if let Some(c) = slots.tips[i] {
-            d.state[n - 1] = r.contacts[c].state;
-            d.foot_force[n - 1] = r.contacts[c].force;
-            d.normal[n - 1] = r.contacts[c].normal;
-        }
-        for (k, kind) in [PointKind::Knee, PointKind::Hip].into_iter().enumerate() {
-            let c = layout
-                .extra_points
-                .iter()
-                .position(|p| *p == (n, kind))
-                .and_then(|e| slots.extras[e]);
-            if let Some(c) = c {
-                d.points[n - 1][k] = (r.contacts[c].state, r.contacts[c].force);
-            }
-        }
-        if let Some(l) = slots.leg(r, i) {
-            d.hip_force[n - 1] = l.hip_force;
-            d.knee_force[n - 1] = l.knee_force;
-            d.torque[n - 1] = l.torque;
+/// The viewer of a run and its row buffers.
+struct View {
+    view: HexapodView,
+    /// Per contact point of the scene, its row in the records.
+    rows: Vec<Option<usize>>,
+    contacts: Vec<(fbd_contact::StateCode, [f64; 3])>,
+    legs: Vec<LegValues>,
+}
+
+impl View {
+    fn new(view: HexapodView, slots: &csv::Slots) -> Self {
+        let rows = view
+            .contacts()
+            .iter()
+            .map(|&point| slots.contacts.iter().position(|&p| p == point))
+            .collect();
+        let n = view.legs().len();
+        Self {
+            view,
+            rows,
+            contacts: Vec::new(),
+            legs: vec![LegValues::default(); n],
         }
     }
-    HexFrame {
-        t: r.t,
-        q: *feet.q(),
-        stance: d.state.map(|s| s != fbd_contact::StateCode::St1),
-        com: feet.com(),
-        margin: None,
-        dynamics: Some(d),
+
+    /// Adds a record: the model's `q`, each contact point's state and
+    /// ground force, each leg's forces and torques.
+    fn push(&mut self, slots: &csv::Slots, r: &RobotRecord) {
+        self.contacts.clear();
+        self.contacts.extend(self.rows.iter().map(|c| {
+            c.map_or((fbd_contact::StateCode::St1, [0.0; 3]), |c| {
+                (r.contacts[c].state, r.contacts[c].force)
+            })
+        }));
+        for (i, l) in self.legs.iter_mut().enumerate() {
+            let normal = slots.tips[i].map_or(0.0, |c| r.contacts[c].normal);
+            *l = slots.leg(r, i).map_or(
+                LegValues {
+                    normal,
+                    ..LegValues::default()
+                },
+                |l| LegValues {
+                    normal,
+                    hip_force: l.hip_force,
+                    knee_force: l.knee_force,
+                    torque: l.torque,
+                },
+            );
+        }
+        self.view
+            .push_dynamic(r.t, &r.q, &self.contacts, &self.legs);
     }
 }
 
@@ -248,7 +266,7 @@ pub struct Outputs {
     plan: crate::tree::Plan,
     output: OutputConfig,
     plot: Option<plots::Recorder>,
-    view: Option<HexapodScene>,
+    view: Option<View>,
     collect: Option<crate::tree::summary::Collector>,
     feet: Feet,
     slots: csv::Slots,
@@ -303,14 +321,12 @@ impl Outputs {
                     .with_surface(&params.terrain)
             }),
             view: out_dir.filter(|_| output.viewer).map(|_| {
-                HexapodScene::dynamic(
-                    params.kinematic_model(),
-                    params.terrain.clone(),
-                    &layout.legs,
-                    &layout.extra_points,
+                let view = HexapodView::dynamic(
+                    params,
                     steps.div_ceil(stride),
                     &crate::viewer::title_of(source, "hexapod, 3D dynamics"),
-                )
+                );
+                View::new(view, &slots)
             }),
             feet: Feet::new(params),
             params: params.clone(),
@@ -335,7 +351,7 @@ impl RunFiles for Outputs {
 
     fn written(&mut self, r: &RobotRecord) {
         if let Some(v) = self.view.as_mut() {
-            v.push(&frame(&mut self.feet, &self.layout, &self.slots, r));
+            v.push(&self.slots, r);
         }
     }
 
@@ -375,10 +391,9 @@ impl RunFiles for Outputs {
             let plot = plot.finish(run.events.iter().map(EventMark::of).collect());
             plots::write(dir, &plot, keep);
         }
-        if let Some(view) = self.view {
-            let mut scene = view.finish();
-            scene.event_rows = output::run_events(run, &StepTimes::new(self.params.dt)).len();
-            keep.keep(crate::viewer::write(dir, &scene));
+        if let Some(View { mut view, .. }) = self.view {
+            view.set_event_rows(output::run_events(run, &StepTimes::new(self.params.dt)).len());
+            keep.keep(view.write(dir));
         }
         output::selected(output::files_as(&FILES, self.output.format), &self.output)
     }
@@ -598,8 +613,9 @@ mod tests {
         assert_eq!(s.final_height, Some(0.6 - fall));
         let page = std::fs::read_to_string(dir.path().join("viewer.html")).unwrap();
         assert!(page.contains("\"dynamic\":true"));
-        assert!(page.contains("\"foot4\""));
-        assert!(!page.contains("\"foot1\""));
+        assert!(page.contains("\"model\":\"robot\""));
+        assert!(page.contains("\"tip4\""));
+        assert!(!page.contains("\"tip1\""));
         for f in ["feet.svg", "torques.svg", "body.svg", "energy.svg"] {
             let svg = std::fs::read_to_string(dir.path().join(f)).unwrap();
             assert!(

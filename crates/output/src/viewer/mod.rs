@@ -10,15 +10,18 @@
 //! `crates/output/assets/THREE_LICENSE`) inlined into the page.
 //!
 //! * [`planar`] fills a scene from the planar model's step records, during
-//!   `fbd run` or from `trajectory.csv` in `fbd view DIR`;
-//! * [`hexapod`] fills one from hexapod frames ([`hexapod::HexFrame`]: the
-//!   24 coordinates, which feet are in stance, the centre of mass; for a
-//!   dynamic run the feet's states and forces and the joint forces), from
-//!   a gait run, a dynamic (3D FBD) run, or their `trajectory.csv`;
-//! * [`robot`] fills one from the frames of an imported robot
-//!   ([`robot::RobotFrames`]: base pose and joint angles, each contact
-//!   point's state and ground force), its bodies drawn as capsules from
-//!   joint to joint with `fbd_robot`'s forward kinematics;
+//!   `fbd run` or from `trajectory.csv` in `fbd view DIR` (side view);
+//! * [`robot`] fills the one 3D scene, of every 3D model: the frames of a
+//!   [`fbd_robot::RobotModel`] ([`robot::RobotFrames`]: base pose and joint
+//!   angles, each contact point's state and ground force), its bodies drawn
+//!   as capsules from joint to joint with `fbd_robot`'s forward kinematics,
+//!   and what a model adds to that drawing as data ([`robot::Decor`]:
+//!   points fixed in bodies, the root's outline, labels, a heading arrow,
+//!   the support polygon, joint-force arrows, its panels);
+//! * [`hexapod`] adapts the hexapod's runs (a kinematic gait, a dynamic 3D
+//!   FBD run, or their `trajectory.csv`) to it: the hexapod is the robot
+//!   model built from its D-H parameters (`fbd_robot::dh::hexapod`) with
+//!   the hexapod's decor (body hexagon, leg numbers, heading, feet, forces);
 //! * [`view`] is `fbd view DIR`.
 //!
 //! Long runs are decimated to at most [`MAX_FRAMES`] frames: every k-th
@@ -53,17 +56,16 @@ const VIEWER_CSS: &str = include_str!("../../assets/viewer.css");
 const THREE_LICENSE: &str = include_str!("../../assets/THREE_LICENSE");
 
 /// How a scene is viewed: `"planar"` (orthographic side view of the XY
-/// plane), `"hexapod"` or `"robot"` (3D, orbiting camera).
+/// plane) or `"robot"` (3D, orbiting camera: every 3D model, the hexapod
+/// included).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum SceneKind {
     /// The planar two-leg model (the default).
     #[default]
     Planar,
-    /// The 24-DOF hexapod.
-    Hexapod,
-    /// An imported robot (URDF/MJCF): its bodies drawn as capsules
-    /// ([`robot`]).
+    /// A 3D robot model (an imported URDF/MJCF robot, the hexapod): its
+    /// bodies drawn as capsules ([`robot`]).
     Robot,
 }
 
@@ -99,7 +101,7 @@ pub enum TerrainView {
         xy: Vec<f64>,
     },
     /// Heights `y = ϱ(x, z)` on an `n × n` grid over `[x0, x1] × [z0, z1]`,
-    /// row by row (z outer, x inner) (hexapod).
+    /// row by row (z outer, x inner) (3D).
     Grid {
         /// Grid corners (m).
         x0: f64,
@@ -151,7 +153,7 @@ pub struct EventMark {
 /// Everything the page draws. The default is an empty planar scene.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Scene {
-    /// Planar or hexapod.
+    /// Planar or 3D.
     pub model: SceneKind,
     /// Page title.
     pub title: String,
@@ -166,7 +168,7 @@ pub struct Scene {
     /// Points whose path is drawn (the feet).
     pub trails: Vec<usize>,
     /// Contact indices around the body, in order, whose stance members form
-    /// the support polygon (hexapod; empty for the planar model).
+    /// the support polygon (the hexapod's feet; empty for the planar model).
     pub ring: Vec<usize>,
     /// The ground.
     pub terrain: TerrainView,
@@ -198,7 +200,7 @@ pub struct Scene {
     pub event_rows: usize,
     /// Time-series panels.
     pub panels: Vec<Panel>,
-    /// A dynamic hexapod run: contact states ST1/ST2/ST3 and force arrows
+    /// A dynamic run: contact states ST1/ST2/ST3 and force arrows
     /// (written only when true).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub dynamic: bool,

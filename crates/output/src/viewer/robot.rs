@@ -1,10 +1,15 @@
-//! The scene of an imported robot (URDF/MJCF, [`fbd_robot::RobotModel`]):
-//! every body drawn as capsules from joint to joint, computed frame by
-//! frame with `fbd_robot`'s forward kinematics; the contact points
-//! coloured by state (ST1/ST2/ST3) with their ground forces as arrows, the
-//! whole robot's centre of mass; panels of the base and centre-of-mass
-//! heights, the joint angles and, with contacts, the vertical ground
-//! forces.
+//! The one 3D scene, of every 3D model: a robot ([`fbd_robot::RobotModel`]:
+//! an imported URDF/MJCF robot, or the hexapod built from its D-H
+//! parameters, [`super::hexapod`]), every body drawn as capsules from joint
+//! to joint, computed frame by frame with `fbd_robot`'s forward kinematics;
+//! the contact points coloured by state (ST1/ST2/ST3) with their ground
+//! forces as arrows, the whole robot's centre of mass; panels of the base
+//! and centre-of-mass heights, the joint angles and, with contacts, the
+//! vertical ground forces. What a model adds to that drawing is data of
+//! the scene ([`Decor`], all optional): points fixed in bodies, the root's
+//! outline, labels beside points, a heading arrow, the feet's trails and
+//! support polygon, joint-force arrows, the names of the contact points in
+//! events and of their states, the limbs' colours and its own panels.
 //!
 //! The drawn points ([`Scene::points`]), in this order:
 //!
@@ -12,19 +17,22 @@
 //! * one per joint, named by the joint: its origin (the child body's
 //!   origin), inertial;
 //! * one per contact point, named by the point: the sphere's centre;
+//! * one per point fixed in a body ([`Decor::fixed`]), named by it;
 //! * `<body>_com`: the centre of mass of each leaf body (no child joint)
-//!   without contact points, when it is off the body's origin.
+//!   without contact or fixed points, when it is off the body's origin.
 //!
 //! The capsules ([`Scene::lines`], one colour per limb, the root's grey):
 //!
-//! * the root, with three or more child joints: a ring through their
+//! * the root, with an outline ([`Decor::outline`]): a ring through its
+//!   points; else, with three or more child joints: a ring through their
 //!   origins in the order of their angle about the root's `+y` axis (a
-//!   hexapod's body outline; the page fills it with a translucent plate
-//!   fanned from `base`); with fewer, from `base` to each child joint's
-//!   origin (a star); and from `base` to each of its own contact points;
+//!   hexapod's body outline); either ring is filled with a translucent
+//!   plate fanned from `base` ([`RobotScene::plate`]); with fewer, from
+//!   `base` to each child joint's origin (a star); and, without an outline,
+//!   from `base` to each of its own contact points;
 //! * every other body: from its joint's origin to each child joint's
-//!   origin; a leaf body from its joint's origin to each of its contact
-//!   points, or to its centre of mass when it has none;
+//!   origin; a leaf body from its joint's origin to each of its contact and
+//!   fixed points, or to its centre of mass when it has none;
 //! * segments of zero length (a massless frame between two joints at one
 //!   point) are left out: a segment's ends are fixed in one body, so its
 //!   length never changes.
@@ -34,12 +42,15 @@
 //! pose (1 cm for a robot of no size). Points are written to 1e-10 m (the
 //! test compares them with forward kinematics to 1e-9), forces to 1e-6 N.
 //!
-//! Use: [`RobotFrames::new`], [`RobotFrames::push`] for every row of
+//! Use: [`RobotFrames::new`] (or [`RobotFrames::with_decor`]),
+//! [`RobotFrames::push`] (or [`RobotFrames::push_row`]) for every row of
 //! `trajectory.csv`, then [`RobotFrames::write`]. The rows are kept until
 //! then (8 bytes per coordinate, contact state and force value, e.g.
 //! 0.4 MB per 1000 rows of an 18-joint robot with 6 contact points), since
 //! the decimation ([`super::Decimator`]) needs their count: every k-th
-//! row, the last one, and the rows at which a contact state changes.
+//! row, the last one, and the rows at which a contact state changes; a run
+//! that knows its count at the start ([`RobotFrames::with_rows_planned`])
+//! keeps only the frames (at most [`super::MAX_FRAMES`] rows).
 //!
 //! `fbd view DIR` ([`super::view`]) pushes the rows of `trajectory.csv`,
 //! gives [`RobotFrames::with_surface`] the configuration's terrain when
@@ -68,7 +79,7 @@ pub const RADIUS_SHARE: f64 = 0.02;
 /// Segments shorter than this (m) are not drawn.
 const MIN_SEGMENT: f64 = 1e-9;
 
-/// A robot's scene: the [`Scene`] and the capsules' radius.
+/// A 3D scene: the [`Scene`] and what only a 3D robot has.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RobotScene {
     /// Points, capsules ([`Scene::lines`]), contacts, frames, panels.
@@ -76,6 +87,145 @@ pub struct RobotScene {
     pub scene: Scene,
     /// Radius of every capsule (m).
     pub radius: f64,
+    /// The root's outline, point indices in order: filled with a
+    /// translucent plate fanned from `base` (empty: no plate).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub plate: Vec<usize>,
+    /// Labels drawn beside points (a hexapod's leg numbers).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub labels: Vec<LabelView>,
+    /// A heading arrow from `base` towards this point.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub heading: Option<usize>,
+    /// Names of the contact states 1, 2, … in the legend, when they are
+    /// not ST1–ST3 (a kinematic gait: swing, stance).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub state_names: Vec<String>,
+}
+
+/// A label drawn beside a point, in the colour of a group.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LabelView {
+    /// Its text.
+    pub text: String,
+    /// The point (index).
+    pub point: usize,
+    /// Colour group (as [`Line::group`]).
+    pub group: usize,
+}
+
+/// A point fixed in a body, drawn beside the robot's own points.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FixedPoint {
+    /// Its name (unique among the drawn points).
+    pub name: String,
+    /// The body carrying it.
+    pub body: usize,
+    /// Its position in the body's frame (m).
+    pub position: Vector3<f64>,
+}
+
+/// A label of the scene ([`Decor::labels`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Label {
+    /// Its text.
+    pub text: String,
+    /// The drawn point it is beside (its name).
+    pub point: String,
+    /// Colour group.
+    pub group: usize,
+}
+
+/// A value plotted in a panel, per frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Series {
+    /// The root's height `ry` (m).
+    BaseHeight,
+    /// The centre of mass's height (m).
+    ComHeight,
+    /// The angle of joint `j` (°).
+    Angle(usize),
+    /// The vertical ground force on contact point `k` (N).
+    GroundFy(usize),
+    /// The `k`-th value of the rows ([`Row::values`]); NaN is no value.
+    Value(usize),
+}
+
+/// A time-series panel of the scene ([`Decor::panels`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PanelPlan {
+    /// Title with the unit.
+    pub title: String,
+    /// Its curves: legend label and series.
+    pub curves: Vec<(String, Series)>,
+    /// Left out when none of its curves has a value.
+    pub optional: bool,
+}
+
+/// What a scene adds to the drawing of a robot's model, all optional
+/// (the default adds nothing): points fixed in bodies, the root's outline,
+/// labels, a heading arrow, the support polygon, joint-force arrows, the
+/// contact points' labels and states, the limbs' colours and the panels.
+/// Points are named as drawn ([`Scene::points`]); unknown names are
+/// ignored.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Decor {
+    /// Points fixed in bodies: drawn after the contact points; a leaf body
+    /// ends at its contact and fixed points (at its centre of mass only
+    /// when it has neither).
+    pub fixed: Vec<FixedPoint>,
+    /// The root's outline, points fixed in the root in order: a ring of
+    /// capsules filled with the plate, instead of the ring through the
+    /// root's child joints. The root's contact points are then drawn on
+    /// the plate, without capsules from `base`.
+    pub outline: Vec<String>,
+    /// Labels beside points.
+    pub labels: Vec<Label>,
+    /// The point the heading arrow from `base` points to.
+    pub heading: Option<String>,
+    /// The points whose paths are drawn (default every contact point).
+    pub trails: Option<Vec<String>>,
+    /// Contact points (indices) around the body, in order: the support
+    /// polygon of those not in ST1.
+    pub ring: Vec<usize>,
+    /// Joint-force arrows, each at a joint's origin: name and joint index;
+    /// every row gives one force for each ([`Row::joint_forces`]).
+    pub joint_forces: Vec<(String, usize)>,
+    /// Each contact point's name in event labels (default its name).
+    pub contact_labels: Vec<String>,
+    /// A kinematic gait: the rows' contact states are swing (1) and stance
+    /// (2), without forces.
+    pub kinematic: bool,
+    /// Colour group of each of the root's child joints, in order (default
+    /// 1, 2, …): the group of its limb.
+    pub limb_groups: Vec<usize>,
+    /// The panels (default: the base's and the centre of mass's heights,
+    /// the joint angles and, with forces, the vertical ground forces).
+    pub panels: Option<Vec<PanelPlan>>,
+    /// How many values every row gives ([`Row::values`], [`Series::Value`]).
+    pub values: usize,
+}
+
+/// One row of a run, for [`RobotFrames::push_row`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Row<'a> {
+    /// Time (s).
+    pub t: f64,
+    /// `(rx, ry, rz, φx, φy, φz, θ…)` (m, rad; the joints in the model's
+    /// order).
+    pub q: &'a [f64],
+    /// With contacts: each contact point's state code (1, 2, 3 for
+    /// ST1–ST3) and the ground's force on it (N, inertial); `None` is ST1
+    /// without force.
+    pub contacts: Option<(&'a [u8], &'a [[f64; 3]])>,
+    /// The force of each joint-force arrow ([`Decor::joint_forces`]), N,
+    /// inertial; empty: none drawn.
+    pub joint_forces: &'a [[f64; 3]],
+    /// The centre of mass (m), when the run gives it (default: the
+    /// model's, by forward kinematics).
+    pub com: Option<[f64; 3]>,
+    /// [`Decor::values`] values for the panels (empty: none).
+    pub values: &'a [f64],
 }
 
 /// Where a drawn point is, at each frame.
@@ -89,6 +239,8 @@ enum Source {
     Contact(usize),
     /// A body's centre of mass.
     Com(usize),
+    /// A point fixed in a body ([`Decor::fixed`]).
+    Fixed(usize),
 }
 
 /// Builds a robot's scene from its rows (see the module docs).
@@ -96,12 +248,14 @@ enum Source {
 pub struct RobotFrames {
     model: RobotModel,
     contacts: bool,
+    decor: Decor,
     title: String,
     surface: Option<Surface>,
     event_rows: Option<usize>,
     points: Vec<String>,
     sources: Vec<Source>,
     lines: Vec<Line>,
+    plate: Vec<usize>,
     radius: f64,
     /// `t` of every row pushed.
     t: Vec<f64>,
@@ -111,8 +265,32 @@ pub struct RobotFrames {
     state: Vec<u8>,
     /// Three force components per contact per row (with contacts).
     force: Vec<f64>,
+    /// Three components per joint-force arrow per row.
+    joint_force: Vec<f64>,
+    /// The centre of mass of each row (NaN: the model's).
+    com: Vec<[f64; 3]>,
+    /// [`Decor::values`] per row.
+    values: Vec<f64>,
+    /// The run's row of each row kept.
+    index: Vec<usize>,
+    /// Rows pushed.
+    seen: usize,
+    /// Decimation while the rows come ([`RobotFrames::with_rows_planned`]).
+    stream: Option<Stream>,
     /// The first malformed row, reported by [`RobotFrames::write`].
     error: Option<String>,
+}
+
+/// The decimation of a run whose row count is known at its start: rows
+/// that are not frames are dropped as they come (the last one pushed is
+/// kept until the next, to end the run).
+#[derive(Clone, Debug)]
+struct Stream {
+    decimator: Decimator,
+    planned: usize,
+    last_state: Option<String>,
+    /// Whether the last row kept is not a frame.
+    pending: bool,
 }
 
 impl RobotFrames {
@@ -120,6 +298,11 @@ impl RobotFrames {
     /// contact point's state and ground force (a run on a terrain), false
     /// in flight (the points are then drawn ST1, without arrows).
     pub fn new(model: &RobotModel, contacts: bool) -> Self {
+        Self::with_decor(model, contacts, Decor::default())
+    }
+
+    /// [`RobotFrames::new`] with what `decor` adds to the drawing.
+    pub fn with_decor(model: &RobotModel, contacts: bool, decor: Decor) -> Self {
         let nb = model.bodies.len();
         let mut children: Vec<Vec<usize>> = vec![Vec::new(); nb];
         for (j, joint) in model.joints.iter().enumerate() {
@@ -133,15 +316,22 @@ impl RobotFrames {
                 on_body[c.body].push(k);
             }
         }
-        // The limb of each body: 1 + the index of the root's child joint
-        // above it (bodies come parents first); the root's is 0.
+        let mut fixed_on: Vec<Vec<usize>> = vec![Vec::new(); nb];
+        for (k, f) in decor.fixed.iter().enumerate() {
+            if f.body < nb {
+                fixed_on[f.body].push(k);
+            }
+        }
+        // The limb of each body: the group of the root's child joint above
+        // it (bodies come parents first); the root's is 0.
         let mut limb = vec![0usize; nb];
         for (j, joint) in model.joints.iter().enumerate() {
             if joint.child >= nb || joint.parent >= nb {
                 continue;
             }
             limb[joint.child] = if joint.parent == 0 {
-                1 + children[0].iter().position(|&c| c == j).unwrap_or(0)
+                let k = children[0].iter().position(|&c| c == j).unwrap_or(0);
+                decor.limb_groups.get(k).copied().unwrap_or(1 + k)
             } else {
                 limb[joint.parent]
             };
@@ -159,13 +349,26 @@ impl RobotFrames {
             points.push(c.name.clone());
             sources.push(Source::Contact(k));
         }
+        let fixed_point = |k: usize| 1 + model.joints.len() + model.contacts.len() + k;
+        for (k, f) in decor.fixed.iter().enumerate() {
+            points.push(f.name.clone());
+            sources.push(Source::Fixed(k));
+        }
+        let index = |points: &[String], name: &str| points.iter().position(|p| p == name);
+        // The root's outline: the decor's, or its child joints' origins by
+        // angle about its +y axis when it has three or more.
+        let outline: Vec<usize> = decor
+            .outline
+            .iter()
+            .filter_map(|n| index(&points, n))
+            .collect();
         let mut lines = Vec::new();
         let mut segment = |a: usize, b: usize, length: f64, group: usize| {
             if length >= MIN_SEGMENT {
                 lines.push(Line { a, b, group });
             }
         };
-        let ring = children.first().is_some_and(|c| c.len() >= 3);
+        let ring = outline.len() >= 3 || children.first().is_some_and(|c| c.len() >= 3);
         for b in 0..nb {
             let from = origin_point(b);
             let group = limb[b];
@@ -177,7 +380,8 @@ impl RobotFrames {
                     group,
                 );
             }
-            if b == 0 || children[b].is_empty() {
+            let leaf = children[b].is_empty();
+            if (b == 0 && outline.len() < 3) || (b != 0 && leaf) {
                 for &k in &on_body[b] {
                     segment(
                         from,
@@ -187,7 +391,12 @@ impl RobotFrames {
                     );
                 }
             }
-            if children[b].is_empty() && on_body[b].is_empty() {
+            if b != 0 && leaf {
+                for &k in &fixed_on[b] {
+                    segment(from, fixed_point(k), decor.fixed[k].position.norm(), group);
+                }
+            }
+            if leaf && on_body[b].is_empty() && fixed_on[b].is_empty() {
                 let com = model.bodies[b].com;
                 if com.norm() >= MIN_SEGMENT {
                     points.push(format!("{}_com", model.bodies[b].name));
@@ -196,9 +405,24 @@ impl RobotFrames {
                 }
             }
         }
-        // The root's ring through its child joints' origins, by angle
-        // about its +y axis.
-        if ring {
+        let mut plate = Vec::new();
+        if outline.len() >= 3 {
+            let at = |i: usize| match sources[i] {
+                Source::Fixed(k) => decor.fixed[k].position,
+                Source::Origin(b) => model.bodies[b].joint.map_or(Vector3::zeros(), |j| {
+                    model.joints[j].origin.translation.vector
+                }),
+                Source::Contact(k) => model.contacts[k].position,
+                _ => Vector3::zeros(),
+            };
+            for k in 0..outline.len() {
+                let (a, b) = (outline[k], outline[(k + 1) % outline.len()]);
+                segment(a, b, (at(a) - at(b)).norm(), 0);
+            }
+            plate = outline;
+        } else if ring {
+            // The ring through the root's child joints, by angle about its
+            // +y axis.
             let mut ring: Vec<(f64, usize)> = children[0]
                 .iter()
                 .map(|&j| {
@@ -213,21 +437,30 @@ impl RobotFrames {
                     - model.joints[b].origin.translation.vector;
                 segment(1 + a, 1 + b, d.norm(), 0);
             }
+            plate = ring.iter().map(|&(_, j)| 1 + j).collect();
         }
         let mut me = Self {
             model: model.clone(),
             contacts,
+            decor,
             title: super::title_of("", &format!("robot {}", model.name)),
             surface: None,
             event_rows: None,
             points,
             sources,
             lines,
+            plate,
             radius: 0.01,
             t: Vec::new(),
             q: Vec::new(),
             state: Vec::new(),
             force: Vec::new(),
+            joint_force: Vec::new(),
+            com: Vec::new(),
+            values: Vec::new(),
+            index: Vec::new(),
+            seen: 0,
+            stream: None,
             error: None,
         };
         // The radius: a share of the size at the zero pose.
@@ -269,14 +502,34 @@ impl RobotFrames {
         self.event_rows = Some(rows);
     }
 
+    /// Decimates the rows as they come, for a run of `rows` rows: keeps
+    /// only the frames ([`super::Decimator`]: every k-th row, the rows at
+    /// which a contact state changes, the last one pushed) instead of every
+    /// row until [`RobotFrames::finish`]. The page is the same when the run
+    /// pushes `rows` rows.
+    pub fn with_rows_planned(mut self, rows: usize) -> Self {
+        self.stream = Some(Stream {
+            decimator: Decimator::new(rows),
+            planned: rows,
+            last_state: None,
+            pending: false,
+        });
+        self
+    }
+
     /// Rows pushed so far.
     pub fn rows(&self) -> usize {
-        self.t.len()
+        self.seen
     }
 
     /// The capsules' radius (m).
     pub fn radius(&self) -> f64 {
         self.radius
+    }
+
+    /// The names of the drawn points, in order.
+    pub fn points(&self) -> &[String] {
+        &self.points
     }
 
     /// Adds the row at time `t`: `q = (rx, ry, rz, φx, φy, φz, θ…)` (m,
@@ -285,44 +538,104 @@ impl RobotFrames {
     /// force on it (N, inertial). A row of the wrong size is reported by
     /// [`RobotFrames::write`]; without contacts, `contacts` is ignored.
     pub fn push(&mut self, t: f64, q: &[f64], contacts: Option<(&[u8], &[[f64; 3]])>) {
+        self.push_row(&Row {
+            t,
+            q,
+            contacts,
+            ..Row::default()
+        });
+    }
+
+    /// Adds a row with everything it may carry ([`Row`]).
+    pub fn push_row(&mut self, row: &Row) {
         let nq = 6 + self.model.joints.len();
         let nc = self.model.contacts.len();
+        let (nf, nv) = (self.decor.joint_forces.len(), self.decor.values);
         if self.error.is_some() {
             return;
         }
-        if q.len() != nq {
+        let r = self.seen;
+        if row.q.len() != nq {
             self.error = Some(format!(
-                "viewer.html: row {}: {} coordinates for a robot of {nq}",
-                self.t.len(),
-                q.len()
+                "viewer.html: row {r}: {} coordinates for a robot of {nq}",
+                row.q.len()
             ));
             return;
         }
-        self.t.push(t);
-        self.q.extend_from_slice(q);
+        if !row.joint_forces.is_empty() && row.joint_forces.len() != nf {
+            self.error = Some(format!(
+                "viewer.html: row {r}: {} joint forces for {nf} arrows",
+                row.joint_forces.len()
+            ));
+            return;
+        }
+        if !row.values.is_empty() && row.values.len() != nv {
+            self.error = Some(format!(
+                "viewer.html: row {r}: {} values for {nv}",
+                row.values.len()
+            ));
+            return;
+        }
+        let contacts = match row.contacts {
+            Some((state, force)) if self.contacts && (state.len() != nc || force.len() != nc) => {
+                self.error = Some(format!(
+                    "viewer.html: row {r}: {} contact states and {} forces for {nc} contact points",
+                    state.len(),
+                    force.len()
+                ));
+                return;
+            }
+            c if self.contacts => c,
+            _ => None,
+        };
+        if let Some(stream) = self.stream.as_mut() {
+            // The row before, when it is not a frame, is dropped.
+            if stream.pending {
+                let n = self.t.len() - 1;
+                self.t.truncate(n);
+                self.index.truncate(n);
+                self.q.truncate(n * nq);
+                self.state.truncate(n * if self.contacts { nc } else { 0 });
+                self.force
+                    .truncate(3 * n * if self.contacts { nc } else { 0 });
+                self.joint_force.truncate(3 * n * nf);
+                self.com.truncate(n);
+                self.values.truncate(n * nv);
+            }
+            let state: String = match contacts {
+                Some((state, _)) => state.iter().map(|&s| char::from(b'0' + code(s))).collect(),
+                None => "1".repeat(nc),
+            };
+            let changed = stream.last_state.as_ref().is_some_and(|s| *s != state);
+            stream.last_state = Some(state);
+            stream.pending = !stream.decimator.keep(r, changed, r + 1 >= stream.planned);
+        }
         if self.contacts {
             match contacts {
-                Some((state, force)) if state.len() == nc && force.len() == nc => {
-                    self.state.extend(
-                        state
-                            .iter()
-                            .map(|&s| if (1..=3).contains(&s) { s } else { 1 }),
-                    );
-                    self.force.extend(force.iter().flatten());
-                }
                 Some((state, force)) => {
-                    self.error = Some(format!(
-                        "viewer.html: row {}: {} contact states and {} forces for {nc} contact points",
-                        self.t.len() - 1,
-                        state.len(),
-                        force.len()
-                    ));
+                    self.state.extend(state.iter().map(|&s| code(s)));
+                    self.force.extend(force.iter().flatten());
                 }
                 None => {
                     self.state.extend(std::iter::repeat_n(1, nc));
                     self.force.extend(std::iter::repeat_n(0.0, 3 * nc));
                 }
             }
+        }
+        self.seen += 1;
+        self.index.push(r);
+        self.t.push(row.t);
+        self.q.extend_from_slice(row.q);
+        if row.joint_forces.is_empty() {
+            self.joint_force.extend(std::iter::repeat_n(0.0, 3 * nf));
+        } else {
+            self.joint_force.extend(row.joint_forces.iter().flatten());
+        }
+        self.com.push(row.com.unwrap_or([f64::NAN; 3]));
+        if row.values.is_empty() {
+            self.values.extend(std::iter::repeat_n(f64::NAN, nv));
+        } else {
+            self.values.extend_from_slice(row.values);
         }
     }
 
@@ -333,6 +646,10 @@ impl RobotFrames {
             Source::Origin(b) => data.frames[b].translation.vector,
             Source::Contact(k) => data.contacts[k],
             Source::Com(b) => data.com(&self.model, b),
+            Source::Fixed(k) => {
+                let f = &self.decor.fixed[k];
+                (data.frames[f.body] * fbd_robot::nalgebra::Point3::from(f.position)).coords
+            }
         }
     }
 
@@ -349,6 +666,50 @@ impl RobotFrames {
         }
     }
 
+    /// Index of the drawn point `name`.
+    fn point(&self, name: &str) -> Option<usize> {
+        self.points.iter().position(|p| p == name)
+    }
+
+    /// The panels drawn: the decor's, or the default ones.
+    fn panel_plan(&self) -> Vec<PanelPlan> {
+        if let Some(p) = &self.decor.panels {
+            return p.clone();
+        }
+        let mut plan = vec![
+            PanelPlan {
+                title: "Heights (m)".into(),
+                curves: vec![
+                    ("base Ry".into(), Series::BaseHeight),
+                    ("centre of mass".into(), Series::ComHeight),
+                ],
+                optional: false,
+            },
+            PanelPlan {
+                title: "Joint angles (°)".into(),
+                curves: (self.model.joints.iter().enumerate())
+                    .map(|(j, joint)| (joint.name.clone(), Series::Angle(j)))
+                    .collect(),
+                optional: false,
+            },
+        ];
+        if self.forces() && !self.model.contacts.is_empty() {
+            plan.push(PanelPlan {
+                title: "Vertical ground forces Fy (N)".into(),
+                curves: (self.model.contacts.iter().enumerate())
+                    .map(|(k, c)| (c.name.clone(), Series::GroundFy(k)))
+                    .collect(),
+                optional: false,
+            });
+        }
+        plan
+    }
+
+    /// Whether the rows carry contact forces.
+    fn forces(&self) -> bool {
+        self.contacts && !self.decor.kinematic
+    }
+
     /// The complete scene, the rows decimated to at most
     /// [`super::MAX_FRAMES`] frames; an error for a malformed row.
     pub fn finish(self) -> Result<RobotScene, OutputError> {
@@ -357,7 +718,26 @@ impl RobotFrames {
         }
         let (nj, nc) = (self.model.joints.len(), self.model.contacts.len());
         let nq = 6 + nj;
-        let rows = self.t.len();
+        let (nf, nv) = (self.decor.joint_forces.len(), self.decor.values);
+        let rows = self.seen;
+        let stored = self.t.len();
+        let forces = self.forces();
+        let names = |names: &[String]| -> Vec<usize> {
+            names.iter().filter_map(|n| self.point(n)).collect()
+        };
+        let trails = match &self.decor.trails {
+            Some(t) => names(t),
+            None => (0..nc).map(|k| 1 + nj + k).collect(),
+        };
+        let joints: Vec<Marker> = self
+            .decor
+            .joint_forces
+            .iter()
+            .map(|(name, j)| Marker {
+                name: name.clone(),
+                point: 1 + j,
+            })
+            .collect();
         let mut scene = Scene {
             model: SceneKind::Robot,
             title: self.title.clone(),
@@ -373,22 +753,33 @@ impl RobotFrames {
                     point: 1 + nj + k,
                 })
                 .collect(),
-            trails: (0..nc).map(|k| 1 + nj + k).collect(),
-            dynamic: self.contacts,
+            joints,
+            trails,
+            ring: self
+                .decor
+                .ring
+                .iter()
+                .copied()
+                .filter(|&k| k < nc)
+                .collect(),
+            dynamic: forces,
             rows,
             ..Scene::default()
         };
+        let plan = self.panel_plan();
+        let mut series: Vec<Vec<Vec<Option<f64>>>> = plan
+            .iter()
+            .map(|p| vec![Vec::new(); p.curves.len()])
+            .collect();
         let mut data = RobotData::new(&self.model);
-        let mut decimator = Decimator::new(rows);
-        let mut height = Vec::new();
-        let mut com_y = Vec::new();
-        let mut angles: Vec<Vec<Option<f64>>> = vec![Vec::new(); nj];
-        let mut fy: Vec<Vec<Option<f64>>> = vec![Vec::new(); if self.contacts { nc } else { 0 }];
+        // Every row kept (decimated as they came) or every k-th row, the
+        // rows at which a state changes and the last row.
+        let mut decimator = Decimator::new(stored);
         let mut last_state: Option<String> = None;
-        for r in 0..rows {
+        for r in 0..stored {
             let state = self.states(r);
             let changed = last_state.as_ref().is_some_and(|s| *s != state);
-            let keep = decimator.keep(r, changed, r + 1 == rows);
+            let keep = self.stream.is_some() || decimator.keep(r, changed, r + 1 == stored);
             last_state = Some(state);
             if !keep {
                 continue;
@@ -400,42 +791,69 @@ impl RobotFrames {
             for &s in &self.sources {
                 p.extend(self.position(&data, s).iter().map(|&x| fine(x)));
             }
-            scene.row.push(r);
+            scene.row.push(self.index[r]);
             scene.t.push(round_time(self.t[r]));
             scene.p.push(p);
             scene.state.push(last_state.clone().unwrap_or_default());
-            let forces = if self.contacts {
+            let contact_forces = if self.contacts {
                 &self.force[3 * nc * r..3 * nc * (r + 1)]
             } else {
                 &[][..]
             };
-            scene.fc.push(if self.contacts {
-                forces.iter().map(|&f| round(f)).collect()
+            scene.fc.push(if forces {
+                contact_forces.iter().map(|&f| round(f)).collect()
             } else {
                 vec![0.0; 3 * nc]
             });
-            scene.fj.push(Vec::new());
-            let com = data.total_com(&self.model);
+            scene.fj.push(
+                self.joint_force[3 * nf * r..3 * nf * (r + 1)]
+                    .iter()
+                    .map(|&f| round(f))
+                    .collect(),
+            );
+            let com = if self.com[r].iter().all(|c| c.is_finite()) {
+                Vector3::from(self.com[r])
+            } else {
+                data.total_com(&self.model)
+            };
             scene.com.push([com.x, com.y, com.z].map(fine));
-            height.push(value(q[1]));
-            com_y.push(value(com.y));
-            for (a, v) in angles.iter_mut().zip(&q[6..]) {
-                a.push(value(v.to_degrees()));
-            }
-            for (k, f) in fy.iter_mut().enumerate() {
-                f.push(value(forces[3 * k + 1]));
+            let values = &self.values[nv * r..nv * (r + 1)];
+            for (p, out) in plan.iter().zip(series.iter_mut()) {
+                for ((_, s), v) in p.curves.iter().zip(out.iter_mut()) {
+                    v.push(match *s {
+                        Series::BaseHeight => value(q[1]),
+                        Series::ComHeight => value(com.y),
+                        Series::Angle(j) => q.get(6 + j).and_then(|a| value(a.to_degrees())),
+                        Series::GroundFy(k) if forces => {
+                            contact_forces.get(3 * k + 1).and_then(|&f| value(f))
+                        }
+                        Series::GroundFy(_) => None,
+                        Series::Value(k) => values.get(k).and_then(|&x| value(x)),
+                    });
+                }
             }
         }
         // Contact events between consecutive frames.
+        let state_name = |s: Option<&u8>| match s {
+            Some(&s) => match self
+                .decor
+                .state_names()
+                .get(usize::from(s.wrapping_sub(b'1')))
+            {
+                Some(name) => (*name).to_owned(),
+                None => format!("ST{}", char::from(s)),
+            },
+            None => "ST?".to_owned(),
+        };
         for k in 1..scene.state.len() {
             let (a, b) = (scene.state[k - 1].as_bytes(), scene.state[k].as_bytes());
             for (c, point) in self.model.contacts.iter().enumerate() {
                 if a.get(c) != b.get(c) {
-                    let st = |s: Option<&u8>| format!("ST{}", s.map_or('?', |&s| char::from(s)));
+                    let what = self.decor.contact_labels.get(c).unwrap_or(&point.name);
                     scene.events.push(EventMark {
                         t: scene.t[k],
                         frame: k,
-                        label: format!("{} {}→{}", point.name, st(a.get(c)), st(b.get(c))),
+                        label: format!("{what} {}→{}", state_name(a.get(c)), state_name(b.get(c))),
                     });
                 }
             }
@@ -445,50 +863,47 @@ impl RobotFrames {
             scene.terrain = surface_view(surface, &scene.p);
             scene.patches = super::patch_views(surface.patches());
         }
-        scene.panels.push(Panel {
-            title: "Heights (m)".into(),
-            curves: vec![
-                Curve {
-                    label: "base Ry".into(),
-                    v: height,
-                },
-                Curve {
-                    label: "centre of mass".into(),
-                    v: com_y,
-                },
-            ],
-        });
-        scene.panels.push(Panel {
-            title: "Joint angles (°)".into(),
-            curves: self
-                .model
-                .joints
-                .iter()
-                .zip(angles)
-                .map(|(j, v)| Curve {
-                    label: j.name.clone(),
-                    v,
-                })
-                .collect(),
-        });
-        if self.contacts && nc > 0 {
+        for (p, curves) in plan.iter().zip(series) {
+            if p.optional && curves.iter().flatten().all(Option::is_none) {
+                continue;
+            }
             scene.panels.push(Panel {
-                title: "Vertical ground forces Fy (N)".into(),
-                curves: self
-                    .model
-                    .contacts
+                title: p.title.clone(),
+                curves: p
+                    .curves
                     .iter()
-                    .zip(fy)
-                    .map(|(c, v)| Curve {
-                        label: c.name.clone(),
+                    .zip(curves)
+                    .map(|((label, _), v)| Curve {
+                        label: label.clone(),
                         v,
                     })
                     .collect(),
             });
         }
+        let labels = self
+            .decor
+            .labels
+            .iter()
+            .filter_map(|l| {
+                Some(LabelView {
+                    text: l.text.clone(),
+                    point: self.point(&l.point)?,
+                    group: l.group,
+                })
+            })
+            .collect();
         Ok(RobotScene {
             scene,
             radius: self.radius,
+            plate: self.plate.clone(),
+            labels,
+            heading: self.decor.heading.as_deref().and_then(|h| self.point(h)),
+            state_names: self
+                .decor
+                .state_names()
+                .iter()
+                .map(|s| (*s).to_owned())
+                .collect(),
         })
     }
 
@@ -498,6 +913,22 @@ impl RobotFrames {
         let page = super::render_json(&scene, &scene.scene.title)?;
         crate::output::write_file(out_dir, "viewer.html", page.as_bytes())
     }
+}
+
+impl Decor {
+    /// The names of the contact states when they are not ST1–ST3.
+    fn state_names(&self) -> &'static [&'static str] {
+        if self.kinematic {
+            &["swing", "stance"]
+        } else {
+            &[]
+        }
+    }
+}
+
+/// A contact state code 1, 2 or 3 (ST1 for any other).
+fn code(s: u8) -> u8 {
+    if (1..=3).contains(&s) { s } else { 1 }
 }
 
 /// A coordinate rounded to 1e-10 m (see the module docs).
@@ -623,6 +1054,27 @@ mod tests {
         let foot = &p[12..15];
         assert!((foot[2] + 0.4).abs() < 1e-9, "{foot:?}");
         assert_eq!(s.fc[1], [0.0, 9.81, 0.0]);
+    }
+
+    #[test]
+    fn rows_decimated_as_they_come_make_the_same_scene() {
+        let m = model();
+        let rows = 3 * crate::viewer::MAX_FRAMES + 7;
+        let mut all = RobotFrames::new(&m, true);
+        let mut stream = RobotFrames::new(&m, true).with_rows_planned(rows);
+        for r in 0..rows {
+            let q = [0.0, 0.5, 0.0, 0.0, 0.0, 0.0, 1e-4 * r as f64, 0.0, 0.0];
+            // The foot touches down and lifts off at rows off the grid.
+            let state = [if (r / 777) % 2 == 1 { 2 } else { 1 }];
+            let force = [[0.0, r as f64, 0.0]];
+            for f in [&mut all, &mut stream] {
+                f.push(0.001 * r as f64, &q, Some((&state, &force)));
+            }
+        }
+        assert!(stream.t.len() <= crate::viewer::MAX_FRAMES);
+        let (a, b) = (all.finish().unwrap(), stream.finish().unwrap());
+        assert!(a.scene.row.contains(&777) && a.scene.row.contains(&1554));
+        assert_eq!(a, b);
     }
 
     #[test]

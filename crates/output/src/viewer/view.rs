@@ -9,10 +9,9 @@ use std::path::{Path, PathBuf};
 use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
 use fbd_kinematics::body::LEG_COUNT;
-use fbd_kinematics::hexapod::NQ;
 use fbd_sim::{Event, Joint, LimitEvent, Model, StepRecord};
 
-use super::hexapod::{HexDynamics, HexFrame, HexapodScene};
+use super::hexapod::{HexapodView, LegValues};
 use super::planar::PlanarScene;
 use crate::OutputError;
 use crate::config::{self, Config};
@@ -196,13 +195,13 @@ fn planar_events(model: &Model, file: &Path) -> Result<Vec<Event>, OutputError> 
     Ok(out)
 }
 
-/// The frames of a hexapod run's `trajectory.csv`: `t, rx, ry, rz, phi_x,
-/// phi_y, phi_z, theta{j}_{n}, stance{n}` and, when present, `com_x/y/z`
-/// and `margin`.
-pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, OutputError> {
-    let table = Table::read(table_file)?;
+/// Pushes the rows of a hexapod gait run's `trajectory.csv` (`table`) to
+/// `view`:
+/// `t, rx, ry, rz, phi_x, phi_y, phi_z, theta{j}_{n}, stance{n}` and, when
+/// present, `com_x/y/z` and `margin`.
+fn hexapod_rows(table: &Table, view: &mut HexapodView) -> Result<(), OutputError> {
     let t_col = table.column("t")?;
-    let mut q_cols = Vec::with_capacity(NQ);
+    let mut q_cols = Vec::with_capacity(6 + 3 * LEG_COUNT);
     for c in ["rx", "ry", "rz", "phi_x", "phi_y", "phi_z"] {
         q_cols.push(table.column(c)?);
     }
@@ -211,30 +210,23 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, OutputError> {
             q_cols.push(table.column(&format!("theta{j}_{n}"))?);
         }
     }
-    let stance: Vec<usize> = (1..=LEG_COUNT)
+    let stance_cols: Vec<usize> = (1..=LEG_COUNT)
         .map(|n| table.column(&format!("stance{n}")))
         .collect::<Result<_, _>>()?;
-    let com: Option<Vec<usize>> = ["com_x", "com_y", "com_z"]
+    let com_cols: Option<Vec<usize>> = ["com_x", "com_y", "com_z"]
         .iter()
         .map(|c| table.columns.get(*c).copied())
         .collect();
-    let margin = table.columns.get("margin").copied();
-    let mut out = Vec::with_capacity(table.rows.len());
+    let margin_col = table.columns.get("margin").copied();
+    let mut q = vec![0.0; q_cols.len()];
     for (r, row) in table.rows.iter().enumerate() {
-        let mut f = HexFrame {
-            t: table.number(row, r, t_col)?,
-            q: [0.0; NQ],
-            stance: [false; LEG_COUNT],
-            com: [f64::NAN; 3],
-            margin: None,
-            dynamics: None,
-        };
-        for (k, &c) in q_cols.iter().enumerate() {
-            f.q[k] = table.number(row, r, c)?;
+        for (v, &c) in q.iter_mut().zip(&q_cols) {
+            *v = table.number(row, r, c)?;
         }
-        for (leg, &c) in stance.iter().enumerate() {
+        let mut stance = [false; LEG_COUNT];
+        for (leg, &c) in stance_cols.iter().enumerate() {
             let s = cell(row, c).trim();
-            f.stance[leg] = match s {
+            stance[leg] = match s {
                 "1" | "true" | "ST2" | "ST3" => true,
                 "0" | "false" | "ST1" => false,
                 _ => {
@@ -247,95 +239,91 @@ pub fn hexapod_frames(table_file: &Path) -> Result<Vec<HexFrame>, OutputError> {
                 }
             };
         }
-        if let Some(c) = &com {
-            for (v, &col) in f.com.iter_mut().zip(c) {
+        let mut com = [q[0], q[1], q[2]];
+        if let Some(c) = &com_cols {
+            for (v, &col) in com.iter_mut().zip(c) {
                 *v = table.number(row, r, col)?;
             }
-        } else {
-            f.com = [f.q[0], f.q[1], f.q[2]];
         }
-        if let Some(c) = margin {
-            let m = table.number(row, r, c)?;
-            f.margin = m.is_finite().then_some(m);
-        }
-        out.push(f);
+        let margin = match margin_col {
+            Some(c) => Some(table.number(row, r, c)?).filter(|m| m.is_finite()),
+            None => None,
+        };
+        view.push_gait(table.number(row, r, t_col)?, &q, &stance, com, margin);
     }
-    Ok(out)
+    Ok(())
 }
 
-/// The frames of a dynamic (3D FBD) hexapod run's `trajectory.csv` for
-/// the model of `params`: pose, joint angles, each foot's state and ground
-/// force, the hip and knee forces and the torques of the model's legs.
-pub fn spatial_frames(
-    table_file: &Path,
+/// Pushes the rows of a dynamic (3D FBD) hexapod run's `trajectory.csv`
+/// for the model of `params` to `view`: pose, joint angles, each contact
+/// point's state and ground force, each leg's foot normal force, hip and
+/// knee forces and torques.
+fn spatial_rows(
+    table: &Table,
     params: &fbd_sim::spatial::SpatialParams,
-) -> Result<Vec<HexFrame>, OutputError> {
-    let table = Table::read(table_file)?;
-    let layout = crate::spatial::Layout::of(params);
+    view: &mut HexapodView,
+) -> Result<(), OutputError> {
+    let legs = view.legs().to_vec();
     let t_col = table.column("t")?;
-    let mut q_cols = Vec::with_capacity(6 + 3 * layout.legs.len());
+    let mut q_cols = Vec::with_capacity(6 + 3 * legs.len());
     for c in crate::spatial::csv::POSE_COLUMNS {
         q_cols.push(table.column(c)?);
     }
-    for n in &layout.legs {
+    for n in &legs {
         for j in 1..=3 {
             q_cols.push(table.column(&format!("theta{j}_{n}"))?);
         }
     }
-    let triple = |name: &str, a: [&str; 3]| -> Result<[usize; 3], OutputError> {
+    let triple = |name: &str| -> Result<[usize; 3], OutputError> {
         Ok([
-            table.column(&format!("{name}{}", a[0]))?,
-            table.column(&format!("{name}{}", a[1]))?,
-            table.column(&format!("{name}{}", a[2]))?,
+            table.column(&format!("{name}_fx"))?,
+            table.column(&format!("{name}_fy"))?,
+            table.column(&format!("{name}_fz"))?,
         ])
     };
-    let f = ["_fx", "_fy", "_fz"];
-    let legs: Vec<[[usize; 3]; 5]> = layout
-        .legs
+    // Per leg: the foot's normal force, the hip and knee forces, the
+    // torques.
+    type LegColumns = (Option<usize>, [usize; 3], [usize; 3], [usize; 3]);
+    let leg_cols: Vec<LegColumns> = legs
         .iter()
         .map(|n| {
-            Ok([
-                [
-                    table.column(&format!("state{n}"))?,
-                    table.column(&format!("foot{n}_n"))?,
-                    0,
-                ],
-                triple(&format!("foot{n}"), f)?,
-                triple(&format!("hip{n}"), f)?,
-                triple(&format!("knee{n}"), f)?,
+            Ok((
+                params
+                    .contact_points
+                    .tips
+                    .then(|| table.column(&format!("foot{n}_n")))
+                    .transpose()?,
+                triple(&format!("hip{n}"))?,
+                triple(&format!("knee{n}"))?,
                 [
                     table.column(&format!("tau1_{n}"))?,
                     table.column(&format!("tau2_{n}"))?,
                     table.column(&format!("tau3_{n}"))?,
                 ],
-            ])
-        })
-        .collect::<Result<_, OutputError>>()?;
-    // The knee and hip contact points: (leg, 0 knee / 1 hip, state
-    // column, force columns).
-    let points: Vec<(usize, usize, usize, [usize; 3])> = layout
-        .extra_points
-        .iter()
-        .map(|&(n, kind)| {
-            let k = usize::from(kind == PointKind::Hip);
-            let prefix = crate::spatial::csv::point_prefix(kind);
-            Ok((
-                n,
-                k,
-                table.column(&format!("{prefix}{n}_state"))?,
-                triple(&format!("{prefix}{n}"), f)?,
             ))
         })
         .collect::<Result<_, OutputError>>()?;
-    let mut feet = crate::spatial::Feet::new(params);
+    // Per contact point of the scene: its state and force columns (a
+    // foot's are `state{n}` and `foot{n}_f*`).
+    let contact_cols: Vec<(usize, [usize; 3])> = view
+        .contacts()
+        .iter()
+        .map(|&(n, kind)| {
+            let prefix = crate::spatial::csv::point_prefix(kind);
+            let state = match kind {
+                PointKind::Tip => format!("state{n}"),
+                _ => format!("{prefix}{n}_state"),
+            };
+            Ok((table.column(&state)?, triple(&format!("{prefix}{n}"))?))
+        })
+        .collect::<Result<_, OutputError>>()?;
     let mut q = vec![0.0; q_cols.len()];
-    let mut out = Vec::with_capacity(table.rows.len());
+    let mut contacts = vec![(StateCode::St1, [0.0; 3]); contact_cols.len()];
+    let mut values = vec![LegValues::default(); legs.len()];
     for (r, row) in table.rows.iter().enumerate() {
         for (v, &c) in q.iter_mut().zip(&q_cols) {
             *v = table.number(row, r, c)?;
         }
-        feet.update(&q);
-        let mut d = HexDynamics::default();
         let v3 = |c: [usize; 3]| -> Result<[f64; 3], OutputError> {
             Ok([
                 table.number(row, r, c[0])?,
@@ -343,22 +331,7 @@ pub fn spatial_frames(
                 table.number(row, r, c[2])?,
             ])
         };
-        for (&n, cols) in layout.legs.iter().zip(&legs) {
-            let s = cell(row, cols[0][0]);
-            d.state[n - 1] = state(s).ok_or_else(|| {
-                OutputError::Io(format!(
-                    "{}: line {}: state{n} = `{s}`: expected ST1, ST2 or ST3",
-                    table.file.display(),
-                    r + 2
-                ))
-            })?;
-            d.normal[n - 1] = table.number(row, r, cols[0][1])?;
-            d.foot_force[n - 1] = v3(cols[1])?;
-            d.hip_force[n - 1] = v3(cols[2])?;
-            d.knee_force[n - 1] = v3(cols[3])?;
-            d.torque[n - 1] = v3(cols[4])?;
-        }
-        for &(n, k, state_col, force) in &points {
+        for (out, &(state_col, force)) in contacts.iter_mut().zip(&contact_cols) {
             let s = cell(row, state_col);
             let code = state(s).ok_or_else(|| {
                 OutputError::Io(format!(
@@ -367,18 +340,19 @@ pub fn spatial_frames(
                     r + 2
                 ))
             })?;
-            d.points[n - 1][k] = (code, v3(force)?);
+            *out = (code, v3(force)?);
         }
-        out.push(HexFrame {
-            t: table.number(row, r, t_col)?,
-            q: *feet.q(),
-            stance: d.state.map(|s| s != StateCode::St1),
-            com: feet.com(),
-            margin: None,
-            dynamics: Some(d),
-        });
+        for (out, &(normal, hip, knee, tau)) in values.iter_mut().zip(&leg_cols) {
+            *out = LegValues {
+                normal: normal.map_or(Ok(0.0), |c| table.number(row, r, c))?,
+                hip_force: v3(hip)?,
+                knee_force: v3(knee)?,
+                torque: v3(tau)?,
+            };
+        }
+        view.push_dynamic(table.number(row, r, t_col)?, &q, &contacts, &values);
     }
-    Ok(out)
+    Ok(())
 }
 
 /// Writes `dir/viewer.html` from the files of a finished run; returns its
@@ -413,7 +387,7 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, OutputError> {
             dir.display()
         )));
     }
-    let scene = match &config {
+    let mut hexapod = match &config {
         Config::Planar(c) => {
             let model = c.model(&source)?;
             let table = Table::read(&traj)?;
@@ -423,39 +397,37 @@ pub fn write_from_dir(dir: &Path) -> Result<PathBuf, OutputError> {
             for r in &records {
                 scene.push(r);
             }
-            scene.finish(&events)
+            let mut scene = scene.finish(&events);
+            // The header counts the rows of events.csv.
+            scene.event_rows = event_rows(dir).unwrap_or(scene.events.len());
+            return super::write(dir, &scene);
         }
         Config::Hexapod(c) if c.is_dynamic() => {
             let params = c.spatial_params(&source)?;
-            let frames = spatial_frames(&traj, &params)?;
-            let mut scene = HexapodScene::dynamic(
-                params.kinematic_model(),
-                params.terrain.clone(),
-                &params.legs,
-                &crate::spatial::Layout::of(&params).extra_points,
-                frames.len(),
-                &title,
-            );
-            for f in &frames {
-                scene.push(f);
-            }
-            scene.finish()
+            let table = Table::read(&traj)?;
+            let mut view = HexapodView::dynamic(&params, table.rows.len(), &title);
+            spatial_rows(&table, &params, &mut view)?;
+            view
         }
         Config::Hexapod(c) => {
             let model = c.gait_model(&source)?;
-            let frames = hexapod_frames(&traj)?;
-            let mut scene = HexapodScene::new(model.kin, model.surface, frames.len(), &title);
-            for f in &frames {
-                scene.push(f);
-            }
-            scene.finish()
+            let table = Table::read(&traj)?;
+            let mut view = HexapodView::gait(&model.kin, model.surface, table.rows.len(), &title);
+            hexapod_rows(&table, &mut view)?;
+            view
         }
     };
-    let mut scene = scene;
-    // The header counts the rows of events.csv.
-    scene.event_rows = std::fs::read_to_string(dir.join("events.csv"))
-        .map_or(scene.events.len(), |t| t.lines().count().saturating_sub(1));
-    super::write(dir, &scene)
+    if let Some(rows) = event_rows(dir) {
+        hexapod.set_event_rows(rows);
+    }
+    hexapod.write(dir)
+}
+
+/// The rows of `dir/events.csv`, when it can be read.
+fn event_rows(dir: &Path) -> Option<usize> {
+    std::fs::read_to_string(dir.join("events.csv"))
+        .ok()
+        .map(|t| t.lines().count().saturating_sub(1))
 }
 
 /// `viewer.html` of an imported robot's run (`model = "robot"`): the base
@@ -535,9 +507,8 @@ fn robot_view(dir: &Path, config_file: &Path, text: &str) -> Result<PathBuf, Out
         let t = table.number(row, r, t_col)?;
         frames.push(t, &q, has_contacts.then_some((&codes[..], &forces[..])));
     }
-    // The header counts the rows of events.csv.
-    if let Ok(t) = std::fs::read_to_string(dir.join("events.csv")) {
-        frames.set_event_rows(t.lines().count().saturating_sub(1));
+    if let Some(rows) = event_rows(dir) {
+        frames.set_event_rows(rows);
     }
     frames.write(dir)
 }

@@ -39,8 +39,9 @@
 //!
 //! The capsules' radius ([`RobotScene::radius`]) is 2 % of the robot's
 //! size, the largest side of the box around its drawn points at the zero
-//! pose (1 cm for a robot of no size). Points are written to 1e-10 m (the
-//! test compares them with forward kinematics to 1e-9), forces to 1e-6 N.
+//! pose (1 cm for a robot of no size). Points are written to 1 µm (a
+//! thousandth of a pixel of a metre-sized robot on a screen; the test
+//! compares them with forward kinematics to 1e-6 m), forces to 1e-6 N.
 //!
 //! Use: [`RobotFrames::new`] (or [`RobotFrames::with_decor`]),
 //! [`RobotFrames::push`] (or [`RobotFrames::push_row`]) for every row of
@@ -931,14 +932,9 @@ fn code(s: u8) -> u8 {
     if (1..=3).contains(&s) { s } else { 1 }
 }
 
-/// A coordinate rounded to 1e-10 m (see the module docs).
+/// A coordinate rounded to 1 µm (see the module docs).
 fn fine(x: f64) -> f64 {
-    if x.is_finite() {
-        let r = (x * 1e10).round() / 1e10;
-        if r == 0.0 { 0.0 } else { r }
-    } else {
-        0.0
-    }
+    round(x)
 }
 
 #[cfg(test)]

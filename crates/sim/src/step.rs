@@ -7,7 +7,8 @@
 //! assembly of [`fbd_dynamics`] as a Newton system (contact equations in
 //! the terrain frame at the anchor or under the point), a contact point's
 //! trial and its violation, the rigid placement of anchors on one body,
-//! and the [`StepRecord`] (sized from the layout).
+//! and the step's [`RobotRecord`], the one record of every model (its
+//! plane embedded in 3D: [`RobotRecord::planar`]).
 //!
 //! **Joint limits** are one-sided, plastic stops (`fbd_dynamics::assemble`):
 //! a free joint whose trial angle crosses an end of its range is held at
@@ -15,8 +16,10 @@
 //! pull it there instead of pushing it away.
 
 use crate::energy;
+use crate::engine::tree_record::{coordinate_rate, plane_q_index};
 use crate::engine::{Engine, Law, LimitInfo, Settings};
-use crate::record::{LimitCode, StepRecord};
+use crate::record::LimitCode;
+use crate::robot::RobotRecord;
 use crate::rules::regularization;
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
@@ -33,7 +36,7 @@ use fbd_solver::{NewtonReport, NewtonSolver, SolverError};
 ///
 /// # Errors
 /// A [`SimError`] naming the step and time.
-pub fn step<'a>(model: &Model, data: &'a mut Data) -> Result<&'a StepRecord, SimError> {
+pub fn step<'a>(model: &Model, data: &'a mut Data) -> Result<&'a RobotRecord, SimError> {
     crate::engine::step::step(model, data)?;
     Ok(&data.record)
 }
@@ -43,7 +46,7 @@ impl Engine for Model {
     type Trial = Trial;
     type Ground = Terrain;
     type Fbd = FbdData;
-    type Record = StepRecord;
+    type Record = RobotRecord;
     type Torques = Vec<f64>;
     type ControlData = ();
 
@@ -180,7 +183,7 @@ impl Engine for Model {
     fn make_record(&self, data: &mut Data, iterations: usize, trials: usize, h: f64) {
         make_record(self, data, iterations, trials, h);
     }
-    fn add_to_record(record: &mut StepRecord, iterations: usize, trials: usize) {
+    fn add_to_record(record: &mut RobotRecord, iterations: usize, trials: usize) {
         record.newton_iterations += iterations;
         record.state_trials += trials;
     }
@@ -252,8 +255,9 @@ fn beta(model: &Model, h: f64) -> f64 {
     regularization(model.contact.regularization, h)
 }
 
-/// Fills `data.record` (sized from the layout by [`Data::new`]) for the
-/// solved step.
+/// Fills `data.record` ([`RobotRecord::planar`], sized by [`Data::new`])
+/// for the solved step: the plane embedded in 3D (z = 0), joint `j`'s
+/// force as reaction `j`'s.
 fn make_record(
     model: &Model,
     data: &mut Data,
@@ -269,31 +273,59 @@ fn make_record(
     r.potential = energy::potential(mech, &data.fbd.kin);
     r.newton_iterations = newton_iterations;
     r.state_trials = state_trials;
-    r.q.copy_from_slice(&data.q[..lay.nq]);
+    r.set_plane_q(&data.q[..lay.nq]);
     // The unknowns by block: joint forces (x, y), contact forces (Fa, N),
     // stop moments.
     let (joint_forces, rest) = data.z[lay.joint_force(0, 0)..].split_at(2 * lay.joints);
     let (contact_forces, moments) = rest.split_at(2 * mech.contacts.len());
     let contacts = mech.contacts.iter().zip(contact_forces.chunks_exact(2));
     for (c, (spec, f)) in contacts.enumerate() {
-        r.point[c] = data.fbd.kin.pos[spec.point];
-        r.state[c] = data.trial[c].code();
-        r.fa[c] = f[0];
-        r.n[c] = f[1];
+        let p = data.fbd.kin.pos[spec.point];
+        let eq = &data.fbd.contact[c];
+        let (t, n) = (eq.tangent, eq.normal);
+        let row = &mut r.contacts[c];
+        row.point = [p[0], p[1], 0.0];
+        row.state = data.trial[c].code();
+        row.tangential = [f[0], 0.0];
+        row.normal = f[1];
+        row.force = [f[0] * t[0] + f[1] * n[0], f[0] * t[1] + f[1] * n[1], 0.0];
     }
-    for (rf, f) in r.joint_force.iter_mut().zip(joint_forces.chunks_exact(2)) {
-        *rf = [f[0], f[1]];
+    for (rf, f) in r
+        .reaction_force
+        .iter_mut()
+        .zip(joint_forces.chunks_exact(2))
+    {
+        *rf = [f[0], f[1], 0.0];
     }
     r.torque.copy_from_slice(&data.fbd.torque);
     r.limit.fill(LimitCode::Free);
-    r.limit_moment.fill(0.0);
+    r.stop.fill(0.0);
     for ((&j, state), &moment) in mech.limits.iter().zip(&data.limit_trial).zip(moments) {
         r.limit[j] = LimitCode::of(state);
-        r.limit_moment[j] = moment;
+        r.stop[j] = moment;
     }
-    r.kinetic = if data.k == 0 {
-        energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)
+    for (j, spec) in mech.joints.iter().enumerate() {
+        r.reaction_moment[j] = [0.0, 0.0, spec.axis_z * (r.torque[j] + r.stop[j])];
+    }
+    for (j, spec) in mech.joints.iter().enumerate() {
+        let rate = coordinate_rate(model, data, spec.q_index);
+        data.record.rate[j] = rate;
+    }
+    let m = if data.k == 0 {
+        energy::motion_exact(mech, &data.fbd.kin, &model.params.qdot0)
     } else {
-        energy::kinetic_central(mech, &data.fbd.kin_prev, &data.fbd.kin_next, h)
+        energy::motion_central(
+            mech,
+            &data.fbd.kin,
+            &data.fbd.kin_prev,
+            &data.fbd.kin_next,
+            h,
+        )
     };
+    let r = &mut data.record;
+    r.kinetic = m.kinetic;
+    r.momentum = m.momentum;
+    r.angular_momentum = m.angular_momentum;
+    r.com = m.com;
+    debug_assert_eq!(r.q.len(), plane_q_index(lay.nq));
 }

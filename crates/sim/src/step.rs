@@ -16,10 +16,9 @@
 //! pull it there instead of pushing it away.
 
 use crate::energy;
-use crate::engine::tree_record::{coordinate_rate, plane_q_index};
 use crate::engine::{Engine, Law, LimitInfo, Settings};
 use crate::record::LimitCode;
-use crate::robot::RobotRecord;
+use crate::robot::{RobotContactRow, RobotRecord};
 use crate::rules::regularization;
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
@@ -257,7 +256,8 @@ fn beta(model: &Model, h: f64) -> f64 {
 
 /// Fills `data.record` ([`RobotRecord::planar`], sized by [`Data::new`])
 /// for the solved step: the plane embedded in 3D (z = 0), joint `j`'s
-/// force as reaction `j`'s.
+/// force as reaction `j`'s; no joint rates, momenta or centre of mass
+/// (left zero: the planar files read none, and they would cost the step).
 fn make_record(
     model: &Model,
     data: &mut Data,
@@ -267,9 +267,10 @@ fn make_record(
 ) {
     let mech = &model.mech;
     let lay = mech.layout();
+    let dt = model.dt();
     let r = &mut data.record;
     r.step = data.k;
-    r.t = data.k as f64 * model.dt();
+    r.t = data.k as f64 * dt;
     r.potential = energy::potential(mech, &data.fbd.kin);
     r.newton_iterations = newton_iterations;
     r.state_trials = state_trials;
@@ -279,23 +280,17 @@ fn make_record(
     let (joint_forces, rest) = data.z[lay.joint_force(0, 0)..].split_at(2 * lay.joints);
     let (contact_forces, moments) = rest.split_at(2 * mech.contacts.len());
     let contacts = mech.contacts.iter().zip(contact_forces.chunks_exact(2));
-    for (c, (spec, f)) in contacts.enumerate() {
+    for ((c, (spec, f)), row) in contacts.enumerate().zip(&mut r.contacts) {
         let p = data.fbd.kin.pos[spec.point];
         let eq = &data.fbd.contact[c];
         let (t, n) = (eq.tangent, eq.normal);
-        let row = &mut r.contacts[c];
-        row.point = [p[0], p[1], 0.0];
-        row.state = data.trial[c].code();
-        row.tangential = [f[0], 0.0];
-        row.normal = f[1];
-        row.force = [f[0] * t[0] + f[1] * n[0], f[0] * t[1] + f[1] * n[1], 0.0];
-    }
-    for (rf, f) in r
-        .reaction_force
-        .iter_mut()
-        .zip(joint_forces.chunks_exact(2))
-    {
-        *rf = [f[0], f[1], 0.0];
+        *row = RobotContactRow {
+            point: [p[0], p[1], 0.0],
+            state: data.trial[c].code(),
+            force: [f[0] * t[0] + f[1] * n[0], f[0] * t[1] + f[1] * n[1], 0.0],
+            normal: f[1],
+            tangential: [f[0], 0.0],
+        };
     }
     r.torque.copy_from_slice(&data.fbd.torque);
     r.limit.fill(LimitCode::Free);
@@ -304,28 +299,14 @@ fn make_record(
         r.limit[j] = LimitCode::of(state);
         r.stop[j] = moment;
     }
-    for (j, spec) in mech.joints.iter().enumerate() {
+    let joints = mech.joints.iter().zip(joint_forces.chunks_exact(2));
+    for (j, (spec, f)) in joints.enumerate() {
+        r.reaction_force[j] = [f[0], f[1], 0.0];
         r.reaction_moment[j] = [0.0, 0.0, spec.axis_z * (r.torque[j] + r.stop[j])];
     }
-    for (j, spec) in mech.joints.iter().enumerate() {
-        let rate = coordinate_rate(model, data, spec.q_index);
-        data.record.rate[j] = rate;
-    }
-    let m = if data.k == 0 {
-        energy::motion_exact(mech, &data.fbd.kin, &model.params.qdot0)
+    r.kinetic = if data.k == 0 {
+        energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)
     } else {
-        energy::motion_central(
-            mech,
-            &data.fbd.kin,
-            &data.fbd.kin_prev,
-            &data.fbd.kin_next,
-            h,
-        )
+        energy::kinetic_central(mech, &data.fbd.kin_prev, &data.fbd.kin_next, h)
     };
-    let r = &mut data.record;
-    r.kinetic = m.kinetic;
-    r.momentum = m.momentum;
-    r.angular_momentum = m.angular_momentum;
-    r.com = m.com;
-    debug_assert_eq!(r.q.len(), plane_q_index(lay.nq));
 }

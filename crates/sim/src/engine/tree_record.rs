@@ -42,11 +42,17 @@ pub struct RobotContactRow {
 ///
 /// The planar model's record is its plane embedded in 3D: `q` holds
 /// `(Rx, Ry, 0, 0, 0, φz)` then its joints ([`Self::plane_q`]), points and
-/// forces have z = 0, reaction `j` is joint `j`'s (force of the parent on
+/// forces have z = 0 (a contact's force is `fa·t + n·n̂` in the frame its
+/// step solved, the terrain's at the anchor for ST2, under the point
+/// otherwise; `fa` is its first tangential component), reaction `j` is
+/// joint `j`'s (force of the parent on
 /// the child at the joint, moment `axis_z·(τ + stop)` about Z), its
 /// energies are those at k (kinetic from the central differences
 /// `q[k−1]` → `q[k+1]`, the exact one from `q̇(0)` at k = 0; potential at
-/// `q[k]`) and so are its momenta (the same velocities).
+/// `q[k]`). Its step computes no joint rates, momenta or centre of mass:
+/// `rate`, `momentum`, `angular_momentum` and `com` stay zero (its files
+/// read none of them, and they would cost every step; a planar model's
+/// rates are its simulator's readout, `Readout::qdot`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RobotRecord {
     /// Step index k.
@@ -69,7 +75,7 @@ pub struct RobotRecord {
     /// Per model joint, its actuator torque at k (N·m).
     pub torque: Vec<f64>,
     /// Per model joint, its rate at k (rad/s, backward difference; the
-    /// initial rate at k = 0).
+    /// initial rate at k = 0; zero for the planar model).
     pub rate: Vec<f64>,
     /// Per model joint, its stop's state at k (free for joints without
     /// limits).
@@ -77,15 +83,20 @@ pub struct RobotRecord {
     /// Per model joint, its stop moment at k (N·m, along the joint axis on
     /// the child).
     pub stop: Vec<f64>,
-    /// Kinetic energy over the step (J, the scheme's).
+    /// Kinetic energy over the step (J, the scheme's; the planar model's
+    /// at k).
     pub kinetic: f64,
-    /// Gravitational potential energy, mean of k and k+1 (J).
+    /// Gravitational potential energy, mean of k and k+1 (J; the planar
+    /// model's at k).
     pub potential: f64,
-    /// Total linear momentum over the step k → k+1 (kg·m/s).
+    /// Total linear momentum over the step k → k+1 (kg·m/s; zero for the
+    /// planar model).
     pub momentum: [f64; 3],
-    /// Total angular momentum about the origin over the step (kg·m²/s).
+    /// Total angular momentum about the origin over the step (kg·m²/s;
+    /// zero for the planar model).
     pub angular_momentum: [f64; 3],
-    /// Centre of mass of the whole robot at `q[k]` (m).
+    /// Centre of mass of the whole robot at `q[k]` (m; zero for the planar
+    /// model).
     pub com: [f64; 3],
     /// Newton iterations of this step (every state trial and substep).
     pub newton_iterations: usize,
@@ -176,6 +187,7 @@ impl RobotRecord {
 
     /// Sets `q` from the planar model's coordinates `plane` (`Rx, Ry, φz`,
     /// then its joints): `(Rx, Ry, 0, 0, 0, φz)`, then the joints.
+    #[inline]
     pub fn set_plane_q(&mut self, plane: &[f64]) {
         self.q[..6].copy_from_slice(&[plane[0], plane[1], 0.0, 0.0, 0.0, plane[2]]);
         self.q[6..].copy_from_slice(&plane[3..]);

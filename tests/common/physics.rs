@@ -84,6 +84,11 @@ pub fn landing(
     p
 }
 
+/// The in-plane coordinates `(x, y)` of a record's point (its z is 0).
+pub fn plane(p: [f64; 3]) -> [f64; 2] {
+    [p[0], p[1]]
+}
+
 /// Builds and runs a model; panics with the error if the run fails.
 pub fn run_ok(p: &PlanarParams) -> (Model, Vec<RobotRecord>, fbd_sim::RunSummary) {
     let model = Model::planar(p).expect("valid parameters");

@@ -851,7 +851,7 @@ mod tests {
         };
         for row in rows.iter().skip(1) {
             sim.step(&Action::Pd(&pd)).unwrap();
-            assert_eq!(bits(sim.q()), bits(&row.q), "step {}", row.step);
+            assert_eq!(bits(sim.q()), bits(&row.plane_q()), "step {}", row.step);
         }
     }
 

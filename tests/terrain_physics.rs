@@ -67,18 +67,13 @@ fn check_law(model: &SpatialModel, rows: &[RobotRecord]) -> (usize, usize) {
             let f = c.force;
             let fnorm = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
             let tol = 1e-6 * (1.0 + fnorm);
-            let mu = friction_at(
-                p.terrain.patches(),
-                &p.friction,
-                c.contacts[0].point,
-                c.contacts[2].point,
-            );
+            let mu = friction_at(p.terrain.patches(), &p.friction, c.point[0], c.point[2]);
             match c.state {
                 StateCode::St1 => assert!(fnorm < 1e-9, "t = {}: free point pushed", r.t),
                 state => {
                     let n = c.normal;
                     assert!(n > -tol, "t = {}: pulling contact N = {n}", r.t);
-                    let [_, nv, _] = frame(&p.terrain, c.contacts[0].point, c.contacts[2].point);
+                    let [_, nv, _] = frame(&p.terrain, c.point[0], c.point[2]);
                     let ftn = (0..3)
                         .map(|i| (f[i] - n * nv[i]).powi(2))
                         .sum::<f64>()

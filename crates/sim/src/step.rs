@@ -279,14 +279,14 @@ fn make_record(
     // stop moments.
     let (joint_forces, rest) = data.z[lay.joint_force(0, 0)..].split_at(2 * lay.joints);
     let (contact_forces, moments) = rest.split_at(2 * mech.contacts.len());
-    let contacts = mech.contacts.iter().zip(contact_forces.chunks_exact(2));
-    for ((c, (spec, f)), row) in contacts.enumerate().zip(&mut r.contacts) {
+    let contacts = (mech.contacts.iter().zip(contact_forces.chunks_exact(2)))
+        .zip(data.fbd.contact.iter().zip(&data.trial));
+    for (((spec, f), (eq, trial)), row) in contacts.zip(&mut r.contacts) {
         let p = data.fbd.kin.pos[spec.point];
-        let eq = &data.fbd.contact[c];
         let (t, n) = (eq.tangent, eq.normal);
         *row = RobotContactRow {
             point: [p[0], p[1], 0.0],
-            state: data.trial[c].code(),
+            state: trial.code(),
             force: [f[0] * t[0] + f[1] * n[0], f[0] * t[1] + f[1] * n[1], 0.0],
             normal: f[1],
             tangential: [f[0], 0.0],
@@ -299,10 +299,12 @@ fn make_record(
         r.limit[j] = LimitCode::of(state);
         r.stop[j] = moment;
     }
-    let joints = mech.joints.iter().zip(joint_forces.chunks_exact(2));
-    for (j, (spec, f)) in joints.enumerate() {
-        r.reaction_force[j] = [f[0], f[1], 0.0];
-        r.reaction_moment[j] = [0.0, 0.0, spec.axis_z * (r.torque[j] + r.stop[j])];
+    let joints = (mech.joints.iter().zip(joint_forces.chunks_exact(2)))
+        .zip(r.torque.iter().zip(&r.stop))
+        .zip(r.reaction_force.iter_mut().zip(&mut r.reaction_moment));
+    for (((spec, f), (tau, stop)), (force, moment)) in joints {
+        *force = [f[0], f[1], 0.0];
+        *moment = [0.0, 0.0, spec.axis_z * (tau + stop)];
     }
     r.kinetic = if data.k == 0 {
         energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)

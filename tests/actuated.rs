@@ -5,7 +5,7 @@ mod common;
 
 use common::physics::{points, run_ok, standing_q, worst_body_imbalance};
 use fbd_contact::{StateCode, Terrain};
-use fbd_sim::{Control, Model, PlanarParams, StepRecord};
+use fbd_sim::{Control, Model, PlanarParams, RobotRecord};
 
 /// PD gains that hold the standing robot (N·m/rad, N·m·s/rad).
 const KP: f64 = 3000.0;
@@ -34,10 +34,15 @@ fn weight(model: &Model) -> f64 {
     model.mech.total_mass() * model.params.gravity
 }
 
+/// The states of the first two contact points (the tips).
+fn states(r: &RobotRecord) -> [StateCode; 2] {
+    [r.contacts[0].state, r.contacts[1].state]
+}
+
 /// Largest generalised velocity between the last two rows.
-fn final_speed(rows: &[StepRecord], dt: f64) -> f64 {
+fn final_speed(rows: &[RobotRecord], dt: f64) -> f64 {
     let (a, b) = (&rows[rows.len() - 2], &rows[rows.len() - 1]);
-    (0..7)
+    (0..b.q.len())
         .map(|i| ((b.q[i] - a.q[i]) / dt).abs())
         .fold(0.0, f64::max)
 }
@@ -116,7 +121,7 @@ fn a_pd_held_joint_moves_towards_its_target_in_flight() {
             target,
         };
         let (model, rows, _) = run_ok(&p);
-        let moved = rows.last().unwrap().q[joint] - p.q0[joint];
+        let moved = rows.last().unwrap().q[fbd_sim::robot::plane_q_index(joint)] - p.q0[joint];
         assert!(
             moved * offset > 0.0 && (moved - offset).abs() < 0.5 * offset.abs(),
             "joint q[{joint}]: moved {moved}, target offset {offset}"
@@ -136,13 +141,16 @@ fn pd_stand_lands_and_comes_to_rest() {
         summary.events
     );
     let (last, w) = (rows.last().unwrap(), weight(&model));
-    assert_eq!(&last.state[..2], &[StateCode::St2, StateCode::St2]);
+    assert_eq!(&states(last), &[StateCode::St2, StateCode::St2]);
     assert!(
         final_speed(&rows, p.dt) < 1e-6,
         "still moving: {}",
         final_speed(&rows, p.dt)
     );
-    let (n, fa) = (last.n[0] + last.n[1], last.fa[0] + last.fa[1]);
+    let (n, fa) = (
+        last.contacts[0].normal + last.contacts[1].normal,
+        last.contacts[0].tangential[0] + last.contacts[1].tangential[0],
+    );
     assert!((n - w).abs() < 1e-6 * w, "n3 + n4 = {n}, weight {w}");
     assert!(fa.abs() < 1e-6 * w, "fa3 + fa4 = {fa}");
     // The joints carry the robot: torques are far from zero, and every
@@ -179,39 +187,38 @@ fn sticks_on_a_10_degree_slope_when_mu_static_exceeds_tan_10() {
     let p = slope_stand(0.4, 0.3);
     let (model, rows, _) = run_ok(&p);
     // After the load-up transient (the legs start unloaded) both tips stick.
-    let settled: Vec<&StepRecord> = rows.iter().filter(|r| r.t >= 0.3).collect();
+    let settled: Vec<&RobotRecord> = rows.iter().filter(|r| r.t >= 0.3).collect();
     let first = settled[0];
     for r in &settled {
-        assert_eq!(
-            &r.state[..2],
-            &[StateCode::St2, StateCode::St2],
-            "t = {}",
-            r.t
-        );
+        assert_eq!(&states(r), &[StateCode::St2, StateCode::St2], "t = {}", r.t);
         for c in 0..2 {
-            let d = (r.point[c][0] - first.point[c][0]).hypot(r.point[c][1] - first.point[c][1]);
+            let d = (r.contacts[c].point[0] - first.contacts[c].point[0])
+                .hypot(r.contacts[c].point[1] - first.contacts[c].point[1]);
             assert!(d < 1e-9, "t = {}: tip {c} moved {d}", r.t);
             assert!(
-                r.fa[c].abs() < 0.4 * r.n[c],
+                r.contacts[c].tangential[0].abs() < 0.4 * r.contacts[c].normal,
                 "t = {}: tip {c} |fa| = {} > μS n = {}",
                 r.t,
-                r.fa[c],
-                0.4 * r.n[c]
+                r.contacts[c].tangential[0],
+                0.4 * r.contacts[c].normal
             );
         }
     }
     let last = rows.last().unwrap();
     assert!(final_speed(&rows, p.dt) < 1e-3);
     // At rest the friction needed is tan 10°: Σfa/Σn along the slope.
-    let ratio = (last.fa[0] + last.fa[1]) / (last.n[0] + last.n[1]);
+    let ratio = (last.contacts[0].tangential[0] + last.contacts[1].tangential[0])
+        / (last.contacts[0].normal + last.contacts[1].normal);
     assert!(
         (ratio - 10f64.to_radians().tan()).abs() < 1e-3,
         "friction ratio {ratio}"
     );
     let w = weight(&model);
     let (c, s) = (10f64.to_radians().cos(), 10f64.to_radians().sin());
-    assert!((last.n[0] + last.n[1] - w * c).abs() < 1e-3 * w);
-    assert!((last.fa[0] + last.fa[1] - w * s).abs() < 1e-3 * w);
+    assert!((last.contacts[0].normal + last.contacts[1].normal - w * c).abs() < 1e-3 * w);
+    assert!(
+        (last.contacts[0].tangential[0] + last.contacts[1].tangential[0] - w * s).abs() < 1e-3 * w
+    );
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");
 }
@@ -222,11 +229,11 @@ fn slides_down_a_10_degree_slope_when_mu_static_is_below_tan_10() {
     let (model, rows, summary) = run_ok(&p);
     assert!(summary.events.iter().any(|e| e.to == StateCode::St3));
     let (first, last) = (&rows[0], rows.last().unwrap());
-    assert_eq!(&last.state[..2], &[StateCode::St3, StateCode::St3]);
+    assert_eq!(&states(last), &[StateCode::St3, StateCode::St3]);
     for c in 0..2 {
         let (dx, dy) = (
-            last.point[c][0] - first.point[c][0],
-            last.point[c][1] - first.point[c][1],
+            last.contacts[c].point[0] - first.contacts[c].point[0],
+            last.contacts[c].point[1] - first.contacts[c].point[1],
         );
         assert!(dx < -0.1 && dy < -0.01, "tip {c} moved ({dx}, {dy})");
         assert!(
@@ -235,10 +242,11 @@ fn slides_down_a_10_degree_slope_when_mu_static_is_below_tan_10() {
         );
         // Sliding downhill (−tangent): friction acts uphill, Fa = μD N.
         assert!(
-            (last.fa[c] - 0.1 * last.n[c]).abs() < 1e-9 * last.n[c],
+            (last.contacts[c].tangential[0] - 0.1 * last.contacts[c].normal).abs()
+                < 1e-9 * last.contacts[c].normal,
             "fa {} n {}",
-            last.fa[c],
-            last.n[c]
+            last.contacts[c].tangential[0],
+            last.contacts[c].normal
         );
     }
     let (worst, at) = worst_body_imbalance(&model, &rows);

@@ -83,10 +83,19 @@ fn planar(rel: &str, q_tol: f64, force_tol: f64) {
     assert_eq!(sa.retries, sb.retries, "{rel}: retried steps");
     let (mut dq, mut df) = (0.0f64, 0.0f64);
     for (ra, rb) in a.iter().zip(&b) {
-        assert_eq!(ra.state, rb.state, "{rel}: step {}", ra.step);
+        let states =
+            |r: &fbd_sim::RobotRecord| r.contacts.iter().map(|c| c.state).collect::<Vec<_>>();
+        assert_eq!(states(ra), states(rb), "{rel}: step {}", ra.step);
         dq = dq.max(worst(ra.q.iter(), rb.q.iter()));
-        df = df.max(worst(ra.fa.iter(), rb.fa.iter()));
-        df = df.max(worst(ra.n.iter(), rb.n.iter()));
+        let fa = |r: &fbd_sim::RobotRecord| {
+            r.contacts
+                .iter()
+                .map(|c| c.tangential[0])
+                .collect::<Vec<_>>()
+        };
+        df = df.max(worst(fa(ra).iter(), fa(rb).iter()));
+        let n = |r: &fbd_sim::RobotRecord| r.contacts.iter().map(|c| c.normal).collect::<Vec<_>>();
+        df = df.max(worst(n(ra).iter(), n(rb).iter()));
     }
     println!("{rel}: |Δq| ≤ {dq:.2e}, |ΔF| ≤ {df:.2e} N");
     assert!(dq <= q_tol, "{rel}: coordinates differ by {dq:e}");

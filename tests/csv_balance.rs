@@ -9,7 +9,7 @@ mod common;
 use common::physics::worst_body_imbalance;
 use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
-use fbd_sim::{Model, PlanarParams, StepRecord};
+use fbd_sim::{Model, PlanarParams, RobotRecord};
 use std::path::Path;
 
 fn run_cli(config: Option<&str>, dir: &Path) {
@@ -30,7 +30,7 @@ fn run_cli(config: Option<&str>, dir: &Path) {
 /// Reads `trajectory.csv` into records, using only the contract's columns, the
 /// `<point>_state, <point>_fa, <point>_n` columns of the extra contact points
 /// of `model` (in its contact order) and the torque columns.
-fn read_rows(path: &Path, model: &Model) -> Vec<StepRecord> {
+fn read_rows(path: &Path, model: &Model) -> Vec<RobotRecord> {
     let mut rd = csv::Reader::from_path(path).unwrap();
     let head = rd.headers().unwrap().clone();
     let col = |name: &str| {
@@ -54,37 +54,38 @@ fn read_rows(path: &Path, model: &Model) -> Vec<StepRecord> {
         .map(|(k, rec)| {
             let rec = rec.unwrap();
             let lay = model.mech.layout();
-            let mut r = StepRecord::new(lay.nq, lay.contacts, lay.joints);
+            let mut r = RobotRecord::planar(lay.contacts, lay.joints);
             (r.step, r.t) = (k, f(&rec, "t"));
-            for (i, c) in q_cols.iter().enumerate() {
-                r.q[i] = f(&rec, c);
-            }
+            let q: Vec<f64> = q_cols.iter().map(|c| f(&rec, c)).collect();
+            r.set_plane_q(&q);
             // Each contact point's columns by its `{leg, kind}`: the
             // contract's `tip{leg}_x, state{leg}, fa{leg}, n{leg}` for a
             // tip, `{kind}{leg}_state, _fa, _n` for a knee or hip.
             for (c, spec) in model.mech.contacts.iter().enumerate() {
                 let leg = spec.leg;
                 let [s, fa, n] = if spec.kind == PointKind::Tip {
-                    r.point[c] = [
+                    r.contacts[c].point = [
                         f(&rec, &format!("tip{leg}_x")),
                         f(&rec, &format!("tip{leg}_y")),
+                        0.0,
                     ];
                     [format!("state{leg}"), format!("fa{leg}"), format!("n{leg}")]
                 } else {
                     let kind = spec.kind.as_str();
                     ["state", "fa", "n"].map(|a| format!("{kind}{leg}_{a}"))
                 };
-                r.state[c] = state(&rec[col(&s)]);
-                r.fa[c] = f(&rec, &fa);
-                r.n[c] = f(&rec, &n);
+                r.contacts[c].state = state(&rec[col(&s)]);
+                r.contacts[c].tangential[0] = f(&rec, &fa);
+                r.contacts[c].normal = f(&rec, &n);
             }
             for (j, name) in joints.iter().enumerate() {
-                r.joint_force[j] = [
+                r.reaction_force[j] = [
                     f(&rec, &format!("{name}_fx")),
                     f(&rec, &format!("{name}_fy")),
+                    0.0,
                 ];
                 r.torque[j] = f(&rec, &format!("tau_{name}"));
-                r.limit_moment[j] = f(&rec, &format!("stop_{name}"));
+                r.stop[j] = f(&rec, &format!("stop_{name}"));
             }
             r
         })
@@ -100,12 +101,13 @@ fn default_run_balances_from_the_csv() {
     assert_eq!(rows.len(), 101);
     // The run exercises knee and hip contacts: they carry load at the end.
     let last = rows.last().unwrap();
-    assert!(last.n[2..6].iter().sum::<f64>() > 50.0, "{:?}", last.n);
+    let n: Vec<f64> = last.contacts.iter().map(|c| c.normal).collect();
+    assert!(n[2..6].iter().sum::<f64>() > 50.0, "{n:?}");
     let (worst, at) = worst_body_imbalance(&model, &rows);
     assert!(worst < 1e-6, "{at}");
     // The check has teeth: a 1 N error in one written force is caught.
     let mut broken = rows.clone();
-    broken[25].joint_force[1][0] += 1.0;
+    broken[25].reaction_force[1][0] += 1.0;
     assert!(worst_body_imbalance(&model, &broken).0 > 0.5);
 }
 
@@ -144,7 +146,7 @@ rate_deg = [140.0, -60.0]
     // Joint forces are far from zero in a tumbling flight.
     let peak = rows
         .iter()
-        .flat_map(|r| r.joint_force.iter().copied())
+        .flat_map(|r| r.reaction_force.iter().copied())
         .map(|f| f[0].hypot(f[1]))
         .fold(0.0, f64::max);
     assert!(peak > 1.0, "peak joint force {peak} N");

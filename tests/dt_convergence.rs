@@ -53,7 +53,7 @@ fn run(dt: f64) -> Outcome {
             .expect("the tip lands");
         // Free fall from rest: the tip at height h reaches the ground after
         // √(2h/g); the touchdown step [t, t + Δt] must contain that time.
-        let h = rows[0].point[i][1];
+        let h = rows[0].contacts[i].point[1];
         let t_ff = (2.0 * h / g).sqrt();
         assert!(
             e.t - 1e-9 <= t_ff && t_ff <= e.t + dt + 1e-9,
@@ -80,7 +80,7 @@ fn run(dt: f64) -> Outcome {
         .t;
     let last = rows.last().unwrap();
     assert!(
-        !last.state.contains(&St3),
+        !last.contacts.iter().any(|c| c.state == St3),
         "Δt = {dt}: a point still slides at the end"
     );
     // Every body balances from the recorded forces, stop moments included.

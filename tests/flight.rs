@@ -28,9 +28,9 @@ fn flight(dt: f64, duration: f64, tumbling: bool) -> PlanarParams {
 #[test]
 fn centre_of_mass_falls_exactly_g_t2_over_2_from_rest() {
     let (model, rows, _) = run_ok(&flight(0.01, 1.0, false));
-    let c0 = system_com(&model, &rows[0].q);
+    let c0 = system_com(&model, &rows[0].plane_q());
     for r in &rows {
-        let c = system_com(&model, &r.q);
+        let c = system_com(&model, &r.plane_q());
         let expect = c0[1] - 0.5 * 9.81 * r.t * r.t;
         assert!(
             (c[1] - expect).abs() < 1e-9,
@@ -46,7 +46,7 @@ fn centre_of_mass_falls_exactly_g_t2_over_2_from_rest() {
             c[0]
         );
         // From rest, a uniform field exerts no internal forces.
-        for f in &r.joint_force {
+        for f in &r.reaction_force {
             assert!(
                 f[0].abs() < 1e-6 && f[1].abs() < 1e-6,
                 "t = {}: joint force {f:?} in free fall",
@@ -68,13 +68,13 @@ fn momentum_and_angular_momentum_are_conserved_while_tumbling() {
         "the tumbling legs must reach a joint limit"
     );
     let dt = p.dt;
-    let p0 = momentum(&model, &rows[0].q, &rows[1].q, dt);
-    let l0 = angular_momentum(&model, &rows[0].q, &rows[1].q, dt);
+    let p0 = momentum(&model, &rows[0].plane_q(), &rows[1].plane_q(), dt);
+    let l0 = angular_momentum(&model, &rows[0].plane_q(), &rows[1].plane_q(), dt);
     assert!(l0.abs() > 0.1, "the test needs a spinning robot (L = {l0})");
     let m = model.mech.total_mass();
     for w in rows.windows(2) {
-        let pk = momentum(&model, &w[0].q, &w[1].q, dt);
-        let lk = angular_momentum(&model, &w[0].q, &w[1].q, dt);
+        let pk = momentum(&model, &w[0].plane_q(), &w[1].plane_q(), dt);
+        let lk = angular_momentum(&model, &w[0].plane_q(), &w[1].plane_q(), dt);
         assert!(
             (pk[0] - p0[0]).abs() < 1e-8 * m,
             "t = {}: horizontal momentum {} vs {}",
@@ -113,7 +113,7 @@ fn trajectory_error_is_second_order() {
         assert!(summary.error.is_none(), "{:?}", summary.error);
         let last = rows.last().unwrap();
         assert!((last.t - t_end).abs() < 1e-9);
-        last.q.clone()
+        last.plane_q()
     };
     let reference = final_q(0.004 / 64.0);
     let err = |dt: f64| {

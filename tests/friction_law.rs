@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::physics::run_ok;
+use common::physics::{plane, run_ok};
 use fbd_contact::StateCode;
 use fbd_sim::PlanarParams;
 
@@ -16,21 +16,28 @@ fn check_rows(p: &PlanarParams) -> (Vec<usize>, Vec<usize>) {
     let nc = model.mech.contacts.len();
     let (mut stick, mut slide) = (vec![0; nc], vec![0; nc]);
     for (k, r) in rows.iter().enumerate() {
-        for c in 0..r.contacts() {
-            let (fa, n, name) = (r.fa[c], r.n[c], &model.mech.contacts[c].name);
+        for c in 0..r.contacts.len() {
+            let (fa, n, name) = (
+                r.contacts[c].tangential[0],
+                r.contacts[c].normal,
+                &model.mech.contacts[c].name,
+            );
             let tol = 1e-6 * (1.0 + n.abs());
             // Feet are rigid; knees and hips are bumpers of documented
             // compliance c, sinking c·N under load. The position of row k is
             // the outcome of step k − 1, so it carries that step's force.
-            let depth = -model.params.terrain.clearance(r.point[c]);
+            let depth = -model.params.terrain.clearance(plane(r.contacts[c].point));
             // A step solved in substeps ends with the last substep's force,
             // not recorded: bounded by the larger of its neighbours' here.
             let n_before = if k == 0 {
                 0.0
             } else if retried(k - 1) {
-                rows[k - 1].n[c].max(r.n[c]).max(0.0)
+                rows[k - 1].contacts[c]
+                    .normal
+                    .max(r.contacts[c].normal)
+                    .max(0.0)
             } else {
-                rows[k - 1].n[c].max(0.0)
+                rows[k - 1].contacts[c].normal.max(0.0)
             };
             let allowed = 1e-9 + model.contact_compliance[c] * n_before;
             assert!(
@@ -38,7 +45,7 @@ fn check_rows(p: &PlanarParams) -> (Vec<usize>, Vec<usize>) {
                 "t = {}: {name} is {depth} m below the terrain (allowed {allowed})",
                 r.t
             );
-            match r.state[c] {
+            match r.contacts[c].state {
                 // Zero to the solver's force tolerance (1e-9 of the weight).
                 StateCode::St1 => assert!(
                     fa.abs() < 1e-9 && n.abs() < 1e-9,

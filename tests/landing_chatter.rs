@@ -65,10 +65,14 @@ fn a_sliding_foot_whose_knee_leaves_its_stop_does_not_chatter() {
     // Coulomb's law on every row (forces of the step's first (sub)step).
     let (mus, mud) = (p.friction.mu_static, p.friction.mu_dynamic);
     for r in &rows {
-        for c in 0..r.contacts() {
-            let (fa, n, name) = (r.fa[c], r.n[c], &model.mech.contacts[c].name);
+        for c in 0..r.contacts.len() {
+            let (fa, n, name) = (
+                r.contacts[c].tangential[0],
+                r.contacts[c].normal,
+                &model.mech.contacts[c].name,
+            );
             let tol = 1e-6 * (1.0 + n.abs());
-            match r.state[c] {
+            match r.contacts[c].state {
                 StateCode::St1 => assert!(fa.abs() < 1e-9 && n.abs() < 1e-9, "t = {}: {name}", r.t),
                 StateCode::St2 => assert!(
                     n >= -1e-6 && fa.abs() <= mus * n + tol,

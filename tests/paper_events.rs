@@ -41,8 +41,8 @@ fn default_run_reproduces_the_papers_events() {
     );
     // The tip on the ground one step after touchdown, and still there while sticking.
     let row = |t: f64| rows.iter().find(|r| near(r.t, t)).unwrap();
-    assert!(row(0.20).point[1][1].abs() < 1e-9 && row(0.19).point[1][1] > 0.0);
-    assert!(row(0.22).point[0][1].abs() < 1e-9 && row(0.21).point[0][1] > 0.0);
+    assert!(row(0.20).contacts[1].point[1].abs() < 1e-9 && row(0.19).contacts[1].point[1] > 0.0);
+    assert!(row(0.22).contacts[0].point[1].abs() < 1e-9 && row(0.21).contacts[0].point[1] > 0.0);
     // Every body balances with the recorded forces throughout.
     let (worst, at) =
         worst_body_imbalance(&common::physics::run_ok(&PlanarParams::default()).0, &rows);

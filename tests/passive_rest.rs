@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::physics::{run_ok, worst_body_imbalance};
+use common::physics::{plane, run_ok, worst_body_imbalance};
 use fbd_contact::StateCode;
 use fbd_sim::PlanarParams;
 
@@ -18,22 +18,26 @@ fn the_passive_experiment_runs_to_rest() {
     assert!((last.t - p.duration).abs() < 1e-9);
     // At rest on the ground: every point in contact sticks and pushes, the
     // others are clear of it, and together they carry the weight.
-    assert_eq!(last.contacts(), 6);
+    assert_eq!(last.contacts.len(), 6);
     for c in 0..6 {
-        match last.state[c] {
-            StateCode::St2 => assert!(last.n[c] > 0.0, "point {c}: n = {}", last.n[c]),
-            StateCode::St1 => assert!(p.terrain.clearance(last.point[c]) > 0.0),
+        match last.contacts[c].state {
+            StateCode::St2 => assert!(
+                last.contacts[c].normal > 0.0,
+                "point {c}: n = {}",
+                last.contacts[c].normal
+            ),
+            StateCode::St1 => assert!(p.terrain.clearance(plane(last.contacts[c].point)) > 0.0),
             StateCode::St3 => panic!("point {c} still slides at the end"),
         }
     }
-    let resting = last.state[..6]
+    let resting = last.contacts[..6]
         .iter()
-        .filter(|s| **s == StateCode::St2)
+        .filter(|c| c.state == StateCode::St2)
         .count();
     assert!(resting >= 4, "resting on {resting} points");
     let w = model.mech.total_mass() * p.gravity;
-    let n: f64 = last.n[..6].iter().sum();
-    let fa: f64 = last.fa[..6].iter().sum();
+    let n: f64 = last.contacts[..6].iter().map(|c| c.normal).sum();
+    let fa: f64 = last.contacts[..6].iter().map(|c| c.tangential[0]).sum();
     assert!((n - w).abs() < 1e-6 * w, "Σn = {n}, weight {w}");
     assert!(fa.abs() < 1e-6 * w, "Σfa = {fa}");
     assert!(
@@ -59,7 +63,7 @@ fn the_passive_experiment_runs_to_rest() {
     let l = &p.joint_limits;
     for r in &rows {
         for (i, range) in [l.theta2, l.theta3, l.theta2, l.theta3].iter().enumerate() {
-            let a = r.q[3 + i];
+            let a = r.q[6 + i];
             assert!(
                 a >= range[0] - 1e-9 && a <= range[1] + 1e-9,
                 "t = {}: joint angle q[{}] = {a} outside {range:?}",

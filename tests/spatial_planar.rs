@@ -36,9 +36,10 @@ fn compare(p: &PlanarParams) -> (usize, usize, f64) {
     let backwards = rows
         .windows(2)
         .find(|w| {
-            (0..w[0].state.len()).any(|c| {
-                w[0].state[c] == fbd_contact::StateCode::St3
-                    && w[0].fa[c] * (w[1].point[c][0] - w[0].point[c][0]) > 0.0
+            (0..w[0].contacts.len()).any(|c| {
+                let (a, b) = (&w[0].contacts[c], &w[1].contacts[c]);
+                a.state == fbd_contact::StateCode::St3
+                    && a.tangential[0] * (b.point[0] - a.point[0]) > 0.0
             })
         })
         .map_or(usize::MAX, |w| w[0].step);
@@ -53,14 +54,15 @@ fn compare(p: &PlanarParams) -> (usize, usize, f64) {
     let map = [(0, 0), (1, 1), (2, 5), (3, 7), (4, 8), (5, 10), (6, 11)];
     let mut worst: f64 = 0.0;
     for (a, b) in rows.iter().zip(&rows3).take_while(|(a, _)| a.step <= cut) {
+        let aq = a.plane_q();
         for (i, j) in map {
-            let d = (a.q[i] - b.q[j]).abs();
+            let d = (aq[i] - b.q[j]).abs();
             worst = worst.max(d);
             assert!(
                 d < 1e-8,
                 "t = {}: planar q[{i}] = {} vs spatial q[{j}] = {}",
                 a.t,
-                a.q[i],
+                aq[i],
                 b.q[j]
             );
         }

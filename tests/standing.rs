@@ -26,24 +26,24 @@ fn high_friction_stance_sticks_and_supports_the_robot() {
     for w in rows.windows(3) {
         let r = &w[1];
         assert_eq!(
-            &r.state[..2],
+            &[r.contacts[0].state, r.contacts[1].state],
             &[StateCode::St2, StateCode::St2],
             "t = {}",
             r.t
         );
         assert!(
-            r.n[0] > 0.0 && r.n[1] > 0.0,
+            r.contacts[0].normal > 0.0 && r.contacts[1].normal > 0.0,
             "t = {}: n = {:?}",
             r.t,
-            &r.n[..2]
+            [r.contacts[0].normal, r.contacts[1].normal]
         );
-        let c: Vec<[f64; 2]> = w.iter().map(|x| system_com(&model, &x.q)).collect();
+        let c: Vec<[f64; 2]> = w.iter().map(|x| system_com(&model, &x.plane_q())).collect();
         let a = [
             (c[2][0] - 2.0 * c[1][0] + c[0][0]) / (dt * dt),
             (c[2][1] - 2.0 * c[1][1] + c[0][1]) / (dt * dt),
         ];
-        let fy = r.n[0] + r.n[1];
-        let fx = r.fa[0] + r.fa[1];
+        let fy = r.contacts[0].normal + r.contacts[1].normal;
+        let fx = r.contacts[0].tangential[0] + r.contacts[1].tangential[0];
         assert!(
             (fy - m * (9.81 + a[1])).abs() < 1e-6 * m,
             "t = {}: Σn = {fy}, M(g + a) = {}",

@@ -285,7 +285,7 @@ fn a_friction_patch_in_the_plane() {
         assert!(s.error.is_none(), "{:?}", s.error);
         let slid = rows
             .iter()
-            .filter(|r| r.state.contains(&StateCode::St3))
+            .filter(|r| r.contacts.iter().any(|c| c.state == StateCode::St3))
             .count();
         (rows.last().unwrap().q[0] - rows[0].q[0], slid)
     };

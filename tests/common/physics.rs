@@ -2,7 +2,7 @@
 //! the system's centre of mass, momenta.
 
 use fbd_dynamics::FbdData;
-use fbd_sim::{Model, PlanarParams, StepRecord};
+use fbd_sim::{Model, PlanarParams, RobotRecord};
 
 /// `(X, Y, ψ)` of every body at `q`.
 pub fn body_coords(model: &Model, q: &[f64]) -> Vec<[f64; 3]> {
@@ -84,8 +84,13 @@ pub fn landing(
     p
 }
 
+/// The in-plane coordinates `(x, y)` of a record's point (its z is 0).
+pub fn plane(p: [f64; 3]) -> [f64; 2] {
+    [p[0], p[1]]
+}
+
 /// Builds and runs a model; panics with the error if the run fails.
-pub fn run_ok(p: &PlanarParams) -> (Model, Vec<StepRecord>, fbd_sim::RunSummary) {
+pub fn run_ok(p: &PlanarParams) -> (Model, Vec<RobotRecord>, fbd_sim::RunSummary) {
     let model = Model::planar(p).expect("valid parameters");
     let (rows, summary) = fbd_sim::run_collect(&model);
     if let Some(e) = &summary.error {
@@ -123,7 +128,7 @@ pub fn standing_q(p: &PlanarParams, theta3_deg: f64) -> [f64; 7] {
 /// the recorded joint forces, contact forces, torques and gravity. Returns
 /// the worst imbalance in newtons (moments divided by the model's length
 /// scale).
-pub fn worst_body_imbalance(model: &Model, rows: &[StepRecord]) -> (f64, String) {
+pub fn worst_body_imbalance(model: &Model, rows: &[RobotRecord]) -> (f64, String) {
     worst_body_imbalance_except(model, rows, &[])
 }
 
@@ -132,7 +137,7 @@ pub fn worst_body_imbalance(model: &Model, rows: &[StepRecord]) -> (f64, String)
 /// substep's (at `t_k`, over `Δt/n`), not a whole step's.
 pub fn worst_body_imbalance_except(
     model: &Model,
-    rows: &[StepRecord],
+    rows: &[RobotRecord],
     skip: &[usize],
 ) -> (f64, String) {
     let mech = &model.mech;
@@ -145,11 +150,11 @@ pub fn worst_body_imbalance_except(
             continue;
         }
         let (xp, xk, xn) = (
-            body_coords(model, &prev.q),
-            body_coords(model, &cur.q),
-            body_coords(model, &next.q),
+            body_coords(model, &prev.plane_q()),
+            body_coords(model, &cur.plane_q()),
+            body_coords(model, &next.plane_q()),
         );
-        let pts = points(model, &cur.q);
+        let pts = points(model, &cur.plane_q());
         // Applied forces and moments about each centre of mass at k.
         let mut acc: Vec<[f64; 3]> = mech
             .bodies
@@ -163,9 +168,9 @@ pub fn worst_body_imbalance_except(
             acc[b][2] += r[0] * f[1] - r[1] * f[0] + tz;
         };
         for (j, spec) in mech.joints.iter().enumerate() {
-            let f = cur.joint_force[j];
+            let f = [cur.reaction_force[j][0], cur.reaction_force[j][1]];
             // Joint torque and the moment of the joint-limit stop.
-            let tz = spec.axis_z * (cur.torque[j] + cur.limit_moment[j]);
+            let tz = spec.axis_z * (cur.torque[j] + cur.stop[j]);
             apply(spec.child, pts[spec.point], f, tz);
             apply(spec.parent, pts[spec.point], [-f[0], -f[1]], -tz);
         }
@@ -178,10 +183,8 @@ pub fn worst_body_imbalance_except(
             } else {
                 (t, n)
             };
-            let f = [
-                cur.fa[c] * t[0] + cur.n[c] * n[0],
-                cur.fa[c] * t[1] + cur.n[c] * n[1],
-            ];
+            let (fa, fn_) = (cur.contacts[c].tangential[0], cur.contacts[c].normal);
+            let f = [fa * t[0] + fn_ * n[0], fa * t[1] + fn_ * n[1]];
             apply(spec.body, pts[spec.point], f, 0.0);
         }
         for (b, spec) in mech.bodies.iter().enumerate() {

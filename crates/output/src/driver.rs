@@ -24,9 +24,9 @@ pub trait Stepper<R> {
     fn step(&self, stop: &AtomicBool, each: impl FnMut(&R)) -> Self::Run;
 }
 
-impl Stepper<fbd_sim::StepRecord> for fbd_sim::Model {
+impl Stepper<fbd_sim::RobotRecord> for fbd_sim::Model {
     type Run = fbd_sim::RunSummary;
-    fn step(&self, stop: &AtomicBool, each: impl FnMut(&fbd_sim::StepRecord)) -> Self::Run {
+    fn step(&self, stop: &AtomicBool, each: impl FnMut(&fbd_sim::RobotRecord)) -> Self::Run {
         fbd_sim::run_until(self, stop, each)
     }
 }
@@ -50,12 +50,6 @@ impl Stepper<fbd_sim::gait::GaitData> for fbd_sim::gait::GaitModel {
 pub trait Stepped {
     /// The step index k.
     fn step(&self) -> usize;
-}
-
-impl Stepped for fbd_sim::StepRecord {
-    fn step(&self) -> usize {
-        self.step
-    }
 }
 
 impl Stepped for fbd_sim::robot::RobotRecord {

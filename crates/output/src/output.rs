@@ -11,12 +11,13 @@ use std::path::{Path, PathBuf};
 use fbd_contact::StateCode;
 use fbd_dynamics::{ContactSpec, PointKind};
 use fbd_kinematics::planar::hexapod_leg_number;
-use fbd_sim::{Event, LimitEvent, RetryEvent, RunSummary, StepRecord};
+use fbd_sim::{Event, LimitEvent, RetryEvent, RunSummary};
 use serde::Serialize;
 use tempfile::NamedTempFile;
 
 use crate::OutputError;
 use crate::steptime::StepTimes;
+use crate::tree::{Plan, Source};
 
 /// Names of the files `fbd run` writes, in the order they are written.
 /// (`torques.svg` is written too when a joint is actuated.)
@@ -529,7 +530,64 @@ impl ContactSlots {
         c.extend(TAIL_COLUMNS.iter().map(|s| (*s).to_owned()));
         c
     }
+
+    /// The planar model's trajectory as a [`Plan`] over its record (the
+    /// one record of every model, [`fbd_sim::RobotRecord`], its plane
+    /// embedded): the [`Self::columns`] and where each one's value is. A
+    /// tip that is not a contact point has a NaN position, `ST1` and zero
+    /// forces.
+    pub fn plan(&self) -> Plan {
+        use fbd_sim::robot::plane_q_index;
+        let names = self.columns();
+        let mut sources = Vec::with_capacity(names.len());
+        sources.push(Source::Time);
+        sources.extend((0..3 + PLANAR_JOINTS).map(|i| Source::Q(plane_q_index(i))));
+        for c in self.tips {
+            sources.extend(match c {
+                Some(c) => [Source::ContactPoint(c, 0), Source::ContactPoint(c, 1)],
+                None => [Source::Nan; 2],
+            });
+        }
+        for c in self.tips {
+            sources.push(c.map_or(Source::Free, Source::ContactState));
+        }
+        for c in self.tips {
+            sources.extend(match c {
+                Some(c) => [Source::ContactTangential(c, 0), Source::ContactNormal(c)],
+                None => [Source::Zero; 2],
+            });
+        }
+        for j in 0..PLANAR_JOINTS {
+            sources.extend([Source::ReactionForce(j, 0), Source::ReactionForce(j, 1)]);
+        }
+        for &(c, _, _) in &self.extras {
+            sources.extend([
+                Source::ContactState(c),
+                Source::ContactTangential(c, 0),
+                Source::ContactNormal(c),
+            ]);
+        }
+        sources.extend((0..PLANAR_JOINTS).map(Source::Torque));
+        sources.extend([
+            Source::Kinetic,
+            Source::Potential,
+            Source::Energy,
+            Source::Iterations,
+        ]);
+        sources.extend((0..PLANAR_JOINTS).map(Source::Stop));
+        assert_eq!(names.len(), sources.len(), "a source for every column");
+        let mut plan = Plan::default();
+        for (name, source) in names.into_iter().zip(sources) {
+            plan.push(name, source);
+        }
+        plan
+    }
 }
+
+/// The joints of the planar model (`hip3, knee3, hip4, knee4`: the
+/// contract's joint-force columns, [`SPEC_COLUMNS`], and the torques and
+/// stops of [`TAIL_COLUMNS`]).
+pub const PLANAR_JOINTS: usize = 4;
 
 /// The trajectory columns for a model whose contact points are `contacts`
 /// (e.g. tips, knees and hips of legs 3 and 4): the contract's list, then
@@ -541,9 +599,8 @@ pub fn trajectory_columns(contacts: &[ContactSpec]) -> Vec<String> {
 
 /// Receives the values of one row of `trajectory.csv`, column by column
 /// in the order of the file's columns: the files' writers and the
-/// in-memory columns of the Python package share the row builders
-/// ([`row_values`], [`crate::tree::Plan::row`]), one source of
-/// the values.
+/// in-memory columns of the Python package share the row builder
+/// ([`crate::tree::Plan::row`]), one source of the values.
 pub trait RowSink {
     /// `t`: the time of step `step` (`t = step·Δt`; the file writes the
     /// exact decimal of `step·Δt`, [`StepTimes`]).
@@ -558,47 +615,6 @@ pub trait RowSink {
     /// the CSV file).
     fn flag(&mut self, on: bool) {
         self.num(if on { 1.0 } else { 0.0 });
-    }
-}
-
-/// Hands the values of the planar row of `r` to `sink`, in the order of
-/// [`ContactSlots::columns`]. No allocation.
-pub fn row_values(slots: &ContactSlots, r: &StepRecord, sink: &mut dyn RowSink) {
-    sink.time(r.step, r.t);
-    for &x in &r.q {
-        sink.num(x);
-    }
-    for c in slots.tips {
-        let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
-        sink.num(p[0]);
-        sink.num(p[1]);
-    }
-    for c in slots.tips {
-        sink.state(c.map_or(StateCode::St1, |c| r.state[c]));
-    }
-    for c in slots.tips {
-        let (fa, n) = c.map_or((0.0, 0.0), |c| (r.fa[c], r.n[c]));
-        sink.num(fa);
-        sink.num(n);
-    }
-    for j in &r.joint_force {
-        sink.num(j[0]);
-        sink.num(j[1]);
-    }
-    for &(c, _, _) in &slots.extras {
-        sink.state(r.state[c]);
-        sink.num(r.fa[c]);
-        sink.num(r.n[c]);
-    }
-    for &t in &r.torque {
-        sink.num(t);
-    }
-    sink.num(r.kinetic);
-    sink.num(r.potential);
-    sink.num(r.kinetic + r.potential);
-    sink.count(r.newton_iterations);
-    for &m in &r.limit_moment {
-        sink.num(m);
     }
 }
 
@@ -1298,23 +1314,26 @@ mod tests {
         ];
         for contacts in &layouts {
             let slots = ContactSlots::of(contacts);
-            let mut r = StepRecord::new(7, contacts.len(), 4);
+            let plan = slots.plan();
+            let mut r = fbd_sim::RobotRecord::planar(contacts.len(), 4);
             (r.step, r.t) = (3, 0.03);
             for c in 0..contacts.len() {
-                r.point[c] = [10.0 + c as f64, 20.0 + c as f64];
-                r.state[c] = StateCode::St2;
-                r.fa[c] = 30.0 + c as f64;
-                r.n[c] = 40.0 + c as f64;
+                let row = &mut r.contacts[c];
+                row.point = [10.0 + c as f64, 20.0 + c as f64, 0.0];
+                row.state = StateCode::St2;
+                row.tangential = [30.0 + c as f64, 0.0];
+                row.normal = 40.0 + c as f64;
             }
             let mut count = Count::default();
-            row_values(&slots, &r, &mut count);
+            plan.row(&r, None, &mut count);
             let columns = slots.columns();
+            assert_eq!(plan.names, columns);
             assert_eq!(count.0, columns.len(), "{contacts:?}");
 
             let mut bytes = Vec::new();
             let (mut num, times) = (ryu::Buffer::new(), StepTimes::new(0.01));
             let mut row = CsvRow::new(&mut bytes, &mut num, &times);
-            row_values(&slots, &r, &mut row);
+            plan.row(&r, None, &mut row);
             row.end().unwrap();
             let line = String::from_utf8(bytes).unwrap();
             let cell: std::collections::HashMap<&str, &str> = columns

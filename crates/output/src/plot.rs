@@ -22,7 +22,7 @@
 
 use fbd_contact::{StateCode, Terrain};
 use fbd_dynamics::{ContactSpec, PointKind};
-use fbd_sim::{Event, StepRecord};
+use fbd_sim::{Event, RobotRecord};
 
 use crate::output::{ContactSlots, PLANAR_LEGS};
 use plotters::coord::types::RangedCoordf64;
@@ -272,25 +272,30 @@ impl PlotRecorder {
     /// Runs for every step of the run, inside the stepping loop: the step's
     /// time column is found once for all the curves ([`Columns::of`]), and
     /// nothing is looked up by name or allocated.
-    pub fn push(&mut self, r: &StepRecord) {
+    pub fn push(&mut self, r: &RobotRecord) {
         let t = r.t;
         let col = self.columns.of(t);
         for (leg, c) in self.tips.iter().enumerate() {
-            let p = c.map_or([f64::NAN; 2], |c| r.point[c]);
+            let p = c.map_or([f64::NAN; 2], |c| {
+                let p = r.contacts[c].point;
+                [p[0], p[1]]
+            });
             self.tip[2 * leg].push_at(col, t, p[0]);
             self.tip[2 * leg + 1].push_at(col, t, p[1]);
         }
-        let used = self.touched.len().min(r.contacts());
-        let rows = self.touched[..used]
+        let rows = self
+            .touched
             .iter_mut()
-            .zip(&mut self.normal[..used])
-            .zip(&mut self.tangential[..used]);
-        for (c, ((touched, normal), tangential)) in rows.enumerate() {
-            *touched |= r.state[c] != StateCode::St1;
-            normal.push_at(col, t, r.n[c]);
-            tangential.push_at(col, t, r.fa[c]);
+            .zip(&mut self.normal)
+            .zip(&mut self.tangential)
+            .zip(&r.contacts);
+        for (((touched, normal), tangential), row) in rows {
+            *touched |= row.state != StateCode::St1;
+            normal.push_at(col, t, row.normal);
+            tangential.push_at(col, t, row.tangential[0]);
         }
-        for (m, q) in self.joints.iter_mut().zip(&r.q[3..]) {
+        // The joints after the root (`Rx, Ry, Rz, φx, φy, φz`).
+        for (m, q) in self.joints.iter_mut().zip(&r.q[6..]) {
             m.push_at(col, t, q.to_degrees());
         }
         for (m, &tau) in self.torques.iter_mut().zip(&r.torque) {
@@ -1227,18 +1232,18 @@ mod tests {
         let steps = 600_000;
         let dt = 1e-5;
         let mut rec = PlotRecorder::new(&tips, (steps - 1) as f64 * dt);
-        let mut r = StepRecord::new(7, 2, 4);
+        let mut r = RobotRecord::planar(2, 4);
         for k in 0..steps {
             let t = k as f64 * dt;
             r.step = k;
             r.t = t;
             let w = (t * 300.0).sin();
-            r.point[0] = [0.1 * w, 0.2 + 0.01 * (t * 7000.0).sin()];
-            r.point[1] = [-0.1 * w, 0.2 - 0.01 * w];
-            r.q[3] = w;
-            r.n[0] = 50.0 + 20.0 * w;
-            r.fa[0] = 5.0 * w;
-            r.state[0] = StateCode::St2;
+            r.contacts[0].point = [0.1 * w, 0.2 + 0.01 * (t * 7000.0).sin(), 0.0];
+            r.contacts[1].point = [-0.1 * w, 0.2 - 0.01 * w, 0.0];
+            r.q[6] = w;
+            r.contacts[0].normal = 50.0 + 20.0 * w;
+            r.contacts[0].tangential[0] = 5.0 * w;
+            r.contacts[0].state = StateCode::St2;
             r.kinetic = w * w;
             r.potential = 1.0 - w * w;
             rec.push(&r);

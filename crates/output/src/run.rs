@@ -7,7 +7,7 @@ use std::sync::atomic::AtomicBool;
 
 use fbd_dynamics::PointKind;
 use fbd_kinematics::planar::PlanarChains;
-use fbd_sim::{Model, RunSummary, StepRecord};
+use fbd_sim::{Model, RobotRecord, RunSummary};
 
 use crate::OutputError;
 use crate::config::{self, Config};
@@ -27,6 +27,7 @@ struct LastRow {
     t: f64,
     kinetic: f64,
     potential: f64,
+    /// The record's `q` (the plane embedded, [`RobotRecord::plane_q`]).
     q: Vec<f64>,
 }
 
@@ -34,6 +35,7 @@ struct LastRow {
 struct Collector {
     snapshot_steps: Vec<usize>,
     plot: PlotRecorder,
+    /// Time and the planar model's coordinates ([`RobotRecord::plane_q`]).
     snapshots: Vec<(f64, Vec<f64>)>,
     last: Option<LastRow>,
     peak_contact: Vec<PeakForce>,
@@ -66,17 +68,17 @@ impl Collector {
         }
     }
 
-    fn push(&mut self, r: &StepRecord) {
+    fn push(&mut self, r: &RobotRecord) {
         self.plot.push(r);
         if self.snapshot_steps.binary_search(&r.step).is_ok() {
-            self.snapshots.push((r.t, r.q.clone()));
+            self.snapshots.push((r.t, r.plane_q()));
         }
-        for (c, p) in self.peak_contact.iter_mut().enumerate() {
-            p.n = p.n.max(r.n[c].abs());
-            p.fa = p.fa.max(r.fa[c].abs());
+        for (p, row) in self.peak_contact.iter_mut().zip(&r.contacts) {
+            p.n = p.n.max(row.normal.abs());
+            p.fa = p.fa.max(row.tangential[0].abs());
         }
         let peaks = self.peak_joint.iter_mut().zip(&mut self.peak_joint_sq);
-        for ((p, sq), f) in peaks.zip(&r.joint_force) {
+        for ((p, sq), f) in peaks.zip(&r.reaction_force) {
             // A NaN force fails the test, as `max` ignores it.
             if f[0] * f[0] + f[1] * f[1] >= *sq {
                 *p = p.max(f[0].hypot(f[1]));
@@ -111,7 +113,10 @@ impl Collector {
         if let Some(r) = &self.last
             && self.snapshots.last().map(|s| s.0) != Some(r.t)
         {
-            self.snapshots.push((r.t, r.q.clone()));
+            let q = &r.q;
+            let plane = fbd_sim::robot::PLANE_ROOT.iter().map(|&i| q[i]);
+            self.snapshots
+                .push((r.t, plane.chain(q[6..].iter().copied()).collect()));
         }
         let chains: &PlanarChains = &model.mech.chains;
         let ix = &model.index;
@@ -229,28 +234,28 @@ struct PlanarFiles<'a> {
     model: &'a Model,
     planar: &'a fbd_scenario::PlanarConfig,
     names: Vec<String>,
-    slots: output::ContactSlots,
+    plan: crate::tree::Plan,
     collect: Option<Collector>,
     view: Option<PlanarScene<'a>>,
     plot: Option<PlotData>,
 }
 
 impl RunFiles for PlanarFiles<'_> {
-    type Record = StepRecord;
+    type Record = RobotRecord;
     type Run = RunSummary;
     type Summary = Summary;
 
-    fn row_values(&mut self, r: &StepRecord, sink: &mut dyn output::RowSink) {
-        output::row_values(&self.slots, r, sink);
+    fn row_values(&mut self, r: &RobotRecord, sink: &mut dyn output::RowSink) {
+        self.plan.row(r, None, sink);
     }
 
-    fn written(&mut self, r: &StepRecord) {
+    fn written(&mut self, r: &RobotRecord) {
         if let Some(v) = self.view.as_mut() {
             v.push(r);
         }
     }
 
-    fn observe(&mut self, r: &StepRecord) {
+    fn observe(&mut self, r: &RobotRecord) {
         if let Some(c) = self.collect.as_mut() {
             c.push(r);
         }
@@ -316,7 +321,7 @@ pub fn simulate(
     source: &str,
     out_dir: Option<&Path>,
     stop: &AtomicBool,
-    on_row: &mut dyn FnMut(&StepRecord),
+    on_row: &mut dyn FnMut(&RobotRecord),
 ) -> Result<Simulated, OutputError> {
     let planar = match config {
         Config::Planar(c) => c,
@@ -329,11 +334,11 @@ pub fn simulate(
     let model = planar.model(source)?;
 
     let names: Vec<String> = model.mech.contacts.iter().map(|c| c.name.clone()).collect();
-    let slots = output::ContactSlots::of(&model.mech.contacts);
+    let plan = output::ContactSlots::of(&model.mech.contacts).plan();
     let table = match out_dir {
         Some(dir) => {
             output::prepare_dir(dir)?;
-            let columns = slots.columns();
+            let columns = plan.names.clone();
             output::warn_size(
                 model.steps.div_ceil(model.params.stride.max(1)),
                 columns.len(),
@@ -367,7 +372,7 @@ pub fn simulate(
         model: &model,
         planar,
         names,
-        slots,
+        plan,
         collect: Some(collect),
         view,
         plot: None,

@@ -1,12 +1,13 @@
 //! Every column of `trajectory.csv`, kept in memory: the same names
 //! ([`fbd_output::output::trajectory_columns`]) and the same values, from the
-//! same row builders ([`fbd_output::output::row_values`],
-//! [`fbd_output::tree::Plan::row`]), so that a run from Python equals
-//! the CLI's file bit for bit (the test suite compares them).
+//! same row builder ([`fbd_output::tree::Plan::row`], the planar model's
+//! plan [`ContactSlots::plan`]), so that a run from Python equals the
+//! CLI's file bit for bit (the test suite compares them).
 
 use fbd_output::output::{ContactSlots, RowSink};
 use fbd_output::steptime::StepTimes;
-use fbd_sim::StepRecord;
+use fbd_output::tree::Plan;
+use fbd_sim::RobotRecord;
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -26,9 +27,9 @@ pub struct Columns {
     names: Vec<String>,
     values: Vec<Values>,
     times: StepTimes,
-    /// Where the planar contact points' values go (empty for
-    /// [`Columns::named`]).
-    slots: ContactSlots,
+    /// The planar model's columns and where their values are in its
+    /// record (empty for [`Columns::named`]).
+    plan: Plan,
 }
 
 impl Columns {
@@ -36,8 +37,9 @@ impl Columns {
     /// (found by their `{leg, kind}`: [`ContactSlots::of`] the model's
     /// contact points) and time step `dt`, with room for `rows` rows.
     pub fn new(slots: ContactSlots, dt: f64, rows: usize) -> Self {
-        let mut c = Self::named(slots.columns(), dt, rows);
-        c.slots = slots;
+        let plan = slots.plan();
+        let mut c = Self::named(plan.names.clone(), dt, rows);
+        c.plan = plan;
         c
     }
 
@@ -61,7 +63,7 @@ impl Columns {
             names,
             values,
             times: StepTimes::new(dt),
-            slots: ContactSlots::default(),
+            plan: Plan::default(),
         }
     }
 
@@ -78,7 +80,7 @@ impl Columns {
     }
 
     /// Appends the row of `r`, in the order of `trajectory.csv`.
-    pub fn push(&mut self, r: &StepRecord) {
+    pub fn push(&mut self, r: &RobotRecord) {
         let mut sink = Sink {
             w: Writer {
                 values: &mut self.values,
@@ -86,7 +88,7 @@ impl Columns {
             },
             times: &self.times,
         };
-        fbd_output::output::row_values(&self.slots, r, &mut sink);
+        self.plan.row(r, None, &mut sink);
         debug_assert_eq!(sink.w.i, self.names.len(), "a value for every column");
     }
 

@@ -1040,7 +1040,14 @@ impl Simulator {
         if let Sim::Planar(s) = &self.sim {
             let r = &s.data().record;
             let n = self.contacts.len();
-            let a = Array2::from_shape_fn((n, 2), |(c, j)| if j == 0 { r.fa[c] } else { r.n[c] });
+            let a = Array2::from_shape_fn((n, 2), |(c, j)| {
+                let row = &r.contacts[c];
+                if j == 0 {
+                    row.tangential[0]
+                } else {
+                    row.normal
+                }
+            });
             return PyArray2::from_owned_array(py, a);
         }
         let f: Vec<[f64; 3]> = self.readout.contacts.iter().map(|c| c.force).collect();
@@ -1059,7 +1066,7 @@ impl Simulator {
                 if d.k == 0 {
                     d.fbd.kin.pos[s.model().mech.contacts[c].point][j]
                 } else {
-                    d.record.point[c][j]
+                    d.record.contacts[c].point[j]
                 }
             });
             return PyArray2::from_owned_array(py, a);
@@ -1081,7 +1088,8 @@ impl Simulator {
         }
         if let Sim::Planar(s) = &self.sim {
             let r = &s.data().record;
-            let a = Array2::from_shape_fn((r.joint_force.len(), 2), |(j, i)| r.joint_force[j][i]);
+            let f = &r.reaction_force;
+            let a = Array2::from_shape_fn((f.len(), 2), |(j, i)| f[j][i]);
             return PyArray2::from_owned_array(py, a).into_any();
         }
         let legs = &self.readout.legs;

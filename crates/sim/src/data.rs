@@ -5,7 +5,7 @@
 use crate::Model;
 use crate::engine::RunData;
 use crate::engine::data::Parts;
-use crate::record::StepRecord;
+use crate::robot::RobotRecord;
 use fbd_dynamics::FbdData;
 use fbd_solver::NewtonSolver;
 
@@ -27,7 +27,7 @@ impl RunData<Model> {
             initial_states: model.initial_states.clone(),
             fbd,
             solver: NewtonSolver::new(model.newton),
-            record: StepRecord::new(lay.nq, lay.contacts, lay.joints),
+            record: RobotRecord::planar(lay.contacts, lay.joints),
             control: (),
         })
     }

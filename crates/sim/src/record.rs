@@ -1,5 +1,6 @@
-//! What one step produces: a record sized from the model's layout
-//! (allocated once, refilled every step), and contact events.
+//! What one step produces besides its record (the one record of every
+//! model, [`crate::robot::RobotRecord`]): the joint limits' codes and the
+//! events of contact points, joint limits and retried steps.
 
 use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
@@ -34,77 +35,6 @@ impl LimitCode {
             LimitCode::Min => "min",
             LimitCode::Max => "max",
         }
-    }
-}
-
-/// Everything known about step `k` once it is solved: row `k` of
-/// `trajectory.csv` (docs/reference.md). Sized from the model's layout
-/// ([`StepRecord::new`]) once per run and refilled every step.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StepRecord {
-    /// Step index k.
-    pub step: usize,
-    /// Time k·Δt (s).
-    pub t: f64,
-    /// `q[k]`: body `(Rx, Ry, φz)` then the joint angles in the model's
-    /// joint order (m, rad).
-    pub q: Vec<f64>,
-    /// Inertial position of each contact point at `q[k]` (m), in the
-    /// model's contact order.
-    pub point: Vec<[f64; 2]>,
-    /// State each contact point was solved in at step k.
-    pub state: Vec<StateCode>,
-    /// Tangential contact force along the terrain tangent (N).
-    pub fa: Vec<f64>,
-    /// Normal contact force along the terrain normal (N).
-    pub n: Vec<f64>,
-    /// Joint forces, parent on child, inertial frame (N), in the model's
-    /// joint order (the two-leg model: hip3, knee3, hip4, knee4).
-    pub joint_force: Vec<[f64; 2]>,
-    /// Joint torques (N·m), same order.
-    pub torque: Vec<f64>,
-    /// State of each joint's limit at step k, same order (free for a joint
-    /// without one).
-    pub limit: Vec<LimitCode>,
-    /// Moment of each joint's limit stop (N·m, positive towards larger
-    /// joint angles; 0 when free), same order.
-    pub limit_moment: Vec<f64>,
-    /// Kinetic energy at k, from central-difference velocities (J).
-    pub kinetic: f64,
-    /// Gravitational potential energy at k (J).
-    pub potential: f64,
-    /// Newton iterations spent on this step (all state trials).
-    pub newton_iterations: usize,
-    /// Number of solves of this step (1 + state switches).
-    pub state_trials: usize,
-}
-
-impl StepRecord {
-    /// A record for a model of `nq` coordinates, `contacts` contact points
-    /// and `joints` joints, every value zero (states ST1, limits free).
-    pub fn new(nq: usize, contacts: usize, joints: usize) -> Self {
-        Self {
-            step: 0,
-            t: 0.0,
-            q: vec![0.0; nq],
-            point: vec![[0.0; 2]; contacts],
-            state: vec![StateCode::St1; contacts],
-            fa: vec![0.0; contacts],
-            n: vec![0.0; contacts],
-            joint_force: vec![[0.0; 2]; joints],
-            torque: vec![0.0; joints],
-            limit: vec![LimitCode::Free; joints],
-            limit_moment: vec![0.0; joints],
-            kinetic: 0.0,
-            potential: 0.0,
-            newton_iterations: 0,
-            state_trials: 0,
-        }
-    }
-
-    /// Contact points of the record.
-    pub fn contacts(&self) -> usize {
-        self.state.len()
     }
 }
 

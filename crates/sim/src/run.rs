@@ -1,6 +1,7 @@
 //! The stepping loop of a whole run.
 
-use crate::record::{Event, LimitEvent, RetryEvent, StepRecord};
+use crate::record::{Event, LimitEvent, RetryEvent};
+use crate::robot::RobotRecord;
 use crate::{Data, Model, SimError};
 use std::sync::atomic::AtomicBool;
 
@@ -81,20 +82,20 @@ impl RunSummary {
 
 /// Runs `model` from its initial state to the end (or the first error),
 /// handing every `stride`-th record to `on_row`.
-pub fn run(model: &Model, on_row: impl FnMut(&StepRecord)) -> RunSummary {
+pub fn run(model: &Model, on_row: impl FnMut(&RobotRecord)) -> RunSummary {
     run_until(model, &AtomicBool::new(false), on_row)
 }
 
 /// [`run`], stopping before the next step once `stop` is set (e.g. by a
 /// signal handler); the summary then says `interrupted`
 /// ([`crate::engine::run::run_until`]).
-pub fn run_until(model: &Model, stop: &AtomicBool, on_row: impl FnMut(&StepRecord)) -> RunSummary {
+pub fn run_until(model: &Model, stop: &AtomicBool, on_row: impl FnMut(&RobotRecord)) -> RunSummary {
     crate::engine::run::run_until(model, Data::new(model), stop, on_row)
 }
 
 /// Runs `model` and keeps every written record in memory (for tests and
 /// small runs).
-pub fn run_collect(model: &Model) -> (Vec<StepRecord>, RunSummary) {
+pub fn run_collect(model: &Model) -> (Vec<RobotRecord>, RunSummary) {
     let mut rows = Vec::with_capacity(model.steps / model.params.stride.max(1) + 1);
     let summary = run(model, |r| rows.push(r.clone()));
     (rows, summary)

@@ -627,21 +627,12 @@ impl Plant for Model {
         let legs = self.mech.joints.len() / 2;
         out.legs.resize(legs, LegReadout::default());
         for (l, leg) in out.legs.iter_mut().enumerate() {
-            let moment = |j: usize| {
-                let spec = &self.mech.joints[j];
-                [
-                    0.0,
-                    0.0,
-                    spec.axis_z * (rec.torque[j] + rec.limit_moment[j]),
-                ]
-            };
-            let f = |j: usize| [rec.joint_force[j][0], rec.joint_force[j][1], 0.0];
             *leg = LegReadout {
                 leg: 3 + l,
-                hip_force: f(2 * l),
-                hip_moment: moment(2 * l),
-                knee_force: f(2 * l + 1),
-                knee_moment: moment(2 * l + 1),
+                hip_force: rec.reaction_force[2 * l],
+                hip_moment: rec.reaction_moment[2 * l],
+                knee_force: rec.reaction_force[2 * l + 1],
+                knee_moment: rec.reaction_moment[2 * l + 1],
             };
         }
         let mut prev = chains.new_data();
@@ -663,14 +654,15 @@ impl Plant for Model {
                 [0.0; 3]
             };
             // The force along the tangent and normal at the step's point.
-            let (t, nn) = self.params.terrain.frame(rec.point[c][0]);
-            let (fa, fn_) = (rec.fa[c], rec.n[c]);
+            let row = &rec.contacts[c];
+            let (t, nn) = self.params.terrain.frame(row.point[0]);
+            let (fa, fn_) = (row.tangential[0], row.normal);
             out.contacts[c] = ContactReadout {
                 leg: spec.leg,
                 kind: spec.kind,
                 position: p3,
                 state: if moved {
-                    rec.state[c]
+                    row.state
                 } else {
                     data.states[c].code()
                 },
@@ -859,7 +851,7 @@ mod tests {
         };
         for row in rows.iter().skip(1) {
             sim.step(&Action::Pd(&pd)).unwrap();
-            assert_eq!(bits(sim.q()), bits(&row.q), "step {}", row.step);
+            assert_eq!(bits(sim.q()), bits(&row.plane_q()), "step {}", row.step);
         }
     }
 

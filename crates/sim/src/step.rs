@@ -7,7 +7,8 @@
 //! assembly of [`fbd_dynamics`] as a Newton system (contact equations in
 //! the terrain frame at the anchor or under the point), a contact point's
 //! trial and its violation, the rigid placement of anchors on one body,
-//! and the [`StepRecord`] (sized from the layout).
+//! and the step's [`RobotRecord`], the one record of every model (its
+//! plane embedded in 3D: [`RobotRecord::planar`]).
 //!
 //! **Joint limits** are one-sided, plastic stops (`fbd_dynamics::assemble`):
 //! a free joint whose trial angle crosses an end of its range is held at
@@ -16,7 +17,8 @@
 
 use crate::energy;
 use crate::engine::{Engine, Law, LimitInfo, Settings};
-use crate::record::{LimitCode, StepRecord};
+use crate::record::LimitCode;
+use crate::robot::{RobotContactRow, RobotRecord};
 use crate::rules::regularization;
 pub use crate::system::StepSystem;
 use crate::system::row_scales;
@@ -33,7 +35,7 @@ use fbd_solver::{NewtonReport, NewtonSolver, SolverError};
 ///
 /// # Errors
 /// A [`SimError`] naming the step and time.
-pub fn step<'a>(model: &Model, data: &'a mut Data) -> Result<&'a StepRecord, SimError> {
+pub fn step<'a>(model: &Model, data: &'a mut Data) -> Result<&'a RobotRecord, SimError> {
     crate::engine::step::step(model, data)?;
     Ok(&data.record)
 }
@@ -43,7 +45,7 @@ impl Engine for Model {
     type Trial = Trial;
     type Ground = Terrain;
     type Fbd = FbdData;
-    type Record = StepRecord;
+    type Record = RobotRecord;
     type Torques = Vec<f64>;
     type ControlData = ();
 
@@ -180,7 +182,7 @@ impl Engine for Model {
     fn make_record(&self, data: &mut Data, iterations: usize, trials: usize, h: f64) {
         make_record(self, data, iterations, trials, h);
     }
-    fn add_to_record(record: &mut StepRecord, iterations: usize, trials: usize) {
+    fn add_to_record(record: &mut RobotRecord, iterations: usize, trials: usize) {
         record.newton_iterations += iterations;
         record.state_trials += trials;
     }
@@ -252,8 +254,10 @@ fn beta(model: &Model, h: f64) -> f64 {
     regularization(model.contact.regularization, h)
 }
 
-/// Fills `data.record` (sized from the layout by [`Data::new`]) for the
-/// solved step.
+/// Fills `data.record` ([`RobotRecord::planar`], sized by [`Data::new`])
+/// for the solved step: the plane embedded in 3D (z = 0), joint `j`'s
+/// force as reaction `j`'s; no joint rates, momenta or centre of mass
+/// (left zero: the planar files read none, and they would cost the step).
 fn make_record(
     model: &Model,
     data: &mut Data,
@@ -263,33 +267,44 @@ fn make_record(
 ) {
     let mech = &model.mech;
     let lay = mech.layout();
+    let dt = model.dt();
     let r = &mut data.record;
     r.step = data.k;
-    r.t = data.k as f64 * model.dt();
+    r.t = data.k as f64 * dt;
     r.potential = energy::potential(mech, &data.fbd.kin);
     r.newton_iterations = newton_iterations;
     r.state_trials = state_trials;
-    r.q.copy_from_slice(&data.q[..lay.nq]);
+    r.set_plane_q(&data.q[..lay.nq]);
     // The unknowns by block: joint forces (x, y), contact forces (Fa, N),
     // stop moments.
     let (joint_forces, rest) = data.z[lay.joint_force(0, 0)..].split_at(2 * lay.joints);
     let (contact_forces, moments) = rest.split_at(2 * mech.contacts.len());
-    let contacts = mech.contacts.iter().zip(contact_forces.chunks_exact(2));
-    for (c, (spec, f)) in contacts.enumerate() {
-        r.point[c] = data.fbd.kin.pos[spec.point];
-        r.state[c] = data.trial[c].code();
-        r.fa[c] = f[0];
-        r.n[c] = f[1];
-    }
-    for (rf, f) in r.joint_force.iter_mut().zip(joint_forces.chunks_exact(2)) {
-        *rf = [f[0], f[1]];
+    let contacts = (mech.contacts.iter().zip(contact_forces.chunks_exact(2)))
+        .zip(data.fbd.contact.iter().zip(&data.trial));
+    for (((spec, f), (eq, trial)), row) in contacts.zip(&mut r.contacts) {
+        let p = data.fbd.kin.pos[spec.point];
+        let (t, n) = (eq.tangent, eq.normal);
+        *row = RobotContactRow {
+            point: [p[0], p[1], 0.0],
+            state: trial.code(),
+            force: [f[0] * t[0] + f[1] * n[0], f[0] * t[1] + f[1] * n[1], 0.0],
+            normal: f[1],
+            tangential: [f[0], 0.0],
+        };
     }
     r.torque.copy_from_slice(&data.fbd.torque);
     r.limit.fill(LimitCode::Free);
-    r.limit_moment.fill(0.0);
+    r.stop.fill(0.0);
     for ((&j, state), &moment) in mech.limits.iter().zip(&data.limit_trial).zip(moments) {
         r.limit[j] = LimitCode::of(state);
-        r.limit_moment[j] = moment;
+        r.stop[j] = moment;
+    }
+    let joints = (mech.joints.iter().zip(joint_forces.chunks_exact(2)))
+        .zip(r.torque.iter().zip(&r.stop))
+        .zip(r.reaction_force.iter_mut().zip(&mut r.reaction_moment));
+    for (((spec, f), (tau, stop)), (force, moment)) in joints {
+        *force = [f[0], f[1], 0.0];
+        *moment = [0.0, 0.0, spec.axis_z * (tau + stop)];
     }
     r.kinetic = if data.k == 0 {
         energy::kinetic_exact(mech, &data.fbd.kin, &model.params.qdot0)

@@ -514,6 +514,7 @@ mod tests {
                 state: if down { StateCode::St2 } else { StateCode::St1 },
                 force: if down { [1.0, 50.0, 0.0] } else { [0.0; 3] },
                 normal: if down { 50.0 } else { 0.0 },
+                tangential: if down { [1.0, 0.0] } else { [0.0; 2] },
             };
         }
         for l in &index.legs {

@@ -6,8 +6,9 @@
 //! the Python package's columns or a sweep's. A model names its columns
 //! ([`crate::spatial::csv::plan`] the hexapod's, leg by leg;
 //! [`crate::robot_run::plan`] an imported robot's, by its joints and
-//! points); what a row holds is written once, here. Their plots:
-//! [`plots`].
+//! points; [`crate::output::ContactSlots::plan`] the planar model's, the
+//! contract's columns); what a row holds is written once, here. Their
+//! plots: [`plots`].
 
 pub mod plots;
 pub mod summary;
@@ -50,6 +51,16 @@ pub enum Source {
     Free,
     /// A force of a point that is not a contact point of the model: 0.
     Zero,
+    /// A position of a point that is not a contact point of the planar
+    /// model: NaN.
+    Nan,
+    /// Component `a` of the ground's force on contact point `c` along the
+    /// contact frame's tangents (N; the planar model's `fa` is `a` = 0).
+    ContactTangential(usize, usize),
+    /// Joint `j`'s stop moment (N·m).
+    Stop(usize),
+    /// Kinetic plus potential energy (J).
+    Energy,
     /// Component `a` of the `i`-th foot of the model placed by its
     /// kinematics (a foot that is not a contact point; [`Feet`]).
     Foot(usize, usize),
@@ -132,6 +143,10 @@ impl Plan {
                 Source::Iterations => sink.count(r.newton_iterations),
                 Source::Free => sink.state(StateCode::St1),
                 Source::Zero => sink.num(0.0),
+                Source::Nan => sink.num(f64::NAN),
+                Source::ContactTangential(c, a) => sink.num(r.contacts[c].tangential[a]),
+                Source::Stop(j) => sink.num(r.stop[j]),
+                Source::Energy => sink.num(r.kinetic + r.potential),
                 Source::Foot(i, a) => {
                     let f = feet.expect("a plan with feet placed by the kinematics");
                     sink.num(f.tip(i)[a]);

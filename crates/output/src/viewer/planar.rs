@@ -9,7 +9,7 @@
 
 use fbd_contact::{StateCode, Terrain};
 use fbd_kinematics::planar::PlanarData;
-use fbd_sim::{Event, Model, StepRecord};
+use fbd_sim::{Event, Model, RobotRecord};
 
 use super::{
     Curve, Decimator, EventMark, Line, Marker, Panel, Scene, SceneKind, frame_at, round,
@@ -37,7 +37,10 @@ pub struct PlanarScene<'a> {
     /// The last row pushed, when it is not a frame (kept by `finish`).
     pending: Option<usize>,
     /// The record of that row (a buffer reused from row to row).
-    pending_record: Option<StepRecord>,
+    pending_record: Option<RobotRecord>,
+    /// The planar model's coordinates of a frame's record
+    /// ([`RobotRecord::plane_q_into`]; a buffer).
+    q: Vec<f64>,
     /// Indices into the chains' points of the drawn points, in order.
     drawn: Vec<usize>,
     touched: Vec<bool>,
@@ -151,6 +154,7 @@ impl<'a> PlanarScene<'a> {
             last_state: Vec::with_capacity(ncontacts),
             pending: None,
             pending_record: None,
+            q: Vec::new(),
             drawn,
             touched: vec![false; ncontacts],
             torques_used: false,
@@ -163,19 +167,20 @@ impl<'a> PlanarScene<'a> {
     }
 
     /// Adds the next row of `trajectory.csv`.
-    pub fn push(&mut self, r: &StepRecord) {
+    pub fn push(&mut self, r: &RobotRecord) {
         let row = self.rows;
         self.rows += 1;
         let nc = self.scene.contacts.len();
-        for (c, s) in r.state[..nc].iter().enumerate() {
-            self.touched[c] |= *s != StateCode::St1;
+        let states = || r.contacts[..nc].iter().map(|c| c.state);
+        for (c, s) in states().enumerate() {
+            self.touched[c] |= s != StateCode::St1;
         }
         self.torques_used |= r.torque.iter().any(|t| *t != 0.0);
-        let changed = !self.last_state.is_empty() && self.last_state[..] != r.state[..nc];
+        let changed = !self.last_state.is_empty() && !self.last_state.iter().copied().eq(states());
         let last = row + 1 >= self.rows_planned;
         let keep = self.decimator.keep(row, changed, last);
         self.last_state.clear();
-        self.last_state.extend_from_slice(&r.state[..nc]);
+        self.last_state.extend(states());
         if keep {
             self.frame(row, r);
             self.pending = None;
@@ -188,11 +193,12 @@ impl<'a> PlanarScene<'a> {
         }
     }
 
-    fn frame(&mut self, row: usize, r: &StepRecord) {
+    fn frame(&mut self, row: usize, r: &RobotRecord) {
         let nc = self.scene.contacts.len();
-        let state: String = r.state[..nc].iter().map(|s| digit(*s)).collect();
+        let state: String = r.contacts[..nc].iter().map(|c| digit(c.state)).collect();
         let chains = &self.model.mech.chains;
-        chains.eval_positions(&r.q, &mut self.kin);
+        r.plane_q_into(&mut self.q);
+        chains.eval_positions(&self.q, &mut self.kin);
         let pos = &self.kin.pos;
         let s = &mut self.scene;
         s.row.push(row);
@@ -213,16 +219,14 @@ impl<'a> PlanarScene<'a> {
             } else {
                 ([1.0, 0.0], [0.0, 1.0])
             };
-            let f = [
-                r.fa[c] * tan[0] + r.n[c] * nor[0],
-                r.fa[c] * tan[1] + r.n[c] * nor[1],
-            ];
+            let (fa, n) = (r.contacts[c].tangential[0], r.contacts[c].normal);
+            let f = [fa * tan[0] + n * nor[0], fa * tan[1] + n * nor[1]];
             fc.extend([round(f[0]), round(f[1]), 0.0]);
-            self.n[c].push(value(r.n[c]));
+            self.n[c].push(value(n));
         }
         s.fc.push(fc);
         s.fj.push(
-            r.joint_force[..s.joints.len()]
+            r.reaction_force[..s.joints.len()]
                 .iter()
                 .flat_map(|f| [round(f[0]), round(f[1]), 0.0])
                 .collect(),
@@ -236,7 +240,7 @@ impl<'a> PlanarScene<'a> {
         let m = if m > 0.0 { m } else { 1.0 };
         s.com.push([round(cx / m), round(cy / m), 0.0]);
         for (k, a) in self.angles.iter_mut().enumerate() {
-            a.push(value(r.q[3 + k].to_degrees()));
+            a.push(value(self.q[3 + k].to_degrees()));
         }
         for (k, a) in self.torque.iter_mut().enumerate() {
             a.push(value(r.torque[k]));

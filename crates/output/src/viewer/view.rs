@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use fbd_contact::StateCode;
 use fbd_dynamics::PointKind;
 use fbd_kinematics::body::LEG_COUNT;
-use fbd_sim::{Event, Joint, LimitEvent, Model, StepRecord};
+use fbd_sim::{Event, Joint, LimitEvent, Model, RobotRecord};
 
 use super::hexapod::{HexapodView, LegValues};
 use super::planar::PlanarScene;
@@ -81,7 +81,7 @@ fn state(s: &str) -> Option<StateCode> {
 }
 
 /// The step records of a planar run's `trajectory.csv`.
-fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, OutputError> {
+fn planar_records(model: &Model, table: &Table) -> Result<Vec<RobotRecord>, OutputError> {
     let q_cols = [
         "rx", "ry", "phi_z", "theta2_3", "theta3_3", "theta2_4", "theta3_4",
     ]
@@ -113,27 +113,29 @@ fn planar_records(model: &Model, table: &Table) -> Result<Vec<StepRecord>, Outpu
     let mut out = Vec::with_capacity(table.rows.len());
     for (r, row) in table.rows.iter().enumerate() {
         let t = table.number(row, r, t_col)?;
-        let mut rec = StepRecord::new(q_cols.len(), contacts.len(), joints.len());
+        let mut rec = RobotRecord::planar(contacts.len(), joints.len());
         (rec.step, rec.t) = (r, t);
         for (k, &c) in q_cols.iter().enumerate() {
-            rec.q[k] = table.number(row, r, c)?;
+            rec.q[fbd_sim::robot::plane_q_index(k)] = table.number(row, r, c)?;
         }
         for (c, cols) in contacts.iter().enumerate() {
             let s = cell(row, cols[0]);
-            rec.state[c] = state(s).ok_or_else(|| {
+            let point = &mut rec.contacts[c];
+            point.state = state(s).ok_or_else(|| {
                 OutputError::Io(format!(
                     "{}: line {}: `{s}` is not a contact state (ST1, ST2 or ST3)",
                     table.file.display(),
                     r + 2
                 ))
             })?;
-            rec.fa[c] = table.number(row, r, cols[1])?;
-            rec.n[c] = table.number(row, r, cols[2])?;
+            point.tangential[0] = table.number(row, r, cols[1])?;
+            point.normal = table.number(row, r, cols[2])?;
         }
         for (j, cols) in joints.iter().enumerate() {
-            rec.joint_force[j] = [
+            rec.reaction_force[j] = [
                 table.number(row, r, cols[0])?,
                 table.number(row, r, cols[1])?,
+                0.0,
             ];
             rec.torque[j] = table.number(row, r, cols[2])?;
         }

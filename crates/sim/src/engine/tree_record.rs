@@ -1,11 +1,13 @@
-//! The one record of every model on the generic tree equations
-//! ([`fbd_dynamics::tree`]: the paper's hexapod and every imported robot),
-//! [`RobotRecord`], and what a step records from its solution, written
-//! once ([`make_record`]): each contact point's force, each joint
-//! reaction's force and moment, each joint's torque, rate and stop, and
-//! the step's energies and momenta (the scheme's own, over the step
-//! k → k+1). A model's own view of it (the hexapod's legs,
-//! [`crate::spatial::LegRow`]) is read from it, not recorded apart.
+//! The one record of every model, [`RobotRecord`]: the models on the
+//! generic tree equations ([`fbd_dynamics::tree`]: the paper's hexapod and
+//! every imported robot) and the planar model (its plane embedded in 3D,
+//! filled by [`crate::step`]). What a step of a tree model records from
+//! its solution is written once ([`make_record`]): each contact point's
+//! force, each joint reaction's force and moment, each joint's torque,
+//! rate and stop, and the step's energies and momenta (the scheme's own,
+//! over the step k → k+1). A model's own view of it (the hexapod's legs,
+//! [`crate::spatial::LegRow`]; the planar model's coordinates,
+//! [`RobotRecord::plane_q`]) is read from it, not recorded apart.
 
 use super::RunData;
 use super::surface::SurfaceEngine;
@@ -28,11 +30,29 @@ pub struct RobotContactRow {
     pub force: [f64; 3],
     /// Normal component of that force (N, along the terrain normal).
     pub normal: f64,
+    /// Its components along the contact frame's two tangents (N): a tree
+    /// model's `t1`, `t2`; the planar model's terrain tangent
+    /// `(1, ϱ′)/√(1+ϱ′²)` (its `fa`), then 0.
+    pub tangential: [f64; 2],
 }
 
 /// Everything known about step `k` of a robot once it is solved: row `k`
 /// of `trajectory.csv`. Sized from the model (allocated once, refilled
 /// every step).
+///
+/// The planar model's record is its plane embedded in 3D: `q` holds
+/// `(Rx, Ry, 0, 0, 0, φz)` then its joints ([`Self::plane_q`]), points and
+/// forces have z = 0 (a contact's force is `fa·t + n·n̂` in the frame its
+/// step solved, the terrain's at the anchor for ST2, under the point
+/// otherwise; `fa` is its first tangential component), reaction `j` is
+/// joint `j`'s (force of the parent on
+/// the child at the joint, moment `axis_z·(τ + stop)` about Z), its
+/// energies are those at k (kinetic from the central differences
+/// `q[k−1]` → `q[k+1]`, the exact one from `q̇(0)` at k = 0; potential at
+/// `q[k]`). Its step computes no joint rates, momenta or centre of mass:
+/// `rate`, `momentum`, `angular_momentum` and `com` stay zero (its files
+/// read none of them, and they would cost every step; a planar model's
+/// rates are its simulator's readout, `Readout::qdot`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RobotRecord {
     /// Step index k.
@@ -55,7 +75,7 @@ pub struct RobotRecord {
     /// Per model joint, its actuator torque at k (N·m).
     pub torque: Vec<f64>,
     /// Per model joint, its rate at k (rad/s, backward difference; the
-    /// initial rate at k = 0).
+    /// initial rate at k = 0; zero for the planar model).
     pub rate: Vec<f64>,
     /// Per model joint, its stop's state at k (free for joints without
     /// limits).
@@ -63,15 +83,20 @@ pub struct RobotRecord {
     /// Per model joint, its stop moment at k (N·m, along the joint axis on
     /// the child).
     pub stop: Vec<f64>,
-    /// Kinetic energy over the step (J, the scheme's).
+    /// Kinetic energy over the step (J, the scheme's; the planar model's
+    /// at k).
     pub kinetic: f64,
-    /// Gravitational potential energy, mean of k and k+1 (J).
+    /// Gravitational potential energy, mean of k and k+1 (J; the planar
+    /// model's at k).
     pub potential: f64,
-    /// Total linear momentum over the step k → k+1 (kg·m/s).
+    /// Total linear momentum over the step k → k+1 (kg·m/s; zero for the
+    /// planar model).
     pub momentum: [f64; 3],
-    /// Total angular momentum about the origin over the step (kg·m²/s).
+    /// Total angular momentum about the origin over the step (kg·m²/s;
+    /// zero for the planar model).
     pub angular_momentum: [f64; 3],
-    /// Centre of mass of the whole robot at `q[k]` (m).
+    /// Centre of mass of the whole robot at `q[k]` (m; zero for the planar
+    /// model).
     pub com: [f64; 3],
     /// Newton iterations of this step (every state trial and substep).
     pub newton_iterations: usize,
@@ -79,23 +104,47 @@ pub struct RobotRecord {
     pub state_trials: usize,
 }
 
+/// Where the planar model's root coordinates `(Rx, Ry, φz)` are in a
+/// record's `q` (`(Rx, Ry, Rz, φx, φy, φz)`, then the joints).
+pub const PLANE_ROOT: [usize; 3] = [0, 1, 5];
+
+/// Where the planar model's coordinate `i` (`Rx, Ry, φz`, then its joints)
+/// is in a record's `q`.
+pub const fn plane_q_index(i: usize) -> usize {
+    if i < 3 { PLANE_ROOT[i] } else { i + 3 }
+}
+
 impl RobotRecord {
     /// A record sized for `mech` at `q0` (every value zero).
     pub fn new(mech: &TreeMechanism, q0: &[f64]) -> Self {
-        let nj = mech.model.joints.len();
-        let nr = mech.reactions.len();
+        let mut r = Self::sized(
+            q0.len(),
+            mech.contacts.len(),
+            mech.reactions.len(),
+            mech.model.joints.len(),
+        );
+        r.q.copy_from_slice(q0);
+        r
+    }
+
+    /// A record of `nq` coordinates, `contacts` contact points,
+    /// `reactions` reactions and `joints` joints, every value zero (states
+    /// ST1, limits free).
+    pub fn sized(nq: usize, contacts: usize, reactions: usize, joints: usize) -> Self {
+        let (nr, nj) = (reactions, joints);
         Self {
             step: 0,
             t: 0.0,
-            q: q0.to_vec(),
+            q: vec![0.0; nq],
             contacts: vec![
                 RobotContactRow {
                     point: [0.0; 3],
                     state: StateCode::St1,
                     force: [0.0; 3],
                     normal: 0.0,
+                    tangential: [0.0; 2],
                 };
-                mech.contacts.len()
+                contacts
             ],
             reaction_force: vec![[0.0; 3]; nr],
             reaction_moment: vec![[0.0; 3]; nr],
@@ -111,6 +160,37 @@ impl RobotRecord {
             newton_iterations: 0,
             state_trials: 0,
         }
+    }
+
+    /// A record of the planar model with `joints` joints and `contacts`
+    /// contact points (its plane embedded: `q` of `6 + joints`
+    /// coordinates, one reaction per joint), every value zero.
+    pub fn planar(contacts: usize, joints: usize) -> Self {
+        Self::sized(6 + joints, contacts, joints, joints)
+    }
+
+    /// The planar model's coordinates of this record's `q`: `(Rx, Ry, φz)`
+    /// then its joints (the inverse of [`Self::set_plane_q`]).
+    pub fn plane_q(&self) -> Vec<f64> {
+        let mut q = Vec::with_capacity(self.q.len().saturating_sub(3));
+        self.plane_q_into(&mut q);
+        q
+    }
+
+    /// [`Self::plane_q`] into `out` (cleared first; no allocation once it
+    /// has the room).
+    pub fn plane_q_into(&self, out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(PLANE_ROOT.iter().map(|&i| self.q[i]));
+        out.extend_from_slice(&self.q[6..]);
+    }
+
+    /// Sets `q` from the planar model's coordinates `plane` (`Rx, Ry, φz`,
+    /// then its joints): `(Rx, Ry, 0, 0, 0, φz)`, then the joints.
+    #[inline]
+    pub fn set_plane_q(&mut self, plane: &[f64]) {
+        self.q[..6].copy_from_slice(&[plane[0], plane[1], 0.0, 0.0, 0.0, plane[2]]);
+        self.q[6..].copy_from_slice(&plane[3..]);
     }
 }
 
@@ -152,7 +232,9 @@ pub fn make_record<M>(
     rec.newton_iterations = newton_iterations;
     rec.state_trials = state_trials;
     for (c, row) in rec.contacts.iter_mut().enumerate() {
-        (row.point, row.force, row.normal) = contact_force(mech, fbd, z, c);
+        let local;
+        (row.point, row.force, local) = contact_force(mech, fbd, z, c);
+        (row.normal, row.tangential) = (local[1], [local[0], local[2]]);
         row.state = data.trial[c].code();
     }
     rec.torque.copy_from_slice(&fbd.torque);
@@ -184,15 +266,15 @@ pub fn make_record<M>(
 }
 
 /// Contact point `c` at `q[k]` (where it touches the ground), and the
-/// ground's force on it (inertial) with its normal component, from the
-/// solution `z`.
+/// ground's force on it: inertial, and its components along the contact
+/// frame `(t1, n, t2)`, from the solution `z`.
 #[inline]
 pub fn contact_force(
     mech: &TreeMechanism,
     fbd: &TreeFbdData,
     z: &[f64],
     c: usize,
-) -> ([f64; 3], [f64; 3], f64) {
+) -> ([f64; 3], [f64; 3], [f64; 3]) {
     let dims = mech.dims();
     let p = fbd.kin.contact[mech.contacts[c].model_contact];
     let fl = [
@@ -204,7 +286,7 @@ pub fn contact_force(
     (
         [p.x, p.y, p.z],
         std::array::from_fn(|i| fl[0] * t1[i] + fl[1] * n[i] + fl[2] * t2[i]),
-        fl[1],
+        fl,
     )
 }
 

@@ -26,7 +26,7 @@ mod params;
 mod plant;
 mod step;
 
-pub use crate::engine::tree_record::{RobotContactRow, RobotRecord};
+pub use crate::engine::tree_record::{PLANE_ROOT, RobotContactRow, RobotRecord, plane_q_index};
 pub use control::{GaitWork, JointTrajectory, RobotControl, joint_rates};
 pub use data::RobotData;
 pub use model::{RobotSim, mass_matrix};

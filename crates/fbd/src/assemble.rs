@@ -176,7 +176,7 @@ impl FbdData {
             terms: StepTerms::new(
                 mech.chains.new_data(),
                 mech.layout().nq,
-                mech.bodies.len(),
+                (mech.bodies.iter().map(|b| b.mass).collect(), mech.gravity),
                 mech.contacts.len(),
                 mech.limits.len(),
                 mech.joints.len(),
@@ -266,16 +266,6 @@ impl FbdModel for Mechanism {
 
     fn dims(&self) -> Dims {
         self.layout().dims()
-    }
-
-    #[inline]
-    fn gravity(&self) -> f64 {
-        self.gravity
-    }
-
-    #[inline]
-    fn mass(&self, b: usize) -> f64 {
-        self.bodies[b].mass
     }
 
     #[inline]

@@ -107,6 +107,10 @@ pub struct StepTerms<S: Space, K, C> {
     pub contact: Vec<C>,
     /// Per body, the constants of this step.
     pub body: Vec<BodyStep<S>>,
+    /// Per body, its mass (kg): the model's, copied here once.
+    pub mass: Vec<f64>,
+    /// Gravity (m/s², along −y): the model's.
+    pub gravity: f64,
     /// Per stop (the model's order of its limits), its equation.
     pub limit: Vec<LimitEquation>,
     /// Actuator torque of every joint at k (N·m), positive towards larger
@@ -132,23 +136,26 @@ pub struct StepTerms<S: Space, K, C> {
 }
 
 impl<S: Space, K: Clone, C: Clone + Default> StepTerms<S, K, C> {
-    /// Terms at the kinematics `kin` for `nq` coordinates, `bodies`
-    /// bodies, `contacts` contact points, `limits` stops and `joints`
-    /// joints.
+    /// Terms at the kinematics `kin` for `nq` coordinates, bodies of
+    /// masses `mass` under `gravity`, `contacts` contact points, `limits`
+    /// stops and `joints` joints.
     pub fn new(
         kin: K,
         nq: usize,
-        bodies: usize,
+        (mass, gravity): (Vec<f64>, f64),
         contacts: usize,
         limits: usize,
         joints: usize,
     ) -> Self {
+        let bodies = mass.len();
         Self {
             kin_prev: kin.clone(),
             kin_next: kin.clone(),
             kin,
             contact: vec![C::default(); contacts],
             body: vec![BodyStep::default(); bodies],
+            mass,
+            gravity,
             limit: vec![LimitEquation::default(); limits],
             torque: vec![0.0; joints],
             dt: 0.0,
@@ -367,10 +374,6 @@ pub trait FbdModel {
 
     /// The layout of unknowns and equations.
     fn dims(&self) -> Dims;
-    /// Gravity (m/s², along −y).
-    fn gravity(&self) -> f64;
-    /// Mass of body `b` (kg).
-    fn mass(&self, b: usize) -> f64;
     /// The sign/projection `P` of body `b`'s rotation rows (the planar
     /// versor, ±1; 1 in space).
     fn rotation_projection(&self, b: usize) -> f64;
@@ -567,9 +570,12 @@ pub fn pattern<M: FbdModel>(
 
 /// Stage 2: every body's wrench at `k`.
 fn loads<M: FbdModel>(model: &M, dims: &Dims, data: &mut M::Data, z: &[f64]) {
-    for (b, w) in model.wrenches(data).iter_mut().enumerate() {
+    let gravity = data.gravity;
+    for b in 0..dims.bodies {
+        let mass = data.mass[b];
+        let w = &mut model.wrenches(data)[b];
         *w = Wrench::default();
-        w.force.as_mut()[1] = -model.mass(b) * model.gravity();
+        w.force.as_mut()[1] = -mass * gravity;
     }
     for i in 0..model.reactions() {
         let re = model.reaction(data, i);
@@ -632,7 +638,7 @@ fn body_rows<M: FbdModel>(
         let rate = model.angular_rate(data, b, jacobian);
         let x = model.com_next(data, b);
         let bs = *model.body_step(data, b);
-        let mass = model.mass(b);
+        let mass = data.mass[b];
         let row = dims.body_row(b);
         let w = model.wrenches(data)[b];
         let (lin, ang) = r[row..row + M::S::LIN + M::S::ANG].split_at_mut(M::S::LIN);
@@ -877,7 +883,7 @@ fn position_entries<M: FbdModel, J: JacobianSink>(
     let dt2 = dt * dt;
     for b in 0..dims.bodies {
         let row = dims.body_row(b);
-        let g = model.mass(b) * model.body_step(data, b).c_next / dt2;
+        let g = data.mass[b] * model.body_step(data, b).c_next / dt2;
         model.com_columns(data, b, |i, v| {
             for a in 0..lin {
                 jac.add(row + a, i, g * v.as_ref()[a]);

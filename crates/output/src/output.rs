@@ -244,6 +244,30 @@ pub fn count(n: usize, one: &str, many: &str) -> String {
     format!("{n} {}", if n == 1 { one } else { many })
 }
 
+/// What a run of the paper's models prints before its own figures: every
+/// contact, limit and retry event in time order, one line each
+/// ([`crate::run::event_line`]), then [`solved`].
+pub fn run_report(run: &RunSummary, dt: f64) -> String {
+    let mut text = String::new();
+    let times = StepTimes::new(dt);
+    for (step, t, e) in run_events(run, &times) {
+        text.push_str(&crate::run::event_line(&times.string(step, t), &e));
+        text.push('\n');
+    }
+    text.push_str(&solved(run));
+    text
+}
+
+/// [`solved_line`] of a run.
+pub fn solved(run: &RunSummary) -> String {
+    solved_line(
+        run.error.is_some() || run.interrupted,
+        run.steps,
+        run.newton_iterations,
+        run.wall_seconds,
+    )
+}
+
 /// The closing line every run prints: `solved 101 steps, 214 Newton
 /// iterations, 0.001 s` (or `stopped after …` when the run did not finish).
 pub fn solved_line(stopped: bool, steps: usize, newton_iterations: usize, wall: f64) -> String {
@@ -1126,7 +1150,37 @@ impl Energy {
     }
 }
 
-/// `summary.json`.
+/// What the `summary.json` of every dynamic model says of the run's
+/// extent and its contact points, in this order (the planar model's
+/// [`Summary`] and the tree models' [`crate::tree::summary::TreeSummary`]).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunExtent {
+    /// Time step (s).
+    pub dt: f64,
+    /// Configured duration (s).
+    pub duration: f64,
+    /// Steps the run was to solve (`round(duration/Δt) + 1`).
+    pub steps_planned: usize,
+    /// Every `stride`-th step is in `trajectory.csv`.
+    pub stride: usize,
+    /// Rows of `trajectory.csv`.
+    pub rows_written: usize,
+    /// Contact points of the model, in the order of their columns (e.g.
+    /// `["tip3", "tip4"]`; none in flight).
+    pub contact_points: Vec<String>,
+    /// First change out of `ST1` (to `ST2` or `ST3`) of each foot (s; null
+    /// if it never touched or started in contact): the paper's models' per
+    /// leg (`"leg4"`, its foot), a robot's per contact point.
+    pub first_touchdown: std::collections::BTreeMap<String, Option<f64>>,
+    /// First change into `ST3` of each foot (s; null if none), keyed as
+    /// `first_touchdown`.
+    pub first_slip: std::collections::BTreeMap<String, Option<f64>>,
+    /// Largest normal force `n` and tangential force magnitude `fa` of
+    /// each contact point (N; empty when no step was given).
+    pub peak_contact_force: std::collections::BTreeMap<String, PeakForce>,
+}
+
+/// `summary.json` of the planar model.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Summary {
     /// Status, error and the solver's counters (as every dynamic run).
@@ -1140,24 +1194,10 @@ pub struct Summary {
     pub audit: RunAudit,
     /// `"planar"`.
     pub model: &'static str,
-    /// Time step (s).
-    pub dt: f64,
-    /// Configured duration (s).
-    pub duration: f64,
-    /// Steps the run was to solve.
-    pub steps_planned: usize,
-    /// Every `stride`-th step is in `trajectory.csv`.
-    pub stride: usize,
-    /// Rows of `trajectory.csv`.
-    pub rows_written: usize,
-    /// Contact points of the model, e.g. `["tip3", "tip4"]`.
-    pub contact_points: Vec<String>,
-    /// First ST1 → contact change of each leg's tip (s), e.g. `"leg4"`.
-    pub first_touchdown: std::collections::BTreeMap<String, Option<f64>>,
-    /// First change of each leg's tip into ST3 (s).
-    pub first_slip: std::collections::BTreeMap<String, Option<f64>>,
-    /// Largest contact forces of each contact point.
-    pub peak_contact_force: std::collections::BTreeMap<String, PeakForce>,
+    /// The run's extent and its contact points' figures (the planar
+    /// model's feet by leg, `"leg4"`, and contact points, `"tip4"`).
+    #[serde(flatten)]
+    pub extent: RunExtent,
     /// Largest joint force magnitude of each joint (N).
     pub peak_joint_force: std::collections::BTreeMap<String, f64>,
     /// Largest joint force magnitude of all joints (N).

@@ -31,18 +31,8 @@ use crate::tree::{Plan, Source};
 /// The files of a robot's run, in the order they are written (the plots
 /// only with `[output] plots`, the viewer only with `[output] viewer`;
 /// `trajectory.parquet` instead of `trajectory.csv` with `[output] format
-/// = "parquet"`).
-pub const FILES: [&str; 9] = [
-    "trajectory.csv",
-    "events.csv",
-    "summary.json",
-    "config.toml",
-    "feet.svg",
-    "torques.svg",
-    "body.svg",
-    "energy.svg",
-    "viewer.html",
-];
+/// = "parquet"`): every tree model's ([`crate::tree::FILES`]).
+pub use crate::tree::FILES;
 
 /// `events.csv`'s header for a robot.
 pub const EVENTS_HEADER: &str = "t,point,from,to\n";
@@ -480,12 +470,7 @@ pub fn run_command(
         &mut |_| {},
     )?;
     let s = &run.summary;
-    let text = output::solved_line(
-        s.error.is_some() || s.interrupted,
-        s.steps,
-        s.newton_iterations,
-        s.wall_seconds,
-    );
+    let text = output::solved(s);
     let ending = Ending::of_run(s, &source, None, run.steps_planned, robot.config.time.dt);
     output::conclude(out, text, out_dir, &files, io_error, ending)
 }

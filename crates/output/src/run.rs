@@ -188,15 +188,17 @@ fn summary(
             .collect(),
         audit: output::RunAudit::of(run),
         model: "planar",
-        dt: model.params.dt,
-        duration: model.params.duration,
-        steps_planned: model.steps,
-        stride: model.params.stride,
-        rows_written: rows,
-        contact_points: names.to_vec(),
-        first_touchdown: by_leg(&|e| e.from == StateCode::St1 && e.to != StateCode::St1),
-        first_slip: by_leg(&|e| e.to == StateCode::St3),
-        peak_contact_force: names.iter().cloned().zip(peaks).collect(),
+        extent: output::RunExtent {
+            dt: model.params.dt,
+            duration: model.params.duration,
+            steps_planned: model.steps,
+            stride: model.params.stride,
+            rows_written: rows,
+            contact_points: names.to_vec(),
+            first_touchdown: by_leg(&|e| e.from == StateCode::St1 && e.to != StateCode::St1),
+            first_slip: by_leg(&|e| e.to == StateCode::St3),
+            peak_contact_force: names.iter().cloned().zip(peaks).collect(),
+        },
         peak_joint_force: model
             .mech
             .joints
@@ -440,22 +442,17 @@ pub fn run_command(
         &mut |_| {},
     )?;
 
-    let mut text = String::new();
-    let times = StepTimes::new(summary.dt);
-    for (step, t, e) in output::run_events(&run, &times) {
-        text.push_str(&event_line(&times.string(step, t), &e));
-        text.push('\n');
-    }
-    text.push_str(&output::solved_line(
-        run.error.is_some() || run.interrupted,
-        run.steps,
-        run.newton_iterations,
-        run.wall_seconds,
-    ));
+    let text = output::run_report(&run, summary.extent.dt);
     let advice = match (&config, &run.error) {
         (Config::Planar(p), Some(e)) => p.advice(e),
         _ => None,
     };
-    let ending = Ending::of_run(&run, &source, advice, summary.steps_planned, summary.dt);
+    let ending = Ending::of_run(
+        &run,
+        &source,
+        advice,
+        summary.extent.steps_planned,
+        summary.extent.dt,
+    );
     output::conclude(out, text, out_dir, &files, io_error, ending)
 }

@@ -104,7 +104,7 @@ impl TreeFbdData {
             terms: StepTerms::new(
                 TreeKin::new(&mech.model),
                 mech.nq(),
-                nb,
+                (mech.bodies.iter().map(|b| b.mass).collect(), mech.gravity),
                 nc,
                 nl,
                 mech.model.joints.len(),
@@ -344,16 +344,6 @@ impl FbdModel for TreeMechanism {
 
     fn dims(&self) -> Dims {
         TreeMechanism::dims(self)
-    }
-
-    #[inline]
-    fn gravity(&self) -> f64 {
-        self.gravity
-    }
-
-    #[inline]
-    fn mass(&self, b: usize) -> f64 {
-        self.bodies[b].mass
     }
 
     #[inline]

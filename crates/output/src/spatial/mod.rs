@@ -32,18 +32,9 @@ use crate::viewer::hexapod::{HexapodView, LegValues};
 pub use csv::columns;
 pub use summary::SpatialSummary;
 
-/// The files a dynamic hexapod run writes, in order.
-pub const FILES: [&str; 9] = [
-    "trajectory.csv",
-    "events.csv",
-    "summary.json",
-    "config.toml",
-    "feet.svg",
-    "torques.svg",
-    "body.svg",
-    "energy.svg",
-    "viewer.html",
-];
+/// The files a dynamic hexapod run writes, in order: every tree
+/// model's ([`crate::tree::FILES`]).
+pub use crate::tree::FILES;
 
 /// The legs and contact points of a spatial model, as the output files
 /// name them.
@@ -464,18 +455,7 @@ pub fn run_command(
         crate::interrupt::flag(),
         &mut |_| {},
     )?;
-    let mut text = String::new();
-    let times = StepTimes::new(params.dt);
-    for (step, t, e) in output::run_events(&run, &times) {
-        text.push_str(&crate::run::event_line(&times.string(step, t), &e));
-        text.push('\n');
-    }
-    text.push_str(&output::solved_line(
-        run.error.is_some() || run.interrupted,
-        run.steps,
-        run.newton_iterations,
-        run.wall_seconds,
-    ));
+    let mut text = output::run_report(&run, params.dt);
     if let Some(h) = summary.final_height {
         text.push_str(&format!(
             "body moved {} m (x {} m, z {} m), final height {} m\n",
@@ -485,7 +465,7 @@ pub fn run_command(
             output::fixed(h, 4)
         ));
     }
-    let ending = Ending::of_run(&run, source, None, summary.steps_planned, params.dt);
+    let ending = Ending::of_run(&run, source, None, summary.extent.steps_planned, params.dt);
     output::conclude(out, text, out_dir, &files, io_error, ending)
 }
 
@@ -598,17 +578,17 @@ mod tests {
         let events = std::fs::read_to_string(dir.path().join("events.csv")).unwrap();
         assert_eq!(events, "t,leg,from,to,point\n0.005,4,ST1,ST2,tip\n");
         let s = r.summary;
-        assert_eq!(s.rows_written, 6);
+        assert_eq!(s.extent.rows_written, 6);
         assert_eq!(s.head.newton_iterations_per_step.max, 4);
-        assert_eq!(s.first_touchdown["leg4"], Some(0.005));
-        assert_eq!(s.first_touchdown["leg3"], None);
+        assert_eq!(s.extent.first_touchdown["leg4"], Some(0.005));
+        assert_eq!(s.extent.first_touchdown["leg3"], None);
         let peak = &s.peak_actuation[5];
         assert_eq!((peak.leg, peak.joint.as_str()), (Some(4), "theta3"));
         assert_eq!((peak.torque, peak.power), (3.0, 3.0));
         assert_eq!(s.peak_torque_max, 3.0);
         assert_eq!(s.peak_power_max, 4.0);
-        assert_eq!(s.peak_contact_force["tip4"].n, 50.0);
-        assert_eq!(s.peak_contact_force["tip4"].fa, 1.0);
+        assert_eq!(s.extent.peak_contact_force["tip4"].n, 50.0);
+        assert_eq!(s.extent.peak_contact_force["tip4"].fa, 1.0);
         let fall = 0.5 * p.gravity * 0.01f64.powi(2);
         assert!((s.displacement[1] + fall).abs() < 1e-15);
         assert_eq!(s.final_height, Some(0.6 - fall));

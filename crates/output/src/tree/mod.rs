@@ -11,6 +11,23 @@
 //! plots: [`plots`].
 
 pub mod plots;
+
+/// The files a run of a model on the tree equations writes (the hexapod's
+/// dynamic runs and every imported robot's), in order: the plots only
+/// with `[output] plots`, the viewer only with `[output] viewer`,
+/// `trajectory.parquet` instead of `trajectory.csv` with `[output] format
+/// = "parquet"`.
+pub const FILES: [&str; 9] = [
+    "trajectory.csv",
+    "events.csv",
+    "summary.json",
+    "config.toml",
+    "feet.svg",
+    "torques.svg",
+    "body.svg",
+    "energy.svg",
+    "viewer.html",
+];
 pub mod summary;
 
 use fbd_contact::StateCode;

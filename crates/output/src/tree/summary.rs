@@ -17,7 +17,7 @@ use fbd_sim::RunSummary;
 use fbd_sim::robot::RobotRecord;
 use serde::Serialize;
 
-use crate::output::{Energy, PeakForce, RunAudit, RunHead};
+use crate::output::{Energy, PeakForce, RunAudit, RunExtent, RunHead};
 use crate::steptime::StepTimes;
 
 /// The largest actuator torque and power of one joint over the run.
@@ -79,30 +79,10 @@ pub struct TreeSummary<E> {
     /// The hexapod's `run`, `control` and `legs` (absent for a robot).
     #[serde(flatten)]
     pub hexapod: Option<HexapodRun>,
-    /// Time step (s).
-    pub dt: f64,
-    /// Configured duration (s).
-    pub duration: f64,
-    /// Steps the run was to solve (`round(duration/Δt) + 1`).
-    pub steps_planned: usize,
-    /// Every `stride`-th step is in `trajectory.csv`.
-    pub stride: usize,
-    /// Rows of `trajectory.csv`.
-    pub rows_written: usize,
-    /// Contact points of the model, e.g. `["tip1", "knee1", "hip1", …]`
-    /// for the hexapod, a robot's in the order of their columns (none in
-    /// flight).
-    pub contact_points: Vec<String>,
-    /// First change out of `ST1` (to `ST2` or `ST3`) of each foot (s; null
-    /// if it never touched or started in contact): the hexapod's per leg
-    /// (`"leg4"`, its foot), a robot's per contact point.
-    pub first_touchdown: BTreeMap<String, Option<f64>>,
-    /// First change into `ST3` of each foot (s; null if none), keyed as
-    /// `first_touchdown`.
-    pub first_slip: BTreeMap<String, Option<f64>>,
-    /// Largest normal force `n` and tangential force magnitude `fa` of
-    /// each contact point (N; empty when no step was given).
-    pub peak_contact_force: BTreeMap<String, PeakForce>,
+    /// The run's extent and its contact points' figures (the hexapod's
+    /// feet by leg, `"leg4"`; a robot's by contact point).
+    #[serde(flatten)]
+    pub extent: RunExtent,
     /// A robot's largest normal force of any contact point (N; the largest
     /// `n` of `peak_contact_force`, 0 without contact points; absent for
     /// the hexapod).
@@ -361,18 +341,20 @@ impl Collector {
             model: facts.model,
             robot: facts.robot,
             hexapod: facts.hexapod,
-            dt: facts.dt,
-            duration: facts.duration,
-            steps_planned: facts.steps_planned,
-            stride: facts.stride.max(1),
-            rows_written: rows,
-            contact_points: facts.contact_points,
-            first_touchdown,
-            first_slip,
             peak_normal_force: facts
                 .peak_normal_force
                 .then(|| max(&mut peak_contact_force.values().map(|p| p.n))),
-            peak_contact_force,
+            extent: RunExtent {
+                dt: facts.dt,
+                duration: facts.duration,
+                steps_planned: facts.steps_planned,
+                stride: facts.stride.max(1),
+                rows_written: rows,
+                contact_points: facts.contact_points,
+                first_touchdown,
+                first_slip,
+                peak_contact_force,
+            },
             peak_joint_force_max: max(&mut peak_joint_force.values().copied()),
             peak_joint_force,
             peak_torque_max: max(&mut peak_actuation.iter().map(|p| p.torque)),

@@ -166,6 +166,8 @@ pub trait SurfaceEngine:
     fn bumper(&self, c: usize) -> f64;
     /// Total mass (kg).
     fn total_mass(&self) -> f64;
+    /// Gravity (m/s², along −Y).
+    fn gravity(&self) -> f64;
 }
 
 /// `impl SurfaceEngine for $model` of a model on the generic tree
@@ -187,6 +189,9 @@ macro_rules! tree_surface_engine {
             }
             fn total_mass(&self) -> f64 {
                 self.mech.total_mass()
+            }
+            fn gravity(&self) -> f64 {
+                self.mech.gravity
             }
         }
     };
@@ -436,8 +441,7 @@ fn row_scales<M: SurfaceEngine>(model: &M, data: &mut RunData<M>) {
     let lay = model.mech().dims();
     let k = data.fbd.position_gain();
     let extent = data.q[0].abs().max(data.q[1].abs()).max(data.q[2].abs());
-    let force =
-        model.total_mass() * model.mech().gravity().abs().max(1.0) + 1e-6 * k * (1.0 + extent);
+    let force = model.total_mass() * model.gravity().abs().max(1.0) + 1e-6 * k * (1.0 + extent);
     let moment = force * model.length_scale(data);
     let ncp = complementarity(model, data);
     for b in 0..lay.bodies {

@@ -33,19 +33,13 @@ fn summary(dir: &Path) -> serde_json::Value {
     serde_json::from_str(&read(&dir.join("summary.json"))).unwrap()
 }
 
-/// The header and the rows of a trajectory.
+/// The header and the rows of a trajectory without contact states.
 fn table(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = read(&dir.join("trajectory.csv"));
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-        .collect();
+    let (header, rows) = common::trajectory(dir);
+    assert!(
+        rows.iter().flatten().all(|v| !v.is_nan()),
+        "a number in every cell"
+    );
     (header, rows)
 }
 
@@ -373,26 +367,6 @@ fn drop_run(dir: &Path, name: &str, extra: &str) -> std::path::PathBuf {
     out
 }
 
-/// The header and the rows of a trajectory with contact states (as NaN).
-fn table_with_states(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = read(&dir.join("trajectory.csv"));
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
-        .collect();
-    (header, rows)
-}
-
 /// The largest value of `f(row)` over the rows.
 fn peak(rows: &[Vec<f64>], f: impl Fn(&Vec<f64>) -> f64) -> f64 {
     rows.iter().map(f).fold(0.0, f64::max)
@@ -403,7 +377,7 @@ fn a_landing_robots_summary_has_every_figure_of_the_trajectory_and_events() {
     let dir = tempfile::tempdir().unwrap();
     let out = drop_run(dir.path(), "drop", "");
     let sm = summary(&out);
-    let (header, rows) = table_with_states(&out);
+    let (header, rows) = common::trajectory(&out);
     let col = |name: &str| {
         header
             .iter()
@@ -592,7 +566,7 @@ fn a_landing_robots_summary_has_every_figure_of_the_trajectory_and_events() {
         "\n[output]\nstride = 3\nplots = false\n",
     );
     let ss = summary(&strided);
-    let (_, rows3) = table_with_states(&strided);
+    let (_, rows3) = common::trajectory(&strided);
     assert_eq!(ss["rows_written"].as_u64().unwrap() as usize, rows3.len());
     for key in ["first_touchdown", "first_slip", "final_position", "events"] {
         assert_eq!(ss[key], sm[key], "{key}");

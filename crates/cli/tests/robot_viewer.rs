@@ -13,21 +13,11 @@ use fbd_robot::nalgebra::Vector3;
 
 /// `trajectory.csv`: column index by name, rows of numbers (NaN for text).
 fn table(dir: &Path) -> (HashMap<String, usize>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
+    let (header, rows) = common::trajectory(dir);
+    let header = header
+        .into_iter()
         .enumerate()
-        .map(|(i, h)| (h.to_owned(), i))
-        .collect();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
+        .map(|(i, h)| (h, i))
         .collect();
     (header, rows)
 }

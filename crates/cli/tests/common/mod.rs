@@ -80,6 +80,27 @@ pub fn fail_prefix() -> String {
 #[path = "../../../../tests/common/readme.rs"]
 pub mod readme;
 
+/// The header and the rows of `dir/trajectory.csv`, every cell a number
+/// (a contact state, `ST1`–`ST3`, as NaN).
+pub fn trajectory(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    let mut lines = text.lines();
+    let header = lines
+        .next()
+        .unwrap()
+        .split(',')
+        .map(str::to_owned)
+        .collect();
+    let rows = lines
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    (header, rows)
+}
+
 /// The scene JSON embedded in `dir/viewer.html`.
 pub fn scene(dir: &Path) -> serde_json::Value {
     let page = std::fs::read_to_string(dir.join("viewer.html")).unwrap();

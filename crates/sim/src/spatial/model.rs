@@ -414,28 +414,8 @@ const CACHE: usize = 16;
 /// initial rates, output stride.
 fn cache_key(p: &SpatialParams) -> SpatialParams {
     let mut key = p.clone();
-    match &mut key.control {
-        SpatialControl::None => {}
-        SpatialControl::Pd {
-            kp,
-            kd,
-            torque_limit,
-            ..
-        }
-        | SpatialControl::Trajectory {
-            kp,
-            kd,
-            torque_limit,
-            ..
-        }
-        | SpatialControl::Gait {
-            kp,
-            kd,
-            torque_limit,
-            ..
-        } => {
-            (*kp, *kd, *torque_limit) = (0.0, 0.0, None);
-        }
+    if let Some((kp, kd, torque_limit)) = key.control.gains_mut() {
+        (*kp, *kd, *torque_limit) = (0.0, 0.0, None);
     }
     key.friction = Default::default();
     key.contact = Default::default();

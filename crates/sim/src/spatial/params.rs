@@ -58,11 +58,11 @@ pub enum SpatialControl {
     },
 }
 
-impl SpatialControl {
-    /// The controller's gains and torque limit, `(kp, kd, torque_limit)`;
-    /// `None` for passive joints.
-    pub fn gains(&self) -> Option<(f64, f64, Option<f64>)> {
-        match self {
+/// The gains and torque limit of a [`SpatialControl`] place (`&` or
+/// `&mut`), `(kp, kd, torque_limit)`; `None` for passive joints.
+macro_rules! control_gains {
+    ($control:expr) => {
+        match $control {
             SpatialControl::None => None,
             SpatialControl::Pd {
                 kp,
@@ -81,8 +81,21 @@ impl SpatialControl {
                 kd,
                 torque_limit,
                 ..
-            } => Some((*kp, *kd, *torque_limit)),
+            } => Some((kp, kd, torque_limit)),
         }
+    };
+}
+
+impl SpatialControl {
+    /// The controller's gains and torque limit, `(kp, kd, torque_limit)`;
+    /// `None` for passive joints.
+    pub fn gains(&self) -> Option<(f64, f64, Option<f64>)> {
+        control_gains!(self).map(|(kp, kd, limit)| (*kp, *kd, *limit))
+    }
+
+    /// [`Self::gains`] to change in place.
+    pub fn gains_mut(&mut self) -> Option<(&mut f64, &mut f64, &mut Option<f64>)> {
+        control_gains!(self)
     }
 }
 

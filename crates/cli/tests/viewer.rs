@@ -13,17 +13,11 @@ use std::path::Path;
 
 /// `trajectory.csv` as a header index and rows of fields.
 fn csv(dir: &Path) -> (HashMap<String, usize>, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
+    let (header, rows) = common::trajectory_fields(dir);
+    let header = header
+        .into_iter()
         .enumerate()
-        .map(|(i, h)| (h.to_owned(), i))
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(str::to_owned).collect())
+        .map(|(i, h)| (h, i))
         .collect();
     (header, rows)
 }

@@ -80,23 +80,22 @@ pub fn fail_prefix() -> String {
 #[path = "../../../../tests/common/readme.rs"]
 pub mod readme;
 
+/// The header and the rows of fields of `dir/trajectory.csv`.
+pub fn trajectory_fields(dir: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
+    let split = |l: &str| l.split(',').map(str::to_owned).collect::<Vec<_>>();
+    let mut lines = text.lines();
+    let header = split(lines.next().unwrap());
+    (header, lines.map(split).collect())
+}
+
 /// The header and the rows of `dir/trajectory.csv`, every cell a number
 /// (a contact state, `ST1`–`ST3`, as NaN).
 pub fn trajectory(dir: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
-    let text = std::fs::read_to_string(dir.join("trajectory.csv")).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|v| v.parse().unwrap_or(f64::NAN))
-                .collect()
-        })
+    let (header, rows) = trajectory_fields(dir);
+    let rows = rows
+        .iter()
+        .map(|r| r.iter().map(|v| v.parse().unwrap_or(f64::NAN)).collect())
         .collect();
     (header, rows)
 }

@@ -23,7 +23,7 @@
 //!   `a_ij −= l_ik·u_kj` of every `(i, j)` of `L`'s column `k` times `U`'s
 //!   row `k`, whose target slots are one precomputed stream.
 //!
-//! The result is copied into the column-run streams of the
+//! The result is copied into the streams of the
 //! triangular sweeps ([`crate::lu::Factors`]), whose entries are fixed at
 //! compile time too.
 //!
@@ -224,11 +224,9 @@ impl CompiledLu {
             let dense = m * m;
             self.a.reserve(2 * n_slots.min(dense));
             self.l_slots.reserve(2 * n_l.min(dense));
-            self.lower.entries.reserve(2 * n_l.min(dense));
-            self.lower.runs.reserve(m);
+            self.lower.reserve(2 * n_l.min(dense));
             self.u_slots.reserve(2 * n_u.min(dense));
-            self.upper.entries.reserve(2 * n_u.min(dense));
-            self.upper.runs.reserve(m);
+            self.upper.reserve(2 * n_u.min(dense));
             self.updates.reserve(2 * n_upd.min(dense * m));
             self.pivot.reserve(m);
             self.l_ptr.reserve(m + 1);
@@ -237,8 +235,8 @@ impl CompiledLu {
             self.row_perm.reserve(m);
         } else if !grow
             && (n_slots > self.a.capacity()
-                || n_l > self.l_slots.capacity().min(self.lower.entries.capacity())
-                || n_u > self.u_slots.capacity().min(self.upper.entries.capacity())
+                || n_l > self.l_slots.capacity().min(self.lower.capacity())
+                || n_u > self.u_slots.capacity().min(self.upper.capacity())
                 || n_upd > self.updates.capacity())
         {
             return false;
@@ -297,6 +295,8 @@ impl CompiledLu {
                 }
             }
         }
+        self.lower.seal();
+        self.upper.seal();
         self.row_perm.clear();
         self.row_perm.extend_from_slice(row_perm);
         self.a.clear();

@@ -126,31 +126,58 @@ pub(crate) struct CompiledLu {
     /// The backward sweep's stream of slots, `U`'s columns last first,
     /// entries above the diagonal.
     pub(crate) upper: Stream<u32>,
-    /// Scratch of [`Self::compile`] and [`Self::choose_rows`], released
-    /// after the compilation.
-    scratch: Scratch,
 }
 
-/// Scratch of [`CompiledLu::compile`].
-#[derive(Clone, Default)]
-struct Scratch {
+/// Scratch of [`CompiledLu::choose_rows`] and [`CompiledLu::compile`],
+/// kept between compilations (one per solver, grown to the largest
+/// dimension `m` met): dense `m × m` arrays, restored after each use at the
+/// entries it set (the filled structure, not `m²`), and the structure's
+/// rows and columns as lists. About `13·m²` bytes (240 kB at `m = 135`)
+/// plus the lists (at most `8·m²` bytes, a dense factor's).
+#[derive(Default)]
+pub(crate) struct CompileScratch {
+    /// [`CompiledLu::choose_rows`]: the dense elimination's values, `0.0`
+    /// outside the structure between uses.
+    dense: Vec<f64>,
+    /// [`CompiledLu::choose_rows`]: the structure, `false` outside it
+    /// between uses.
+    nz: Vec<bool>,
+    /// [`CompiledLu::compile`]: the slot of each position of `P·A·Q`,
+    /// `u32::MAX` outside the structure between uses.
+    slot: Vec<u32>,
+    /// The structure's columns of each row and rows of each column (as
+    /// filled, unsorted; a row's and a column's are sorted once final).
+    row_list: Vec<Vec<u32>>,
+    col_list: Vec<Vec<u32>>,
+    /// [`CompiledLu::compile`]: pivot positions of rows and columns; each
+    /// pivot's first entry below (right of) the diagonal in its column's
+    /// (row's) list.
     row_pos: Vec<usize>,
     col_pos: Vec<usize>,
-    nz: Vec<bool>,
-    slot: Vec<u32>,
+    splits: Vec<(u32, u32)>,
+    /// [`CompiledLu::choose_rows`]: the rows left in the current column,
+    /// the pivot row's columns right of it, the rows taken, the order.
     rows: Vec<usize>,
-    cols: Vec<usize>,
-    /// [`CompiledLu::compile`]: the ends of each pivot's rows of `L` and
-    /// columns of `U` in `rows` and `cols` (all pivots').
-    ends: Vec<(usize, usize)>,
-    /// [`CompiledLu::choose_rows`]: the dense elimination, the rows
-    /// taken, the order.
-    dense: Vec<f64>,
+    cols: Vec<u32>,
     used: Vec<bool>,
     order: Vec<usize>,
     /// Entries of each row right of the current column (the Markowitz
     /// row count).
     count: Vec<usize>,
+}
+
+impl CompileScratch {
+    /// Empty structure lists for dimension `m`.
+    fn lists(&mut self, m: usize) {
+        for lists in [&mut self.row_list, &mut self.col_list] {
+            if lists.len() < m {
+                lists.resize_with(m, Vec::new);
+            }
+            for l in &mut lists[..m] {
+                l.clear();
+            }
+        }
+    }
 }
 
 /// A pivot failed its check: factor with faer instead.
@@ -161,12 +188,18 @@ impl CompiledLu {
     /// Compiles the LU of the `m × m` reduced structure (`col_ptr`,
     /// `row_idx`, CSC) with column order `fwd` (ordered position →
     /// column) and row order `row_perm` (pivot position → row), reusing
-    /// this value's storage. The first compilation allocates, with room
-    /// for programs of twice its size; a later one (a fallback's new row
-    /// order) only when `grow`, else it returns `false` and leaves the
-    /// program as it was when the new one does not fit.
+    /// this value's storage and the scratch `sc`. The first compilation
+    /// allocates, with room for programs of twice its size; a later one (a
+    /// fallback's new row order) only when `grow`, else it returns `false`
+    /// and leaves the program as it was when the new one does not fit.
+    ///
+    /// The symbolic elimination visits the structure only (each pivot's
+    /// column and row, sorted once final, and the fill they make), not the
+    /// `m²` positions: 0.8 M → 0.2 M instructions a compilation on
+    /// `bench/peer/hexapod_drop.toml` (reduced dimensions 50–135).
     pub(crate) fn compile(
         &mut self,
+        sc: &mut CompileScratch,
         col_ptr: &[usize],
         row_idx: &[usize],
         fwd: &[usize],
@@ -176,49 +209,108 @@ impl CompiledLu {
         let m = fwd.len();
         assert!(u32::try_from(m * m).is_ok(), "dimension {m} beyond u32");
         let first = !self.is_compiled() || self.m != m;
-        let sc = &mut self.scratch;
+        if sc.slot.len() < m * m {
+            sc.slot.resize(m * m, u32::MAX);
+        }
+        sc.lists(m);
         sc.row_pos.resize(m, 0);
         sc.col_pos.resize(m, 0);
-        sc.nz.clear();
-        sc.nz.resize(m * m, false);
-        sc.slot.resize(m * m, u32::MAX);
-        sc.rows.reserve(m);
-        sc.cols.reserve(m);
         for (i, &r) in row_perm.iter().enumerate() {
             sc.row_pos[r] = i;
         }
         for (c, &j) in fwd.iter().enumerate() {
             sc.col_pos[j] = c;
         }
-        // Symbolic elimination on a dense boolean matrix of P·A·Q, and the
-        // program's sizes.
-        let nz = &mut sc.nz;
-        for j in 0..m {
-            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                nz[sc.row_pos[r] * m + sc.col_pos[j]] = true;
+        let fits = self.compile_with(sc, m, col_ptr, row_idx, first, grow);
+        // The slot map back to `u32::MAX` where it was set: the
+        // structure, every position of it in its row's list.
+        for (i, row) in sc.row_list[..m].iter().enumerate() {
+            for &j in row {
+                sc.slot[i * m + j as usize] = u32::MAX;
             }
         }
-        let mut n_upd = 0;
-        // Each pivot's rows and columns are final when it is reached
-        // (only earlier pivots fill them): kept for the program below.
-        sc.rows.clear();
-        sc.cols.clear();
-        sc.ends.clear();
+        if fits {
+            self.row_perm.clear();
+            self.row_perm.extend_from_slice(row_perm);
+        }
+        fits
+    }
+
+    /// [`Self::compile`] once the scratch holds the pivot positions of the
+    /// rows and columns and empty lists.
+    fn compile_with(
+        &mut self,
+        sc: &mut CompileScratch,
+        m: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        first: bool,
+        grow: bool,
+    ) -> bool {
+        /// A position of the fill, before its slot is known.
+        const FILL: u32 = u32::MAX - 1;
+        let slot = &mut sc.slot;
+        // The values' slots, in their CSC order (a factorisation copies
+        // them in one block), and the structure of P·A·Q.
+        let mut slots = 0u32;
+        for j in 0..m {
+            let c = sc.col_pos[j];
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                let i = sc.row_pos[r];
+                slot[i * m + c] = slots;
+                slots += 1;
+                sc.row_list[i].push(c as u32);
+                sc.col_list[c].push(i as u32);
+            }
+        }
+        self.values = slots as usize;
+        // Symbolic elimination, pivot after pivot: pivot `k`'s column and
+        // row are final when it is reached (only earlier pivots fill
+        // them), and stay so. Its rows of `L` (below the diagonal) times
+        // its columns of `U` (right of it) fill the positions not yet in
+        // the structure.
+        let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
+        sc.splits.clear();
         for k in 0..m {
-            let (r0, c0) = (sc.rows.len(), sc.cols.len());
-            sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
-            sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
-            let (rows, cols) = (&sc.rows[r0..], &sc.cols[c0..]);
+            let (col_head, col_tail) = sc.col_list.split_at_mut(k + 1);
+            let (row_head, row_tail) = sc.row_list.split_at_mut(k + 1);
+            let (col, row) = (&mut col_head[k], &mut row_head[k]);
+            col.sort_unstable();
+            row.sort_unstable();
+            let r0 = col.partition_point(|&i| i as usize <= k);
+            let c0 = row.partition_point(|&j| j as usize <= k);
+            let (rows, cols) = (&col[r0..], &row[c0..]);
             for &i in rows {
+                let (target, fill_row) = (
+                    &mut slot[i as usize * m..],
+                    &mut row_tail[i as usize - k - 1],
+                );
                 for &j in cols {
-                    nz[i * m + j] = true;
+                    let s = &mut target[j as usize];
+                    if *s == u32::MAX {
+                        *s = FILL;
+                        fill_row.push(j);
+                        col_tail[j as usize - k - 1].push(i);
+                    }
                 }
             }
+            n_l += rows.len();
+            n_u += cols.len();
             n_upd += rows.len() * cols.len();
-            sc.ends.push((sc.rows.len(), sc.cols.len()));
+            sc.splits.push((r0 as u32, c0 as u32));
         }
-        let (n_l, n_u) = (sc.rows.len(), sc.cols.len());
-        let n_slots = nz.iter().filter(|&&z| z).count();
+        // The fill's slots after the values', row-major (each row's list
+        // sorted).
+        for (i, row) in sc.row_list[..m].iter().enumerate() {
+            for &j in row {
+                let s = &mut slot[i * m + j as usize];
+                if *s == FILL {
+                    *s = slots;
+                    slots += 1;
+                }
+            }
+        }
+        let n_slots = slots as usize;
         if first {
             // Room for a later row order's program of up to twice the size.
             let dense = m * m;
@@ -244,26 +336,7 @@ impl CompiledLu {
             return false;
         }
         self.m = m;
-        // Slots: the values' in their CSC order (a factorisation copies
-        // them in one block), then the fill-in's, row-major.
-        let slot = &mut sc.slot;
-        slot.clear();
-        slot.resize(m * m, u32::MAX);
-        let mut slots = 0u32;
-        for j in 0..m {
-            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                slot[sc.row_pos[r] * m + sc.col_pos[j]] = slots;
-                slots += 1;
-            }
-        }
-        self.values = slots as usize;
-        for (s, &z) in slot.iter_mut().zip(nz.iter()) {
-            if z && *s == u32::MAX {
-                *s = slots;
-                slots += 1;
-            }
-        }
-        self.slots = slots as usize;
+        self.slots = n_slots;
         self.pivot.clear();
         self.l_ptr.clear();
         self.l_slots.clear();
@@ -273,40 +346,39 @@ impl CompiledLu {
         self.l_ptr.push(0);
         self.u_ptr.push(0);
         self.lower.clear();
-        let (mut r0, mut c0) = (0, 0);
-        for (k, &(r1, c1)) in sc.ends.iter().enumerate() {
+        for (k, &(r0, c0)) in sc.splits.iter().enumerate() {
             // A structurally zero pivot gets no slot: it never verifies,
             // faer reports the singularity.
             self.pivot.push(slot[k * m + k]);
-            let (rows, cols) = (&sc.rows[r0..r1], &sc.cols[c0..c1]);
-            (r0, c0) = (r1, c1);
-            self.l_slots.extend(rows.iter().map(|&i| slot[i * m + k]));
-            self.u_slots.extend(cols.iter().map(|&j| slot[k * m + j]));
+            let rows = &sc.col_list[k][r0 as usize..];
+            let cols = &sc.row_list[k][c0 as usize..];
+            self.l_slots
+                .extend(rows.iter().map(|&i| slot[i as usize * m + k]));
+            let pivot_row = &slot[k * m..(k + 1) * m];
+            self.u_slots
+                .extend(cols.iter().map(|&j| pivot_row[j as usize]));
             for &i in rows {
-                self.updates.extend(cols.iter().map(|&j| slot[i * m + j]));
-                self.lower.push(i as u32, k as u32, slot[i * m + k]);
+                let target = &slot[i as usize * m..(i as usize + 1) * m];
+                self.updates
+                    .extend(cols.iter().map(|&j| target[j as usize]));
+                self.lower.push(i, k as u32, target[k]);
             }
             self.l_ptr.push(self.l_slots.len() as u32);
             self.u_ptr.push(self.u_slots.len() as u32);
         }
+        // `U` above the diagonal, last column first, each column's rows in
+        // order (its sorted list up to the diagonal).
         self.upper.clear();
         for j in (0..m).rev() {
-            for i in 0..j {
-                if nz[i * m + j] {
-                    self.upper.push(i as u32, j as u32, slot[i * m + j]);
-                }
+            for &i in sc.col_list[j].iter().take_while(|&&i| (i as usize) < j) {
+                self.upper.push(i, j as u32, slot[i as usize * m + j]);
             }
         }
-        self.row_perm.clear();
-        self.row_perm.extend_from_slice(row_perm);
         self.a.clear();
         self.a.resize(self.slots, 0.0);
         let widest = self.u_ptr.windows(2).map(|p| p[1] - p[0]).max();
         self.u_row.clear();
         self.u_row.resize(widest.unwrap_or(0) as usize, 0.0);
-        // The scratch (dense m × m arrays) is not needed again: a pattern
-        // is compiled once.
-        self.scratch = Scratch::default();
         true
     }
 
@@ -315,24 +387,49 @@ impl CompiledLu {
     /// order `fwd`: at each column, among the rows whose entry is at least
     /// [`ROW_CHOICE_THRESHOLD`] of the column's largest, the one with the
     /// fewest entries right of the column (the least fill; ties to the
-    /// larger entry). An elimination of the first values on dense arrays
-    /// that visits only the pivot rows' and columns' entries (the LU's own
-    /// updates, kept rows counted as they fill), once per compilation. `None` when a column has no usable entry (faer's order
-    /// is then used). Writes the order into `order`; allocation-free once
-    /// the scratch has this dimension.
-    pub(crate) fn choose_rows(
-        &mut self,
+    /// larger entry, then to the first row). An elimination of the first
+    /// values on the dense arrays of the scratch `sc` that visits only the
+    /// structure (each column's rows from its list, sorted once final, the
+    /// pivot row's columns, the LU's own updates; kept rows counted as they
+    /// fill), once per compilation. `None` when a column has no usable
+    /// entry (faer's order is then used). Writes the order into the
+    /// scratch; allocation-free once the scratch has this dimension and
+    /// its lists their length.
+    pub(crate) fn choose_rows<'s>(
+        sc: &'s mut CompileScratch,
         col_ptr: &[usize],
         row_idx: &[usize],
         fwd: &[usize],
         values: &[f64],
-    ) -> Option<&[usize]> {
+    ) -> Option<&'s [usize]> {
         let m = fwd.len();
-        let sc = &mut self.scratch;
-        sc.dense.clear();
-        sc.dense.resize(m * m, 0.0);
-        sc.nz.clear();
-        sc.nz.resize(m * m, false);
+        if sc.dense.len() < m * m {
+            sc.dense.resize(m * m, 0.0);
+            sc.nz.resize(m * m, false);
+        }
+        sc.lists(m);
+        let found = Self::eliminate(sc, col_ptr, row_idx, fwd, values);
+        // The dense arrays back to zero where they were set: the structure,
+        // every position of it in its row's list.
+        for (r, row) in sc.row_list[..m].iter().enumerate() {
+            for &c in row {
+                sc.dense[r * m + c as usize] = 0.0;
+                sc.nz[r * m + c as usize] = false;
+            }
+        }
+        found.then_some(&sc.order[..])
+    }
+
+    /// The elimination of [`Self::choose_rows`] into `sc.order`; `false`
+    /// when a column has no usable entry.
+    fn eliminate(
+        sc: &mut CompileScratch,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        values: &[f64],
+    ) -> bool {
+        let m = fwd.len();
         sc.used.clear();
         sc.used.resize(m, false);
         sc.order.clear();
@@ -348,22 +445,29 @@ impl CompiledLu {
                 d[r * m + c] = v;
                 nz[r * m + c] = true;
                 count[r] += 1;
+                sc.row_list[r].push(c as u32);
+                sc.col_list[c].push(r as u32);
             }
         }
         for k in 0..m {
-            // The rows left with an entry in column k; `count` becomes
-            // each row's entries right of it.
+            // The rows left with an entry in column k, in order (the
+            // column's list is final: only earlier pivots fill it);
+            // `count` becomes each row's entries right of it.
+            let (col_head, col_tail) = sc.col_list.split_at_mut(k + 1);
+            let col = &mut col_head[k];
+            col.sort_unstable();
             sc.rows.clear();
             let mut column = 0.0f64;
-            for r in 0..m {
-                if !sc.used[r] && nz[r * m + k] {
+            for &r in col.iter() {
+                let r = r as usize;
+                if !sc.used[r] {
                     sc.rows.push(r);
                     count[r] -= 1;
                     column = column.max(d[r * m + k].abs());
                 }
             }
             if !(column > 0.0 && column.is_finite()) {
-                return None;
+                return false;
             }
             let mut best: Option<(usize, usize, f64)> = None;
             for &r in &sc.rows {
@@ -376,11 +480,16 @@ impl CompiledLu {
                     best = Some((r, c, v));
                 }
             }
-            let (p, _, _) = best?;
+            let Some((p, _, _)) = best else {
+                return false;
+            };
             sc.used[p] = true;
             sc.order.push(p);
+            // The pivot row's columns right of k, in any order (each
+            // update of a row touches another entry).
             sc.cols.clear();
-            sc.cols.extend((k + 1..m).filter(|&j| nz[p * m + j]));
+            sc.cols
+                .extend(sc.row_list[p].iter().filter(|&&j| j as usize > k));
             let inv = d[p * m + k].recip();
             for &i in &sc.rows {
                 if i == p {
@@ -388,15 +497,18 @@ impl CompiledLu {
                 }
                 let l = d[i * m + k] * inv;
                 for &j in &sc.cols {
+                    let j = j as usize;
                     d[i * m + j] -= l * d[p * m + j];
                     if !nz[i * m + j] {
                         nz[i * m + j] = true;
                         count[i] += 1;
+                        sc.row_list[i].push(j as u32);
+                        col_tail[j - k - 1].push(i as u32);
                     }
                 }
             }
         }
-        Some(&self.scratch.order)
+        true
     }
 
     /// Whether a program has been compiled.

@@ -106,7 +106,7 @@ use faer::sparse::linalg::lu::{LuSymbolicParams, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 use crate::SolverError;
-use crate::compiled::{CompiledLu, MAX_PERTURBED};
+use crate::compiled::{CompileScratch, CompiledLu, MAX_PERTURBED};
 
 /// Which path a factorisation took (see [`crate::compiled`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -512,11 +512,18 @@ impl Factors {
     /// of faer's factorisation of these values just made when `faer_rows`,
     /// else nothing is compiled. Allocates, as a pattern's registration
     /// does.
-    fn add_program(&mut self, pattern: &mut Pattern, reduced: &[f64], zeros: u64, faer_rows: bool) {
+    fn add_program(
+        &mut self,
+        sc: &mut CompileScratch,
+        pattern: &mut Pattern,
+        reduced: &[f64],
+        zeros: u64,
+        faer_rows: bool,
+    ) {
         let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
         let fwd = pattern.col_perm.arrays().0;
         let mut program = CompiledLu::default();
-        let rows = match program.choose_rows(col_ptr, row_idx, fwd, reduced) {
+        let rows = match CompiledLu::choose_rows(sc, col_ptr, row_idx, fwd, reduced) {
             Some(order) => {
                 self.row_choice.clear();
                 self.row_choice.extend_from_slice(order);
@@ -525,7 +532,7 @@ impl Factors {
             None if faer_rows => &self.row_perm,
             None => return,
         };
-        program.compile(col_ptr, row_idx, fwd, rows, true);
+        program.compile(sc, col_ptr, row_idx, fwd, rows, true);
         pattern.programs.push((zeros, program));
     }
 
@@ -587,7 +594,10 @@ impl Factors {
 
     /// Numeric LU of `values` (the layout of `pattern`'s slots), reusing its
     /// column ordering; the eliminated rows' pivots and columns are copied
-    /// into `pattern`. `mem` must hold [`Self::scratch`]. Allocation-free.
+    /// into `pattern`. `mem` must hold [`Self::scratch`]; `sc` is the
+    /// scratch of a compilation (the pattern's first factorisation with
+    /// `compiled`, or a set of exact zeros' second fallback, which allocate
+    /// the program). Allocation-free otherwise.
     ///
     /// # Errors
     /// [`SolverError::Singular`] when faer finds no structurally non-zero
@@ -598,6 +608,7 @@ impl Factors {
         pattern: &mut Pattern,
         values: &[f64],
         mem: &mut MemBuffer,
+        sc: &mut CompileScratch,
         compiled: bool,
     ) -> Result<FactorPath, SolverError> {
         let n = self.n;
@@ -621,7 +632,7 @@ impl Factors {
         if compiled && n > 0 && pattern.programs.is_empty() {
             // The pattern's first program, before any factorisation; where
             // the row choice finds no pivot, faer's LU below and its rows.
-            self.add_program(pattern, reduced, zeros, false);
+            self.add_program(sc, pattern, reduced, zeros, false);
         }
         let known = pattern.programs.iter().position(|(z, _)| *z == zeros);
         if compiled && n > 0 && !pattern.programs.is_empty() {
@@ -754,7 +765,7 @@ impl Factors {
                 // mostly a passing cancellation; recompiling on such values
                 // was measured dearer, 1.6 M instructions a time on the
                 // hexapod walk).
-                self.add_program(pattern, reduced, zeros, true);
+                self.add_program(sc, pattern, reduced, zeros, true);
             }
         }
         self.owner = Some(pattern.id);
@@ -1142,7 +1153,13 @@ mod tests {
                 ));
             let mut factors = Factors::new(pattern.m);
             factors
-                .factor(&mut pattern, &values, &mut mem, false)
+                .factor(
+                    &mut pattern,
+                    &values,
+                    &mut mem,
+                    &mut CompileScratch::default(),
+                    false,
+                )
                 .expect("nonsingular");
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
             let mut ours = b.clone();
@@ -1194,7 +1211,13 @@ mod tests {
         compiled: bool,
     ) -> (Vec<f64>, FactorPath) {
         let path = factors
-            .factor(pattern, values, mem, compiled)
+            .factor(
+                pattern,
+                values,
+                mem,
+                &mut CompileScratch::default(),
+                compiled,
+            )
             .expect("nonsingular");
         let mut x = b.to_vec();
         factors.solve(pattern, &mut x);
@@ -1457,7 +1480,13 @@ mod tests {
         let mut mem = MemBuffer::new(Factors::scratch(1));
         let mut factors = Factors::new(0);
         factors
-            .factor(&mut pattern, &values, &mut mem, false)
+            .factor(
+                &mut pattern,
+                &values,
+                &mut mem,
+                &mut CompileScratch::default(),
+                false,
+            )
             .unwrap();
         let mut x = vec![1.0, 2.0, 3.0, 4.0];
         factors.solve(&mut pattern, &mut x);

@@ -14,6 +14,7 @@
 
 use faer::dyn_stack::{MemBuffer, StackReq};
 
+use crate::compiled::CompileScratch;
 use crate::lu::{FactorPath, Factors, Pattern};
 use crate::{JacobianSink, NewtonSystem, SolverError};
 
@@ -172,6 +173,9 @@ struct Workspace {
     r_trial: Vec<f64>,
     mem: MemBuffer,
     mem_req: StackReq,
+    /// Scratch of the compiled LU's compilations (grown to the largest
+    /// reduced dimension compiled, see `CompileScratch`).
+    compile: CompileScratch,
     numeric_factorizations: u64,
     /// Factorisations by the compiled LU.
     compiled_factorizations: u64,
@@ -183,8 +187,10 @@ struct Workspace {
 }
 
 impl Clone for Workspace {
-    /// The buffers' values (scratch; overwritten before use) and a fresh
-    /// scratch arena of the same size (faer's `MemBuffer` is not `Clone`).
+    /// The buffers' values (scratch; overwritten before use), a fresh
+    /// scratch arena of the same size (faer's `MemBuffer` is not `Clone`)
+    /// and an empty compilation scratch (grown by the clone's first
+    /// compilation, which allocates its program anyway).
     fn clone(&self) -> Self {
         Self {
             values: self.values.clone(),
@@ -194,6 +200,7 @@ impl Clone for Workspace {
             r_trial: self.r_trial.clone(),
             mem: MemBuffer::new(self.mem_req),
             mem_req: self.mem_req,
+            compile: CompileScratch::default(),
             numeric_factorizations: self.numeric_factorizations,
             compiled_factorizations: self.compiled_factorizations,
             lu_fallbacks: self.lu_fallbacks,
@@ -275,6 +282,7 @@ impl NewtonSolver {
                 r_trial: Vec::new(),
                 mem: MemBuffer::new(StackReq::EMPTY),
                 mem_req: StackReq::EMPTY,
+                compile: CompileScratch::default(),
                 numeric_factorizations: 0,
                 compiled_factorizations: 0,
                 lu_fallbacks: 0,
@@ -527,6 +535,7 @@ impl NewtonSolver {
             pattern,
             &self.ws.values,
             &mut self.ws.mem,
+            &mut self.ws.compile,
             self.params.compiled_lu,
         )?;
         if let Some(dx) = dx {
@@ -755,7 +764,13 @@ impl Workspace {
                 return Err(SolverError::NonFinite { iter: full });
             }
             negate(&mut self.dx, &self.r);
-            let fp = factors.factor(pattern, &self.values, &mut self.mem, params.compiled_lu)?;
+            let fp = factors.factor(
+                pattern,
+                &self.values,
+                &mut self.mem,
+                &mut self.compile,
+                params.compiled_lu,
+            )?;
             match fp {
                 FactorPath::Compiled => self.compiled_factorizations += 1,
                 FactorPath::Fallback => self.lu_fallbacks += 1,

@@ -130,36 +130,39 @@ pub(crate) struct CompiledLu {
 
 /// Scratch of [`CompiledLu::choose_rows`] and [`CompiledLu::compile`],
 /// kept between compilations (one per solver, grown to the largest
-/// dimension `m` met): dense `m × m` arrays, restored after each use at the
-/// entries it set (the filled structure, not `m²`), and the structure's
-/// rows and columns as lists. About `13·m²` bytes (240 kB at `m = 135`)
-/// plus the lists (at most `8·m²` bytes, a dense factor's).
+/// dimension `m` met): two dense `m × m` arrays, restored after each use
+/// at the entries it set (the filled structure, not all `m²`), and the
+/// structure as bit sets of each row's columns and each column's rows
+/// (`2·m·⌈m/64⌉` words, cleared at each use). About `12·m²` bytes: 220 kB
+/// at `m = 135`.
 #[derive(Default)]
 pub(crate) struct CompileScratch {
     /// [`CompiledLu::choose_rows`]: the dense elimination's values, `0.0`
     /// outside the structure between uses.
     dense: Vec<f64>,
-    /// [`CompiledLu::choose_rows`]: the structure, `false` outside it
-    /// between uses.
-    nz: Vec<bool>,
     /// [`CompiledLu::compile`]: the slot of each position of `P·A·Q`,
     /// `u32::MAX` outside the structure between uses.
     slot: Vec<u32>,
-    /// The structure's columns of each row and rows of each column (as
-    /// filled, unsorted; a row's and a column's are sorted once final).
-    row_list: Vec<Vec<u32>>,
-    col_list: Vec<Vec<u32>>,
-    /// [`CompiledLu::compile`]: pivot positions of rows and columns; each
-    /// pivot's first entry below (right of) the diagonal in its column's
-    /// (row's) list.
+    /// Words of a row's (column's) bit set: `⌈m/64⌉`.
+    words: usize,
+    /// The structure: row `i`'s columns, bits of
+    /// `row_bits[i·words..(i+1)·words]`; column `j`'s rows the same in
+    /// `col_bits`.
+    row_bits: Vec<u64>,
+    col_bits: Vec<u64>,
+    /// [`CompiledLu::choose_rows`]: the rows taken, a bit set.
+    used: Vec<u64>,
+    /// [`CompiledLu::compile`]: pivot positions of rows and columns.
     row_pos: Vec<usize>,
     col_pos: Vec<usize>,
-    splits: Vec<(u32, u32)>,
-    /// [`CompiledLu::choose_rows`]: the rows left in the current column,
-    /// the pivot row's columns right of it, the rows taken, the order.
+    /// The current pivot's rows below it and columns right of it (their
+    /// values for [`CompiledLu::choose_rows`]).
     rows: Vec<usize>,
     cols: Vec<u32>,
-    used: Vec<bool>,
+    pivot_row: Vec<f64>,
+    /// [`CompiledLu::choose_rows`]: the pivot row's bit set.
+    pivot_bits: Vec<u64>,
+    /// [`CompiledLu::choose_rows`]: the order.
     order: Vec<usize>,
     /// Entries of each row right of the current column (the Markowitz
     /// row count).
@@ -167,17 +170,71 @@ pub(crate) struct CompileScratch {
 }
 
 impl CompileScratch {
-    /// Empty structure lists for dimension `m`.
-    fn lists(&mut self, m: usize) {
-        for lists in [&mut self.row_list, &mut self.col_list] {
-            if lists.len() < m {
-                lists.resize_with(m, Vec::new);
-            }
-            for l in &mut lists[..m] {
-                l.clear();
-            }
+    /// Empty bit sets for dimension `m`.
+    fn clear_bits(&mut self, m: usize) {
+        self.words = m.div_ceil(64);
+        for bits in [&mut self.row_bits, &mut self.col_bits] {
+            bits.clear();
+            bits.resize(m * self.words, 0);
         }
     }
+}
+
+/// The set bits of `words` from bit `from` on, in order.
+fn bits(words: &[u64], from: usize) -> Bits<'_> {
+    let index = from / 64;
+    let word = words
+        .get(index)
+        .map_or(0, |&w| w & (u64::MAX << (from % 64)));
+    Bits { words, index, word }
+}
+
+/// Iterator of [`bits`].
+struct Bits<'a> {
+    words: &'a [u64],
+    index: usize,
+    word: u64,
+}
+
+impl Iterator for Bits<'_> {
+    type Item = usize;
+
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        while self.word == 0 {
+            self.index += 1;
+            self.word = *self.words.get(self.index)?;
+        }
+        let bit = self.word.trailing_zeros() as usize;
+        self.word &= self.word - 1;
+        Some(self.index * 64 + bit)
+    }
+}
+
+/// Sets in `row` the bits of `pivot` from bit `from` on, calling `fill`
+/// with each bit newly set (in order).
+#[inline]
+fn merge(row: &mut [u64], pivot: &[u64], from: usize, mut fill: impl FnMut(usize)) {
+    let first = from / 64;
+    for (w, (r, &p)) in row.iter_mut().zip(pivot).enumerate().skip(first) {
+        let p = if w == first {
+            p & (u64::MAX << (from % 64))
+        } else {
+            p
+        };
+        let mut new = p & !*r;
+        *r |= p;
+        while new != 0 {
+            fill(w * 64 + new.trailing_zeros() as usize);
+            new &= new - 1;
+        }
+    }
+}
+
+/// Sets bit `i` of `words`.
+#[inline]
+fn set(words: &mut [u64], i: usize) {
+    words[i / 64] |= 1 << (i % 64);
 }
 
 /// A pivot failed its check: factor with faer instead.
@@ -192,11 +249,6 @@ impl CompiledLu {
     /// allocates, with room for programs of twice its size; a later one (a
     /// fallback's new row order) only when `grow`, else it returns `false`
     /// and leaves the program as it was when the new one does not fit.
-    ///
-    /// The symbolic elimination visits the structure only (each pivot's
-    /// column and row, sorted once final, and the fill they make), not the
-    /// `m²` positions: 0.8 M → 0.2 M instructions a compilation on
-    /// `bench/peer/hexapod_drop.toml` (reduced dimensions 50–135).
     pub(crate) fn compile(
         &mut self,
         sc: &mut CompileScratch,
@@ -212,7 +264,7 @@ impl CompiledLu {
         if sc.slot.len() < m * m {
             sc.slot.resize(m * m, u32::MAX);
         }
-        sc.lists(m);
+        sc.clear_bits(m);
         sc.row_pos.resize(m, 0);
         sc.col_pos.resize(m, 0);
         for (i, &r) in row_perm.iter().enumerate() {
@@ -222,11 +274,11 @@ impl CompiledLu {
             sc.col_pos[j] = c;
         }
         let fits = self.compile_with(sc, m, col_ptr, row_idx, first, grow);
-        // The slot map back to `u32::MAX` where it was set: the
-        // structure, every position of it in its row's list.
-        for (i, row) in sc.row_list[..m].iter().enumerate() {
-            for &j in row {
-                sc.slot[i * m + j as usize] = u32::MAX;
+        // The slot map back to `u32::MAX` where it was set: the structure.
+        let w = sc.words;
+        for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+            for j in bits(row, 0) {
+                sc.slot[i * m + j] = u32::MAX;
             }
         }
         if fits {
@@ -237,7 +289,7 @@ impl CompiledLu {
     }
 
     /// [`Self::compile`] once the scratch holds the pivot positions of the
-    /// rows and columns and empty lists.
+    /// rows and columns and empty bit sets.
     fn compile_with(
         &mut self,
         sc: &mut CompileScratch,
@@ -249,6 +301,7 @@ impl CompiledLu {
     ) -> bool {
         /// A position of the fill, before its slot is known.
         const FILL: u32 = u32::MAX - 1;
+        let w = sc.words;
         let slot = &mut sc.slot;
         // The values' slots, in their CSC order (a factorisation copies
         // them in one block), and the structure of P·A·Q.
@@ -259,51 +312,40 @@ impl CompiledLu {
                 let i = sc.row_pos[r];
                 slot[i * m + c] = slots;
                 slots += 1;
-                sc.row_list[i].push(c as u32);
-                sc.col_list[c].push(i as u32);
+                set(&mut sc.row_bits[i * w..(i + 1) * w], c);
+                set(&mut sc.col_bits[c * w..(c + 1) * w], i);
             }
         }
         self.values = slots as usize;
         // Symbolic elimination, pivot after pivot: pivot `k`'s column and
         // row are final when it is reached (only earlier pivots fill
-        // them), and stay so. Its rows of `L` (below the diagonal) times
-        // its columns of `U` (right of it) fill the positions not yet in
-        // the structure.
+        // them), and stay so. Each of its rows below the diagonal takes
+        // its row's columns right of it (a word of 64 columns at a time),
+        // the new ones the fill.
         let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
-        sc.splits.clear();
         for k in 0..m {
-            let (col_head, col_tail) = sc.col_list.split_at_mut(k + 1);
-            let (row_head, row_tail) = sc.row_list.split_at_mut(k + 1);
-            let (col, row) = (&mut col_head[k], &mut row_head[k]);
-            col.sort_unstable();
-            row.sort_unstable();
-            let r0 = col.partition_point(|&i| i as usize <= k);
-            let c0 = row.partition_point(|&j| j as usize <= k);
-            let (rows, cols) = (&col[r0..], &row[c0..]);
-            for &i in rows {
-                let (target, fill_row) = (
-                    &mut slot[i as usize * m..],
-                    &mut row_tail[i as usize - k - 1],
-                );
-                for &j in cols {
-                    let s = &mut target[j as usize];
-                    if *s == u32::MAX {
-                        *s = FILL;
-                        fill_row.push(j);
-                        col_tail[j as usize - k - 1].push(i);
-                    }
-                }
+            let (row_head, row_tail) = sc.row_bits.split_at_mut((k + 1) * w);
+            let (col_head, col_tail) = sc.col_bits.split_at_mut((k + 1) * w);
+            let pivot = &row_head[k * w..];
+            let n_cols = bits(pivot, k + 1).count();
+            let mut n_rows = 0;
+            for i in bits(&col_head[k * w..], k + 1) {
+                n_rows += 1;
+                let target = &mut slot[i * m..(i + 1) * m];
+                let row = &mut row_tail[(i - k - 1) * w..(i - k) * w];
+                merge(row, pivot, k + 1, |j| {
+                    target[j] = FILL;
+                    set(&mut col_tail[(j - k - 1) * w..(j - k) * w], i);
+                });
             }
-            n_l += rows.len();
-            n_u += cols.len();
-            n_upd += rows.len() * cols.len();
-            sc.splits.push((r0 as u32, c0 as u32));
+            n_l += n_rows;
+            n_u += n_cols;
+            n_upd += n_rows * n_cols;
         }
-        // The fill's slots after the values', row-major (each row's list
-        // sorted).
-        for (i, row) in sc.row_list[..m].iter().enumerate() {
-            for &j in row {
-                let s = &mut slot[i * m + j as usize];
+        // The fill's slots after the values', row-major.
+        for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+            for j in bits(row, 0) {
+                let s = &mut slot[i * m + j];
                 if *s == FILL {
                     *s = slots;
                     slots += 1;
@@ -346,32 +388,33 @@ impl CompiledLu {
         self.l_ptr.push(0);
         self.u_ptr.push(0);
         self.lower.clear();
-        for (k, &(r0, c0)) in sc.splits.iter().enumerate() {
+        for k in 0..m {
             // A structurally zero pivot gets no slot: it never verifies,
             // faer reports the singularity.
             self.pivot.push(slot[k * m + k]);
-            let rows = &sc.col_list[k][r0 as usize..];
-            let cols = &sc.row_list[k][c0 as usize..];
-            self.l_slots
-                .extend(rows.iter().map(|&i| slot[i as usize * m + k]));
+            sc.cols.clear();
+            sc.cols.extend(
+                bits(&sc.row_bits[k * w..(k + 1) * w], k + 1).map(|j| j as u32),
+            );
             let pivot_row = &slot[k * m..(k + 1) * m];
             self.u_slots
-                .extend(cols.iter().map(|&j| pivot_row[j as usize]));
-            for &i in rows {
-                let target = &slot[i as usize * m..(i as usize + 1) * m];
+                .extend(sc.cols.iter().map(|&j| pivot_row[j as usize]));
+            for i in bits(&sc.col_bits[k * w..(k + 1) * w], k + 1) {
+                let target = &slot[i * m..(i + 1) * m];
+                self.l_slots.push(target[k]);
                 self.updates
-                    .extend(cols.iter().map(|&j| target[j as usize]));
-                self.lower.push(i, k as u32, target[k]);
+                    .extend(sc.cols.iter().map(|&j| target[j as usize]));
+                self.lower.push(i as u32, k as u32, target[k]);
             }
             self.l_ptr.push(self.l_slots.len() as u32);
             self.u_ptr.push(self.u_slots.len() as u32);
         }
         // `U` above the diagonal, last column first, each column's rows in
-        // order (its sorted list up to the diagonal).
+        // order.
         self.upper.clear();
         for j in (0..m).rev() {
-            for &i in sc.col_list[j].iter().take_while(|&&i| (i as usize) < j) {
-                self.upper.push(i, j as u32, slot[i as usize * m + j]);
+            for i in bits(&sc.col_bits[j * w..(j + 1) * w], 0).take_while(|&i| i < j) {
+                self.upper.push(i as u32, j as u32, slot[i * m + j]);
             }
         }
         self.a.clear();
@@ -388,13 +431,12 @@ impl CompiledLu {
     /// [`ROW_CHOICE_THRESHOLD`] of the column's largest, the one with the
     /// fewest entries right of the column (the least fill; ties to the
     /// larger entry, then to the first row). An elimination of the first
-    /// values on the dense arrays of the scratch `sc` that visits only the
-    /// structure (each column's rows from its list, sorted once final, the
-    /// pivot row's columns, the LU's own updates; kept rows counted as they
+    /// values on the dense array of the scratch `sc` that visits only the
+    /// structure (each column's rows left and the pivot row's columns from
+    /// their bit sets, the LU's own updates; kept rows counted as they
     /// fill), once per compilation. `None` when a column has no usable
     /// entry (faer's order is then used). Writes the order into the
-    /// scratch; allocation-free once the scratch has this dimension and
-    /// its lists their length.
+    /// scratch; allocation-free once the scratch has this dimension.
     pub(crate) fn choose_rows<'s>(
         sc: &'s mut CompileScratch,
         col_ptr: &[usize],
@@ -405,37 +447,38 @@ impl CompiledLu {
         let m = fwd.len();
         if sc.dense.len() < m * m {
             sc.dense.resize(m * m, 0.0);
-            sc.nz.resize(m * m, false);
         }
-        sc.lists(m);
-        let found = Self::eliminate(sc, col_ptr, row_idx, fwd, values);
-        // The dense arrays back to zero where they were set: the structure,
-        // every position of it in its row's list.
-        for (r, row) in sc.row_list[..m].iter().enumerate() {
-            for &c in row {
-                sc.dense[r * m + c as usize] = 0.0;
-                sc.nz[r * m + c as usize] = false;
+        sc.clear_bits(m);
+        let found = Self::eliminate(sc, m, col_ptr, row_idx, fwd, values);
+        // The dense values back to zero where they were set: the
+        // structure.
+        let w = sc.words;
+        for (r, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+            for c in bits(row, 0) {
+                sc.dense[r * m + c] = 0.0;
             }
         }
         found.then_some(&sc.order[..])
     }
 
-    /// The elimination of [`Self::choose_rows`] into `sc.order`; `false`
-    /// when a column has no usable entry.
+    /// The elimination of [`Self::choose_rows`] into `sc.order`, once the
+    /// scratch has empty bit sets; `false` when a column has no usable
+    /// entry.
     fn eliminate(
         sc: &mut CompileScratch,
+        m: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
         fwd: &[usize],
         values: &[f64],
     ) -> bool {
-        let m = fwd.len();
+        let w = sc.words;
         sc.used.clear();
-        sc.used.resize(m, false);
+        sc.used.resize(w, 0);
         sc.order.clear();
         sc.count.clear();
         sc.count.resize(m, 0);
-        let (d, nz, count) = (&mut sc.dense, &mut sc.nz, &mut sc.count);
+        let (d, count) = (&mut sc.dense, &mut sc.count);
         // Rows as given, columns in order: d[r·m + c].
         for (c, &j) in fwd.iter().enumerate() {
             for (&r, &v) in row_idx[col_ptr[j]..col_ptr[j + 1]]
@@ -443,24 +486,26 @@ impl CompiledLu {
                 .zip(&values[col_ptr[j]..col_ptr[j + 1]])
             {
                 d[r * m + c] = v;
-                nz[r * m + c] = true;
                 count[r] += 1;
-                sc.row_list[r].push(c as u32);
-                sc.col_list[c].push(r as u32);
+                set(&mut sc.row_bits[r * w..(r + 1) * w], c);
+                set(&mut sc.col_bits[c * w..(c + 1) * w], r);
             }
         }
         for k in 0..m {
             // The rows left with an entry in column k, in order (the
-            // column's list is final: only earlier pivots fill it);
-            // `count` becomes each row's entries right of it.
-            let (col_head, col_tail) = sc.col_list.split_at_mut(k + 1);
-            let col = &mut col_head[k];
-            col.sort_unstable();
+            // column is final: only earlier pivots fill it); `count`
+            // becomes each row's entries right of it.
             sc.rows.clear();
             let mut column = 0.0f64;
-            for &r in col.iter() {
-                let r = r as usize;
-                if !sc.used[r] {
+            for (x, (&c, &u)) in sc.col_bits[k * w..(k + 1) * w]
+                .iter()
+                .zip(&sc.used)
+                .enumerate()
+            {
+                let mut b = c & !u;
+                while b != 0 {
+                    let r = x * 64 + b.trailing_zeros() as usize;
+                    b &= b - 1;
                     sc.rows.push(r);
                     count[r] -= 1;
                     column = column.max(d[r * m + k].abs());
@@ -483,29 +528,35 @@ impl CompiledLu {
             let Some((p, _, _)) = best else {
                 return false;
             };
-            sc.used[p] = true;
+            set(&mut sc.used, p);
             sc.order.push(p);
-            // The pivot row's columns right of k, in any order (each
-            // update of a row touches another entry).
+            // The pivot row's columns right of k and their values (the
+            // updates of step k change other rows only).
+            let pivot = &sc.row_bits[p * w..(p + 1) * w];
             sc.cols.clear();
-            sc.cols
-                .extend(sc.row_list[p].iter().filter(|&&j| j as usize > k));
+            sc.pivot_row.clear();
+            for j in bits(pivot, k + 1) {
+                sc.cols.push(j as u32);
+                sc.pivot_row.push(d[p * m + j]);
+            }
+            sc.pivot_bits.clear();
+            sc.pivot_bits.extend_from_slice(pivot);
             let inv = d[p * m + k].recip();
             for &i in &sc.rows {
                 if i == p {
                     continue;
                 }
-                let l = d[i * m + k] * inv;
-                for &j in &sc.cols {
-                    let j = j as usize;
-                    d[i * m + j] -= l * d[p * m + j];
-                    if !nz[i * m + j] {
-                        nz[i * m + j] = true;
-                        count[i] += 1;
-                        sc.row_list[i].push(j as u32);
-                        col_tail[j - k - 1].push(i as u32);
-                    }
+                let target = &mut d[i * m..(i + 1) * m];
+                let l = target[k] * inv;
+                for (&j, &u) in sc.cols.iter().zip(&sc.pivot_row) {
+                    target[j as usize] -= l * u;
                 }
+                let col_bits = &mut sc.col_bits;
+                let count_i = &mut count[i];
+                merge(&mut sc.row_bits[i * w..(i + 1) * w], &sc.pivot_bits, k + 1, |j| {
+                    *count_i += 1;
+                    set(&mut col_bits[j * w..(j + 1) * w], i);
+                });
             }
         }
         true

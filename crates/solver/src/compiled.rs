@@ -162,8 +162,13 @@ pub(crate) struct CompileScratch {
     pivot_row: Vec<f64>,
     /// [`CompiledLu::choose_rows`]: the pivot row's bit set.
     pivot_bits: Vec<u64>,
-    /// [`CompiledLu::choose_rows`]: the order.
+    /// [`CompiledLu::choose_rows`]: the order, and whether the bit sets
+    /// hold the structure of its elimination (which
+    /// [`CompiledLu::compile`] with that order then takes).
     order: Vec<usize>,
+    chosen: bool,
+    /// [`CompiledLu::compile`]: the rows' bit sets being permuted.
+    spare: Vec<u64>,
     /// Entries of each row right of the current column (the Markowitz
     /// row count).
     count: Vec<usize>,
@@ -178,6 +183,77 @@ impl CompileScratch {
             bits.resize(m * self.words, 0);
         }
     }
+}
+
+impl CompileScratch {
+    /// The structure of the LU of the reduced structure (`col_ptr`,
+    /// `row_idx`) in the pivot positions [`Self::row_pos`],
+    /// [`Self::col_pos`] of dimension `m`, into the bit sets: the values',
+    /// then the fill of a symbolic elimination, pivot after pivot. Pivot
+    /// `k`'s column and row are final when it is reached (only earlier
+    /// pivots fill them), and stay so; each of its rows below the
+    /// diagonal takes its row's columns right of it (64 columns a word),
+    /// the new ones the fill.
+    fn symbolic(&mut self, m: usize, col_ptr: &[usize], row_idx: &[usize]) {
+        self.clear_bits(m);
+        let w = self.words;
+        for j in 0..m {
+            let c = self.col_pos[j];
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                let i = self.row_pos[r];
+                set(&mut self.row_bits, i * w, c);
+                set(&mut self.col_bits, c * w, i);
+            }
+        }
+        for k in 0..m {
+            let (row_head, row_tail) = self.row_bits.split_at_mut((k + 1) * w);
+            let (col_head, col_tail) = self.col_bits.split_at_mut((k + 1) * w);
+            let pivot = &row_head[k * w..];
+            for i in bits(&col_head[k * w..], k + 1) {
+                let row = &mut row_tail[(i - k - 1) * w..(i - k) * w];
+                merge(row, pivot, k + 1, |j| {
+                    set(col_tail, (j - k - 1) * w, i);
+                });
+            }
+        }
+    }
+
+    /// The structure left by [`CompiledLu::choose_rows`] (rows as given)
+    /// with its rows in pivot order ([`Self::order`]): row `i`'s bit set
+    /// is that of row `order[i]`, the columns' sets rebuilt.
+    fn permute_rows(&mut self, m: usize) {
+        let w = self.words;
+        self.spare.clear();
+        for &r in &self.order {
+            self.spare
+                .extend_from_slice(&self.row_bits[r * w..(r + 1) * w]);
+        }
+        std::mem::swap(&mut self.spare, &mut self.row_bits);
+        self.col_bits.fill(0);
+        for (i, row) in self.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+            for j in bits(row, 0) {
+                set(&mut self.col_bits, j * w, i);
+            }
+        }
+    }
+}
+
+/// The number of set bits of `words` from bit `from` on.
+fn count(words: &[u64], from: usize) -> usize {
+    let first = from / 64;
+    words
+        .iter()
+        .enumerate()
+        .skip(first)
+        .map(|(w, &x)| {
+            let x = if w == first {
+                x & (u64::MAX << (from % 64))
+            } else {
+                x
+            };
+            x.count_ones() as usize
+        })
+        .sum()
 }
 
 /// The set bits of `words` from bit `from` on, in order.
@@ -216,12 +292,10 @@ impl Iterator for Bits<'_> {
 #[inline]
 fn merge(row: &mut [u64], pivot: &[u64], from: usize, mut fill: impl FnMut(usize)) {
     let first = from / 64;
+    let mut mask = u64::MAX << (from % 64);
     for (w, (r, &p)) in row.iter_mut().zip(pivot).enumerate().skip(first) {
-        let p = if w == first {
-            p & (u64::MAX << (from % 64))
-        } else {
-            p
-        };
+        let p = p & mask;
+        mask = u64::MAX;
         let mut new = p & !*r;
         *r |= p;
         while new != 0 {
@@ -231,10 +305,21 @@ fn merge(row: &mut [u64], pivot: &[u64], from: usize, mut fill: impl FnMut(usize
     }
 }
 
-/// Sets bit `i` of `words`.
+/// Rows `a` and `b` (different) of the row-major `d` of `m` columns.
+fn two_rows(d: &mut [f64], m: usize, a: usize, b: usize) -> (&mut [f64], &mut [f64]) {
+    if a < b {
+        let (x, y) = d.split_at_mut(b * m);
+        (&mut x[a * m..(a + 1) * m], &mut y[..m])
+    } else {
+        let (x, y) = d.split_at_mut(a * m);
+        (&mut y[..m], &mut x[b * m..(b + 1) * m])
+    }
+}
+
+/// Sets bit `i` of the bit set starting at word `start` of `words`.
 #[inline]
-fn set(words: &mut [u64], i: usize) {
-    words[i / 64] |= 1 << (i % 64);
+fn set(words: &mut [u64], start: usize, i: usize) {
+    words[start + i / 64] |= 1 << (i % 64);
 }
 
 /// A pivot failed its check: factor with faer instead.
@@ -264,7 +349,6 @@ impl CompiledLu {
         if sc.slot.len() < m * m {
             sc.slot.resize(m * m, u32::MAX);
         }
-        sc.clear_bits(m);
         sc.row_pos.resize(m, 0);
         sc.col_pos.resize(m, 0);
         for (i, &r) in row_perm.iter().enumerate() {
@@ -273,6 +357,14 @@ impl CompiledLu {
         for (c, &j) in fwd.iter().enumerate() {
             sc.col_pos[j] = c;
         }
+        if sc.chosen && sc.order == row_perm {
+            // The structure of the row choice's elimination along this
+            // order: the same fill, its rows in pivot order.
+            sc.permute_rows(m);
+        } else {
+            sc.symbolic(m, col_ptr, row_idx);
+        }
+        sc.chosen = false;
         let fits = self.compile_with(sc, m, col_ptr, row_idx, first, grow);
         // The slot map back to `u32::MAX` where it was set: the structure.
         let w = sc.words;
@@ -299,58 +391,37 @@ impl CompiledLu {
         first: bool,
         grow: bool,
     ) -> bool {
-        /// A position of the fill, before its slot is known.
-        const FILL: u32 = u32::MAX - 1;
         let w = sc.words;
         let slot = &mut sc.slot;
         // The values' slots, in their CSC order (a factorisation copies
-        // them in one block), and the structure of P·A·Q.
+        // them in one block), then the fill's, row-major.
         let mut slots = 0u32;
         for j in 0..m {
             let c = sc.col_pos[j];
             for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                let i = sc.row_pos[r];
-                slot[i * m + c] = slots;
+                slot[sc.row_pos[r] * m + c] = slots;
                 slots += 1;
-                set(&mut sc.row_bits[i * w..(i + 1) * w], c);
-                set(&mut sc.col_bits[c * w..(c + 1) * w], i);
             }
         }
         self.values = slots as usize;
-        // Symbolic elimination, pivot after pivot: pivot `k`'s column and
-        // row are final when it is reached (only earlier pivots fill
-        // them), and stay so. Each of its rows below the diagonal takes
-        // its row's columns right of it (a word of 64 columns at a time),
-        // the new ones the fill.
-        let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
-        for k in 0..m {
-            let (row_head, row_tail) = sc.row_bits.split_at_mut((k + 1) * w);
-            let (col_head, col_tail) = sc.col_bits.split_at_mut((k + 1) * w);
-            let pivot = &row_head[k * w..];
-            let n_cols = bits(pivot, k + 1).count();
-            let mut n_rows = 0;
-            for i in bits(&col_head[k * w..], k + 1) {
-                n_rows += 1;
-                let target = &mut slot[i * m..(i + 1) * m];
-                let row = &mut row_tail[(i - k - 1) * w..(i - k) * w];
-                merge(row, pivot, k + 1, |j| {
-                    target[j] = FILL;
-                    set(&mut col_tail[(j - k - 1) * w..(j - k) * w], i);
-                });
-            }
-            n_l += n_rows;
-            n_u += n_cols;
-            n_upd += n_rows * n_cols;
-        }
-        // The fill's slots after the values', row-major.
         for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+            let target = &mut slot[i * m..(i + 1) * m];
             for j in bits(row, 0) {
-                let s = &mut slot[i * m + j];
-                if *s == FILL {
-                    *s = slots;
+                if target[j] == u32::MAX {
+                    target[j] = slots;
                     slots += 1;
                 }
             }
+        }
+        // Pivot `k`'s rows of `L` (below the diagonal) and columns of `U`
+        // (right of it).
+        let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
+        for k in 0..m {
+            let rows = count(&sc.col_bits[k * w..(k + 1) * w], k + 1);
+            let cols = count(&sc.row_bits[k * w..(k + 1) * w], k + 1);
+            n_l += rows;
+            n_u += cols;
+            n_upd += rows * cols;
         }
         let n_slots = slots as usize;
         if first {
@@ -393,9 +464,8 @@ impl CompiledLu {
             // faer reports the singularity.
             self.pivot.push(slot[k * m + k]);
             sc.cols.clear();
-            sc.cols.extend(
-                bits(&sc.row_bits[k * w..(k + 1) * w], k + 1).map(|j| j as u32),
-            );
+            sc.cols
+                .extend(bits(&sc.row_bits[k * w..(k + 1) * w], k + 1).map(|j| j as u32));
             let pivot_row = &slot[k * m..(k + 1) * m];
             self.u_slots
                 .extend(sc.cols.iter().map(|&j| pivot_row[j as usize]));
@@ -450,6 +520,7 @@ impl CompiledLu {
         }
         sc.clear_bits(m);
         let found = Self::eliminate(sc, m, col_ptr, row_idx, fwd, values);
+        sc.chosen = found;
         // The dense values back to zero where they were set: the
         // structure.
         let w = sc.words;
@@ -487,8 +558,8 @@ impl CompiledLu {
             {
                 d[r * m + c] = v;
                 count[r] += 1;
-                set(&mut sc.row_bits[r * w..(r + 1) * w], c);
-                set(&mut sc.col_bits[c * w..(c + 1) * w], r);
+                set(&mut sc.row_bits, r * w, c);
+                set(&mut sc.col_bits, c * w, r);
             }
         }
         for k in 0..m {
@@ -528,7 +599,7 @@ impl CompiledLu {
             let Some((p, _, _)) = best else {
                 return false;
             };
-            set(&mut sc.used, p);
+            set(&mut sc.used, 0, p);
             sc.order.push(p);
             // The pivot row's columns right of k and their values (the
             // updates of step k change other rows only).
@@ -542,21 +613,37 @@ impl CompiledLu {
             sc.pivot_bits.clear();
             sc.pivot_bits.extend_from_slice(pivot);
             let inv = d[p * m + k].recip();
-            for &i in &sc.rows {
-                if i == p {
-                    continue;
+            // The other rows, two at a time (the pivot row's values read
+            // once for both; each entry takes the same operations).
+            sc.rows.retain(|&i| i != p);
+            let (pairs, last) = sc.rows.as_chunks::<2>();
+            for &[i1, i2] in pairs {
+                let (t1, t2) = two_rows(d, m, i1, i2);
+                let (l1, l2) = (t1[k] * inv, t2[k] * inv);
+                for (&j, &u) in sc.cols.iter().zip(&sc.pivot_row) {
+                    t1[j as usize] -= l1 * u;
+                    t2[j as usize] -= l2 * u;
                 }
+            }
+            if let [i] = *last {
                 let target = &mut d[i * m..(i + 1) * m];
                 let l = target[k] * inv;
                 for (&j, &u) in sc.cols.iter().zip(&sc.pivot_row) {
                     target[j as usize] -= l * u;
                 }
+            }
+            for &i in &sc.rows {
                 let col_bits = &mut sc.col_bits;
                 let count_i = &mut count[i];
-                merge(&mut sc.row_bits[i * w..(i + 1) * w], &sc.pivot_bits, k + 1, |j| {
-                    *count_i += 1;
-                    set(&mut col_bits[j * w..(j + 1) * w], i);
-                });
+                merge(
+                    &mut sc.row_bits[i * w..(i + 1) * w],
+                    &sc.pivot_bits,
+                    k + 1,
+                    |j| {
+                        *count_i += 1;
+                        set(col_bits, j * w, i);
+                    },
+                );
             }
         }
         true

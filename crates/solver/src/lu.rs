@@ -99,10 +99,10 @@ use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::{Perm, PermRef};
 use faer::sparse::linalg::LuError;
 use faer::sparse::linalg::colamd;
+use faer::sparse::linalg::lu::LuSymbolicParams;
 use faer::sparse::linalg::lu::simplicial::{
     SimplicialLu, factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
 };
-use faer::sparse::linalg::lu::LuSymbolicParams;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 use crate::SolverError;
@@ -217,31 +217,32 @@ fn zero_signature(values: &[f64]) -> u64 {
     h
 }
 
-/// Sorts `entries` (`(row, col)`, each below `n`) column-major, rows in
-/// order within a column, and removes the duplicates: a stable counting
-/// sort by row, then by column, `O(len + n)` (a comparison sort cost
-/// 0.3 M instructions a pattern on `bench/peer/hexapod_drop.toml`, 1 600
-/// entries of 150 unknowns).
+/// Sorts `entries` (`(row, col)`, each below `n`, else it panics)
+/// column-major, rows in order within a column, and removes the
+/// duplicates: a stable counting sort by row, then by column, `O(len + n)`
+/// (a comparison sort cost 0.3 M instructions a pattern on
+/// `bench/peer/hexapod_drop.toml`, 1 600 entries of 150 unknowns).
 fn sort_entries(n: usize, entries: &mut Vec<(usize, usize)>) {
     let mut start = vec![0usize; n + 1];
-    let mut by_row = vec![(0, 0); entries.len()];
-    for &(row, _) in entries.iter() {
+    let mut col_start = vec![0usize; n + 1];
+    for &(row, col) in entries.iter() {
+        assert!(
+            row < n && col < n,
+            "Jacobian pattern entry ({row}, {col}) is out of range for dimension {n}"
+        );
         start[row + 1] += 1;
+        col_start[col + 1] += 1;
     }
+    let mut by_row = vec![(0, 0); entries.len()];
     for j in 0..n {
         start[j + 1] += start[j];
+        col_start[j + 1] += col_start[j];
     }
     for &e in entries.iter() {
         by_row[start[e.0]] = e;
         start[e.0] += 1;
     }
-    start.fill(0);
-    for &(_, col) in &by_row {
-        start[col + 1] += 1;
-    }
-    for j in 0..n {
-        start[j + 1] += start[j];
-    }
+    let mut start = col_start;
     for &e in &by_row {
         entries[start[e.1]] = e;
         start[e.1] += 1;
@@ -279,13 +280,8 @@ impl Pattern {
     /// pattern `id`; [`Self::factors`] is to be set by the caller (storage
     /// of dimension [`Self::m`]). Allocates.
     pub(crate) fn build(id: usize, n: usize, entries: &mut Vec<(usize, usize)>) -> Self {
-        for &(row, col) in entries.iter() {
-            assert!(
-                row < n && col < n,
-                "Jacobian pattern entry ({row}, {col}) is out of range for dimension {n}"
-            );
-        }
-        // Column-major order, rows sorted within a column, no duplicates.
+        // Column-major order, rows sorted within a column, no duplicates
+        // (entries out of range panic).
         sort_entries(n, entries);
         let nnz = entries.len();
         assert!(
@@ -293,12 +289,15 @@ impl Pattern {
             "Jacobian pattern has too many entries ({nnz})"
         );
 
-        // Singleton rows, in row order; a column is claimed once.
+        // Singleton rows, in row order; a column is claimed once. (And
+        // each column's entries: the full structure's column pointers.)
         let mut row_count = vec![0usize; n];
         let mut row_col = vec![0usize; n];
+        let mut full_ptr = vec![0usize; n + 1];
         for &(row, col) in entries.iter() {
             row_count[row] += 1;
             row_col[row] = col;
+            full_ptr[col + 1] += 1;
         }
         const NONE: usize = usize::MAX;
         let mut single_of_row = vec![NONE; n];
@@ -323,46 +322,42 @@ impl Pattern {
         for (c, &col) in kept_cols.iter().enumerate() {
             reduced_col[col] = c;
         }
+        // An eliminated column's entries other than its singleton's are
+        // in kept rows (a second singleton row of the column is kept).
+        let n_couplings: usize = singles.iter().map(|&(_, col)| full_ptr[col + 1] - 1).sum();
+        let reduced_nnz = nnz - singles.len() - n_couplings;
+        for j in 0..n {
+            full_ptr[j + 1] += full_ptr[j];
+        }
 
-        // The reduced CSC structure (entries stay in column-major order).
+        // In one pass: the reduced CSC structure (entries stay in
+        // column-major order), the slots, the full structure's rows.
         let mut col_ptr = vec![0usize; m + 1];
-        let mut row_idx = Vec::with_capacity(nnz);
-        for &(row, col) in entries.iter() {
-            if single_of_row[row] == NONE && single_of_col[col] == NONE {
-                col_ptr[reduced_col[col] + 1] += 1;
-                row_idx.push(reduced_row[row]);
-            }
-        }
-        for j in 0..m {
-            col_ptr[j + 1] += col_ptr[j];
-        }
-        let reduced_nnz = row_idx.len();
+        let mut row_idx = Vec::with_capacity(reduced_nnz);
+        let mut full_rows = Vec::with_capacity(nnz);
         let mut slot = vec![u32::MAX; n * n];
-        let mut couplings = Vec::new();
-        let mut k = 0;
+        let mut couplings = Vec::with_capacity(n_couplings);
         for &(row, col) in entries.iter() {
+            full_rows.push(row);
             let s = if single_of_row[row] != NONE {
                 reduced_nnz + single_of_row[row]
             } else if single_of_col[col] != NONE {
                 couplings.push((row, single_of_col[col]));
                 reduced_nnz + singles.len() + couplings.len() - 1
             } else {
-                k += 1;
-                k - 1
+                col_ptr[reduced_col[col] + 1] += 1;
+                row_idx.push(reduced_row[row]);
+                row_idx.len() - 1
             };
             slot[row * n + col] = s as u32;
+        }
+        debug_assert_eq!(row_idx.len(), reduced_nnz);
+        for j in 0..m {
+            col_ptr[j + 1] += col_ptr[j];
         }
 
         // The full pattern's COLAMD ordering, restricted to the kept
         // columns.
-        let mut full_ptr = vec![0usize; n + 1];
-        for &(_, col) in entries.iter() {
-            full_ptr[col + 1] += 1;
-        }
-        for j in 0..n {
-            full_ptr[j + 1] += full_ptr[j];
-        }
-        let full_rows: Vec<usize> = entries.iter().map(|e| e.0).collect();
         let full = SymbolicSparseColMatRef::new_checked(n, n, &full_ptr, None, &full_rows);
         let full_order = colamd_order(full);
         let fwd: Vec<usize> = full_order

@@ -474,8 +474,9 @@ impl CompiledLu {
                 self.l_slots.push(target[k]);
                 self.updates
                     .extend(sc.cols.iter().map(|&j| target[j as usize]));
-                self.lower.push(i as u32, k as u32, target[k]);
+                self.lower.entries.push((i as u32, target[k]));
             }
+            self.lower.end_run(k as u32);
             self.l_ptr.push(self.l_slots.len() as u32);
             self.u_ptr.push(self.u_slots.len() as u32);
         }
@@ -483,9 +484,12 @@ impl CompiledLu {
         // order.
         self.upper.clear();
         for j in (0..m).rev() {
-            for i in bits(&sc.col_bits[j * w..(j + 1) * w], 0).take_while(|&i| i < j) {
-                self.upper.push(i as u32, j as u32, slot[i * m + j]);
-            }
+            self.upper.entries.extend(
+                bits(&sc.col_bits[j * w..(j + 1) * w], 0)
+                    .take_while(|&i| i < j)
+                    .map(|i| (i as u32, slot[i * m + j])),
+            );
+            self.upper.end_run(j as u32);
         }
         self.a.clear();
         self.a.resize(self.slots, 0.0);

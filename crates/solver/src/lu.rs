@@ -450,6 +450,16 @@ impl<T> Stream<T> {
         self.entries.clear();
     }
 
+    /// Closes column `j`'s run: the entries pushed since the last run
+    /// (directly into [`Self::entries`]) are column `j`'s, a run when
+    /// there are any. The same as [`Self::push`] for each of them.
+    pub(crate) fn end_run(&mut self, j: u32) {
+        let end = self.entries.len() as u32;
+        if self.runs.last().map_or(0, |&(_, e)| e) < end {
+            self.runs.push((j, end));
+        }
+    }
+
     /// Appends entry `(i, v)` of column `j`: to the last run when it is
     /// column `j`'s (a column's entries must be pushed together).
     pub(crate) fn push(&mut self, i: u32, j: u32, v: T) {

@@ -5,11 +5,12 @@
 //! # Allocation behaviour
 //!
 //! The first solve of a pattern key allocates: the CSC structure, the dense
-//! slot map, faer's symbolic LU (column approximate minimum degree ordering),
+//! slot map, faer's COLAMD ordering (column approximate minimum degree),
 //! the pattern's numeric-LU storage (grown to the dense worst case, see
-//! [`crate::lu`]), and, when the pattern needs more than any earlier one,
-//! the residual/step vectors, the Jacobian value array and the `MemBuffer`
-//! scratch. After that, solving a system with an already seen key performs
+//! [`crate::lu`]), its compiled program, and, when the pattern needs more
+//! than any earlier one, the residual/step vectors, the Jacobian value
+//! array, the `MemBuffer` scratch and the compilation's scratch (kept, see
+//! [`crate::compiled`]). After that, solving a system with an already seen key performs
 //! **no heap allocation** (checked by `tests/no_alloc.rs`).
 
 use faer::dyn_stack::{MemBuffer, StackReq};

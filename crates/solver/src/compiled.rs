@@ -237,8 +237,9 @@ impl CompileScratch {
 
     /// The structure left by [`CompiledLu::choose_rows`] (rows as given)
     /// with its rows in pivot order ([`Self::order`]): row `i`'s bit set
-    /// is that of row `order[i]`, the columns' sets rebuilt.
-    fn permute_rows(&mut self, m: usize) {
+    /// is that of row `order[i]`; the columns' sets cleared (to be
+    /// rebuilt).
+    fn permute_rows(&mut self) {
         let w = self.words;
         self.spare.clear();
         for &r in &self.order {
@@ -247,11 +248,6 @@ impl CompileScratch {
         }
         std::mem::swap(&mut self.spare, &mut self.row_bits);
         self.col_bits.fill(0);
-        for (i, row) in self.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
-            for j in bits(row, 0) {
-                set(&mut self.col_bits, j * w, i);
-            }
-        }
     }
 }
 
@@ -374,15 +370,17 @@ impl CompiledLu {
         for (c, &j) in fwd.iter().enumerate() {
             sc.col_pos[j] = c;
         }
-        if sc.chosen && sc.order == row_perm {
+        let chosen = sc.chosen && sc.order == row_perm;
+        if chosen {
             // The structure of the row choice's elimination along this
-            // order: the same fill, its rows in pivot order.
-            sc.permute_rows(m);
+            // order: the same fill, its rows in pivot order (the columns'
+            // sets rebuilt below).
+            sc.permute_rows();
         } else {
             sc.symbolic(m, col_ptr, row_idx);
         }
         sc.chosen = false;
-        let fits = self.compile_with(sc, m, col_ptr, row_idx, first, grow);
+        let fits = self.compile_with(sc, m, col_ptr, row_idx, chosen, first, grow);
         // The slot map back to `u32::MAX` where it was set: the structure.
         let w = sc.words;
         for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
@@ -398,13 +396,16 @@ impl CompiledLu {
     }
 
     /// [`Self::compile`] once the scratch holds the pivot positions of the
-    /// rows and columns and empty bit sets.
+    /// rows and columns and the rows' bit sets of the structure, the
+    /// columns' too unless `rebuild`.
+    #[allow(clippy::too_many_arguments)]
     fn compile_with(
         &mut self,
         sc: &mut CompileScratch,
         m: usize,
         col_ptr: &[usize],
         row_idx: &[usize],
+        rebuild: bool,
         first: bool,
         grow: bool,
     ) -> bool {
@@ -421,25 +422,31 @@ impl CompiledLu {
             }
         }
         self.values = slots as usize;
+        // In one pass over the structure, row-major: the columns' bit sets
+        // when rebuilt, and pivot `k`'s rows of `L` (below the diagonal)
+        // and columns of `U` (right of it) counted.
+        sc.count.clear();
+        sc.count.resize(2 * m, 0);
+        let (l_count, u_count) = sc.count.split_at_mut(m);
         for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
             let target = &mut slot[i * m..(i + 1) * m];
             for j in bits(row, 0) {
+                if rebuild {
+                    set(&mut sc.col_bits, j * w, i);
+                }
                 if target[j] == u32::MAX {
                     target[j] = slots;
                     slots += 1;
                 }
+                if j < i {
+                    l_count[j] += 1;
+                }
             }
+            u_count[i] = count(row, i + 1);
         }
-        // Pivot `k`'s rows of `L` (below the diagonal) and columns of `U`
-        // (right of it).
-        let (mut n_l, mut n_u, mut n_upd) = (0, 0, 0);
-        for k in 0..m {
-            let rows = count(&sc.col_bits[k * w..(k + 1) * w], k + 1);
-            let cols = count(&sc.row_bits[k * w..(k + 1) * w], k + 1);
-            n_l += rows;
-            n_u += cols;
-            n_upd += rows * cols;
-        }
+        let n_l: usize = l_count.iter().sum();
+        let n_u: usize = u_count.iter().sum();
+        let n_upd: usize = l_count.iter().zip(u_count.iter()).map(|(l, u)| l * u).sum();
         let n_slots = slots as usize;
         if first {
             // Room for a later row order's program of up to twice the size.

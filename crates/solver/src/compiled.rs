@@ -363,6 +363,7 @@ impl CompiledLu {
         if sc.slot.len() < m * m {
             sc.slot.resize(m * m, u32::MAX);
         }
+        debug_assert!(sc.slot.iter().all(|&s| s == u32::MAX));
         sc.row_pos.resize(m, 0);
         sc.col_pos.resize(m, 0);
         for (i, &r) in row_perm.iter().enumerate() {
@@ -382,17 +383,20 @@ impl CompiledLu {
         }
         sc.chosen = false;
         let fits = self.compile_with(sc, m, col_ptr, row_idx, chosen, first, grow);
-        // The slot map back to `u32::MAX` where it was set: the structure.
-        let w = sc.words;
-        for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
-            for j in bits(row, 0) {
-                sc.slot[i * m + j] = u32::MAX;
-            }
-        }
         if fits {
             self.row_perm.clear();
             self.row_perm.extend_from_slice(row_perm);
+        } else {
+            // The slot map back to `u32::MAX` where it was set, the
+            // structure (a program's emission does it as it reads them).
+            let w = sc.words;
+            for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+                for j in bits(row, 0) {
+                    sc.slot[i * m + j] = u32::MAX;
+                }
+            }
         }
+        debug_assert!(sc.slot.iter().all(|&s| s == u32::MAX));
         fits
     }
 
@@ -487,7 +491,11 @@ impl CompiledLu {
         for k in 0..m {
             // A structurally zero pivot gets no slot: it never verifies,
             // faer reports the singularity.
+            // Each position of the structure is read for the last time
+            // where it is emitted (a pivot here, `L` below, `U` with the
+            // backward sweep's stream), and its slot cleared there.
             self.pivot.push(slot[k * m + k]);
+            slot[k * m + k] = u32::MAX;
             sc.cols.clear();
             sc.cols
                 .extend(bits(&sc.row_bits[k * w..(k + 1) * w], k + 1).map(|j| j as u32));
@@ -496,10 +504,12 @@ impl CompiledLu {
                 .extend(sc.cols.iter().map(|&j| pivot_row[j as usize]));
             for i in bits(&sc.col_bits[k * w..(k + 1) * w], k + 1) {
                 let target = &slot[i * m..(i + 1) * m];
-                self.l_slots.push(target[k]);
+                let s = target[k];
+                self.l_slots.push(s);
                 self.updates
                     .extend(sc.cols.iter().map(|&j| target[j as usize]));
-                self.lower.entries.push((i as u32, target[k]));
+                self.lower.entries.push((i as u32, s));
+                slot[i * m + k] = u32::MAX;
             }
             self.lower.end_run(k as u32);
             self.l_ptr.push(self.l_slots.len() as u32);
@@ -512,7 +522,7 @@ impl CompiledLu {
             self.upper.entries.extend(
                 bits(&sc.col_bits[j * w..(j + 1) * w], 0)
                     .take_while(|&i| i < j)
-                    .map(|i| (i as u32, slot[i * m + j])),
+                    .map(|i| (i as u32, std::mem::replace(&mut slot[i * m + j], u32::MAX))),
             );
             self.upper.end_run(j as u32);
         }
@@ -547,6 +557,7 @@ impl CompiledLu {
         if sc.dense.len() < m * m {
             sc.dense.resize(m * m, 0.0);
         }
+        debug_assert!(sc.dense.iter().all(|&v| v.to_bits() == 0));
         sc.clear_bits(m);
         let found = Self::eliminate(sc, m, col_ptr, row_idx, fwd, values);
         sc.chosen = found;
@@ -558,6 +569,7 @@ impl CompiledLu {
                 sc.dense[r * m + c] = 0.0;
             }
         }
+        debug_assert!(sc.dense.iter().all(|&v| v.to_bits() == 0));
         found.then_some(&sc.order[..])
     }
 

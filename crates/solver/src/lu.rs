@@ -1266,6 +1266,12 @@ mod tests {
         }
     }
 
+    thread_local! {
+        /// One compilation scratch per test, reused by all its patterns
+        /// and dimensions (as a solver's is).
+        static SCRATCH: std::cell::RefCell<CompileScratch> = Default::default();
+    }
+
     /// Solution of `pattern`'s system with `values` and right-hand side
     /// `b`, through `factors` (compiled path or not), with its path.
     fn solve_with(
@@ -1276,14 +1282,8 @@ mod tests {
         mem: &mut MemBuffer,
         compiled: bool,
     ) -> (Vec<f64>, FactorPath) {
-        let path = factors
-            .factor(
-                pattern,
-                values,
-                mem,
-                &mut CompileScratch::default(),
-                compiled,
-            )
+        let path = SCRATCH
+            .with_borrow_mut(|sc| factors.factor(pattern, values, mem, sc, compiled))
             .expect("nonsingular");
         let mut x = b.to_vec();
         factors.solve(pattern, &mut x);

@@ -41,9 +41,9 @@
 //! only for another one (faer's rows). On `bench/peer/hexapod_drop.toml`
 //! (238 compilations of reduced dimension 78–138, 8.4 k updates each on
 //! average), callgrind: the row choice 157 M → 85 M instructions, the
-//! compilation 190 M → 86 M (both 348 M → 172 M), with dense passes over
-//! the `m²` positions and the dense arrays allocated, zeroed and freed at
-//! each compilation before.
+//! compilation 190 M → 81 M (both, `Factors::add_program`, 348 M →
+//! 166 M), with dense passes over the `m²` positions and the dense arrays
+//! allocated, zeroed and freed at each compilation before.
 //!
 //! # Numerically safe pivots
 //!
@@ -173,8 +173,9 @@ pub(crate) struct CompileScratch {
     /// [`CompiledLu::compile`]: pivot positions of rows and columns.
     row_pos: Vec<usize>,
     col_pos: Vec<usize>,
-    /// The current pivot's rows below it and columns right of it (their
-    /// values for [`CompiledLu::choose_rows`]).
+    /// The current pivot's rows left below it ([`CompiledLu::choose_rows`])
+    /// and its columns right of it (and their values in
+    /// [`CompiledLu::choose_rows`]).
     rows: Vec<usize>,
     cols: Vec<u32>,
     pivot_row: Vec<f64>,
@@ -201,9 +202,7 @@ impl CompileScratch {
             bits.resize(m * self.words, 0);
         }
     }
-}
 
-impl CompileScratch {
     /// The structure of the LU of the reduced structure (`col_ptr`,
     /// `row_idx`) in the pivot positions [`Self::row_pos`],
     /// [`Self::col_pos`] of dimension `m`, into the bit sets: the values',

@@ -822,3 +822,273 @@ impl CompiledLu {
         self.a[s as usize]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The program of the dense compilation this module had before its
+    /// scratch was kept (symbolic elimination on a dense `m × m` boolean
+    /// matrix): values, slots, pivots, `L`'s and `U`'s slots, updates and
+    /// the two streams.
+    #[derive(Debug, PartialEq)]
+    struct Program {
+        values: usize,
+        slots: usize,
+        pivot: Vec<u32>,
+        l_ptr: Vec<u32>,
+        l_slots: Vec<u32>,
+        u_ptr: Vec<u32>,
+        u_slots: Vec<u32>,
+        updates: Vec<u32>,
+        lower: Runs,
+        upper: Runs,
+    }
+
+    /// A stream's runs and entries.
+    type Runs = (Vec<(u32, u32)>, Vec<(u32, u32)>);
+
+    fn program(lu: &CompiledLu) -> Program {
+        Program {
+            values: lu.values,
+            slots: lu.slots,
+            pivot: lu.pivot.clone(),
+            l_ptr: lu.l_ptr.clone(),
+            l_slots: lu.l_slots.clone(),
+            u_ptr: lu.u_ptr.clone(),
+            u_slots: lu.u_slots.clone(),
+            updates: lu.updates.clone(),
+            lower: (lu.lower.runs.clone(), lu.lower.entries.clone()),
+            upper: (lu.upper.runs.clone(), lu.upper.entries.clone()),
+        }
+    }
+
+    fn dense_compile(
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        rows: &[usize],
+    ) -> Program {
+        let m = fwd.len();
+        let (mut row_pos, mut col_pos) = (vec![0; m], vec![0; m]);
+        for (i, &r) in rows.iter().enumerate() {
+            row_pos[r] = i;
+        }
+        for (c, &j) in fwd.iter().enumerate() {
+            col_pos[j] = c;
+        }
+        let mut nz = vec![false; m * m];
+        for j in 0..m {
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                nz[row_pos[r] * m + col_pos[j]] = true;
+            }
+        }
+        let mut pivots = Vec::new();
+        for k in 0..m {
+            let rows: Vec<usize> = (k + 1..m).filter(|&i| nz[i * m + k]).collect();
+            let cols: Vec<usize> = (k + 1..m).filter(|&j| nz[k * m + j]).collect();
+            for &i in &rows {
+                for &j in &cols {
+                    nz[i * m + j] = true;
+                }
+            }
+            pivots.push((rows, cols));
+        }
+        let mut slot = vec![u32::MAX; m * m];
+        let mut slots = 0u32;
+        for j in 0..m {
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                slot[row_pos[r] * m + col_pos[j]] = slots;
+                slots += 1;
+            }
+        }
+        let values = slots as usize;
+        for (s, &z) in slot.iter_mut().zip(&nz) {
+            if z && *s == u32::MAX {
+                *s = slots;
+                slots += 1;
+            }
+        }
+        let mut p = Program {
+            values,
+            slots: slots as usize,
+            pivot: Vec::new(),
+            l_ptr: vec![0],
+            l_slots: Vec::new(),
+            u_ptr: vec![0],
+            u_slots: Vec::new(),
+            updates: Vec::new(),
+            lower: (Vec::new(), Vec::new()),
+            upper: (Vec::new(), Vec::new()),
+        };
+        let mut lower = Stream::default();
+        for (k, (rows, cols)) in pivots.iter().enumerate() {
+            p.pivot.push(slot[k * m + k]);
+            p.l_slots.extend(rows.iter().map(|&i| slot[i * m + k]));
+            p.u_slots.extend(cols.iter().map(|&j| slot[k * m + j]));
+            for &i in rows {
+                p.updates.extend(cols.iter().map(|&j| slot[i * m + j]));
+                lower.push(i as u32, k as u32, slot[i * m + k]);
+            }
+            p.l_ptr.push(p.l_slots.len() as u32);
+            p.u_ptr.push(p.u_slots.len() as u32);
+        }
+        let mut upper = Stream::default();
+        for j in (0..m).rev() {
+            for i in 0..j {
+                if nz[i * m + j] {
+                    upper.push(i as u32, j as u32, slot[i * m + j]);
+                }
+            }
+        }
+        p.lower = (lower.runs, lower.entries);
+        p.upper = (upper.runs, upper.entries);
+        p
+    }
+
+    /// The row choice on dense arrays, as this module made it before.
+    fn dense_rows(
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        values: &[f64],
+    ) -> Option<Vec<usize>> {
+        let m = fwd.len();
+        let (mut d, mut nz) = (vec![0.0; m * m], vec![false; m * m]);
+        let (mut used, mut count, mut order) = (vec![false; m], vec![0usize; m], Vec::new());
+        for (c, &j) in fwd.iter().enumerate() {
+            for e in col_ptr[j]..col_ptr[j + 1] {
+                let r = row_idx[e];
+                d[r * m + c] = values[e];
+                nz[r * m + c] = true;
+                count[r] += 1;
+            }
+        }
+        for k in 0..m {
+            let mut rows = Vec::new();
+            let mut column = 0.0f64;
+            for r in 0..m {
+                if !used[r] && nz[r * m + k] {
+                    rows.push(r);
+                    count[r] -= 1;
+                    column = column.max(d[r * m + k].abs());
+                }
+            }
+            if !(column > 0.0 && column.is_finite()) {
+                return None;
+            }
+            let mut best: Option<(usize, usize, f64)> = None;
+            for &r in &rows {
+                let v = d[r * m + k].abs();
+                if v < ROW_CHOICE_THRESHOLD * column {
+                    continue;
+                }
+                let c = count[r];
+                if best.is_none_or(|(_, bc, b)| c < bc || (c == bc && v > b)) {
+                    best = Some((r, c, v));
+                }
+            }
+            let (p, _, _) = best?;
+            used[p] = true;
+            order.push(p);
+            let cols: Vec<usize> = (k + 1..m).filter(|&j| nz[p * m + j]).collect();
+            let inv = d[p * m + k].recip();
+            for &i in &rows {
+                if i == p {
+                    continue;
+                }
+                let l = d[i * m + k] * inv;
+                for &j in &cols {
+                    d[i * m + j] -= l * d[p * m + j];
+                    if !nz[i * m + j] {
+                        nz[i * m + j] = true;
+                        count[i] += 1;
+                    }
+                }
+            }
+        }
+        Some(order)
+    }
+
+    /// A sparse `m × m` CSC structure with values (a diagonal with some
+    /// entries left out, a few entries a column, ties of values), and a
+    /// column order.
+    fn case(m: usize, seed: u64) -> (Vec<usize>, Vec<usize>, Vec<f64>, Vec<usize>) {
+        let mut s = seed;
+        let mut next = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as usize
+        };
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..m {
+            let mut rows: Vec<usize> = (0..3).map(|_| next() % m).collect();
+            if next() % 4 != 0 {
+                rows.push(j);
+            }
+            rows.sort_unstable();
+            rows.dedup();
+            for r in rows {
+                row_idx.push(r);
+                // Few distinct magnitudes: ties of the row choice.
+                values.push([1.0, -2.0, 0.5, 2.0][next() % 4]);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let mut fwd: Vec<usize> = (0..m).collect();
+        for i in (1..m).rev() {
+            fwd.swap(i, next() % (i + 1));
+        }
+        (col_ptr, row_idx, values, fwd)
+    }
+
+    #[test]
+    fn programs_and_row_choices_equal_the_dense_ones() {
+        // One scratch for every case and dimension (one word of bits and
+        // several), as a solver keeps it.
+        let mut sc = CompileScratch::default();
+        let (mut chosen, mut symbolic) = (0, 0);
+        for (m, seed) in [
+            (1, 1),
+            (5, 2),
+            (19, 3),
+            (63, 4),
+            (64, 5),
+            (65, 6),
+            (130, 7),
+            (40, 8),
+            (200, 9),
+        ] {
+            let (col_ptr, row_idx, values, fwd) = case(m, seed);
+            let dense = dense_rows(&col_ptr, &row_idx, &fwd, &values);
+            let ours = CompiledLu::choose_rows(&mut sc, &col_ptr, &row_idx, &fwd, &values)
+                .map(<[usize]>::to_vec);
+            assert_eq!(ours, dense, "m = {m}: the row choice");
+            // The chosen order (compiled from the row choice's structure)
+            // and others (a symbolic elimination of their own).
+            let reverse: Vec<usize> = (0..m).rev().collect();
+            let orders = dense.iter().cloned().chain([reverse]);
+            for rows in orders {
+                let mut lu = CompiledLu::default();
+                if ours.as_deref() == Some(&rows[..]) {
+                    CompiledLu::choose_rows(&mut sc, &col_ptr, &row_idx, &fwd, &values);
+                    chosen += 1;
+                } else {
+                    symbolic += 1;
+                }
+                assert!(lu.compile(&mut sc, &col_ptr, &row_idx, &fwd, &rows, true));
+                assert_eq!(
+                    program(&lu),
+                    dense_compile(&col_ptr, &row_idx, &fwd, &rows),
+                    "m = {m}"
+                );
+                assert_eq!(lu.row_perm, rows);
+            }
+        }
+        assert!(
+            chosen >= 3 && symbolic >= 6,
+            "{chosen} chosen, {symbolic} symbolic"
+        );
+    }
+}

@@ -4,8 +4,8 @@
 //!
 //! # What is compiled
 //!
-//! faer's symbolic analysis gives the column ordering `Q` (COLAMD, see
-//! [`crate::lu`]); the values of the pattern's first factorisation give a
+//! faer's COLAMD gives the column ordering `Q` (see [`crate::lu`]); the
+//! values of the pattern's first factorisation give a
 //! row order `P`, by threshold Markowitz pivoting along `Q`
 //! ([`CompiledLu::choose_rows`]: among the rows whose entry is at least a
 //! tenth of the column's largest, the one of least fill; faer's partial
@@ -26,6 +26,24 @@
 //! The result is copied into the streams of the
 //! triangular sweeps ([`crate::lu::Factors`]), whose entries are fixed at
 //! compile time too.
+//!
+//! # The cost of a compilation
+//!
+//! The row choice and the compilation work on one scratch per solver
+//! ([`CompileScratch`], kept between compilations): dense `m × m` arrays
+//! (the row choice's values, the compilation's slots) restored only where
+//! they were set, and the structure as bit sets of each row's columns and
+//! each column's rows (64 a word), so that both visit the structure and
+//! its fill, not the `m²` positions, and find each column's rows in order
+//! without a sort. The compilation takes the structure the row choice's
+//! elimination left (the same elimination, the same fill) when it
+//! compiles that row order, and runs a symbolic elimination of its own
+//! only for another one (faer's rows). On `bench/peer/hexapod_drop.toml`
+//! (238 compilations of reduced dimension 78–138, 8.4 k updates each on
+//! average), callgrind: the row choice 157 M → 85 M instructions, the
+//! compilation 190 M → 81 M (both, `Factors::add_program`, 348 M →
+//! 166 M), with dense passes over the `m²` positions and the dense arrays
+//! allocated, zeroed and freed at each compilation before.
 //!
 //! # Numerically safe pivots
 //!
@@ -126,31 +144,195 @@ pub(crate) struct CompiledLu {
     /// The backward sweep's stream of slots, `U`'s columns last first,
     /// entries above the diagonal.
     pub(crate) upper: Stream<u32>,
-    /// Scratch of [`Self::compile`] and [`Self::choose_rows`], released
-    /// after the compilation.
-    scratch: Scratch,
 }
 
-/// Scratch of [`CompiledLu::compile`].
-#[derive(Clone, Default)]
-struct Scratch {
+/// Scratch of [`CompiledLu::choose_rows`] and [`CompiledLu::compile`],
+/// kept between compilations (one per solver, grown to the largest
+/// dimension `m` met): two dense `m × m` arrays, restored after each use
+/// at the entries it set (the filled structure, not all `m²`), and the
+/// structure as bit sets of each row's columns and each column's rows
+/// (`2·m·⌈m/64⌉` words, cleared at each use). About `12·m²` bytes: 220 kB
+/// at `m = 135`.
+#[derive(Default)]
+pub(crate) struct CompileScratch {
+    /// [`CompiledLu::choose_rows`]: the dense elimination's values, `0.0`
+    /// outside the structure between uses.
+    dense: Vec<f64>,
+    /// [`CompiledLu::compile`]: the slot of each position of `P·A·Q`,
+    /// `u32::MAX` outside the structure between uses.
+    slot: Vec<u32>,
+    /// Words of a row's (column's) bit set: `⌈m/64⌉`.
+    words: usize,
+    /// The structure: row `i`'s columns, bits of
+    /// `row_bits[i·words..(i+1)·words]`; column `j`'s rows the same in
+    /// `col_bits`.
+    row_bits: Vec<u64>,
+    col_bits: Vec<u64>,
+    /// [`CompiledLu::choose_rows`]: the rows taken, a bit set.
+    used: Vec<u64>,
+    /// [`CompiledLu::compile`]: pivot positions of rows and columns.
     row_pos: Vec<usize>,
     col_pos: Vec<usize>,
-    nz: Vec<bool>,
-    slot: Vec<u32>,
+    /// The current pivot's rows left below it ([`CompiledLu::choose_rows`])
+    /// and its columns right of it (and their values in
+    /// [`CompiledLu::choose_rows`]).
     rows: Vec<usize>,
-    cols: Vec<usize>,
-    /// [`CompiledLu::compile`]: the ends of each pivot's rows of `L` and
-    /// columns of `U` in `rows` and `cols` (all pivots').
-    ends: Vec<(usize, usize)>,
-    /// [`CompiledLu::choose_rows`]: the dense elimination, the rows
-    /// taken, the order.
-    dense: Vec<f64>,
-    used: Vec<bool>,
+    cols: Vec<u32>,
+    pivot_row: Vec<f64>,
+    /// [`CompiledLu::choose_rows`]: the pivot row's bit set.
+    pivot_bits: Vec<u64>,
+    /// [`CompiledLu::choose_rows`]: the order, and whether the bit sets
+    /// hold the structure of its elimination (which
+    /// [`CompiledLu::compile`] with that order then takes).
     order: Vec<usize>,
+    chosen: bool,
+    /// [`CompiledLu::compile`]: the rows' bit sets being permuted.
+    spare: Vec<u64>,
     /// Entries of each row right of the current column (the Markowitz
     /// row count).
     count: Vec<usize>,
+}
+
+impl CompileScratch {
+    /// Empty bit sets for dimension `m`.
+    fn clear_bits(&mut self, m: usize) {
+        self.words = m.div_ceil(64);
+        for bits in [&mut self.row_bits, &mut self.col_bits] {
+            bits.clear();
+            bits.resize(m * self.words, 0);
+        }
+    }
+
+    /// The structure of the LU of the reduced structure (`col_ptr`,
+    /// `row_idx`) in the pivot positions [`Self::row_pos`],
+    /// [`Self::col_pos`] of dimension `m`, into the bit sets: the values',
+    /// then the fill of a symbolic elimination, pivot after pivot. Pivot
+    /// `k`'s column and row are final when it is reached (only earlier
+    /// pivots fill them), and stay so; each of its rows below the
+    /// diagonal takes its row's columns right of it (64 columns a word),
+    /// the new ones the fill.
+    fn symbolic(&mut self, m: usize, col_ptr: &[usize], row_idx: &[usize]) {
+        self.clear_bits(m);
+        let w = self.words;
+        for j in 0..m {
+            let c = self.col_pos[j];
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                let i = self.row_pos[r];
+                set(&mut self.row_bits, i * w, c);
+                set(&mut self.col_bits, c * w, i);
+            }
+        }
+        for k in 0..m {
+            let (row_head, row_tail) = self.row_bits.split_at_mut((k + 1) * w);
+            let (col_head, col_tail) = self.col_bits.split_at_mut((k + 1) * w);
+            let pivot = &row_head[k * w..];
+            for i in bits(&col_head[k * w..], k + 1) {
+                let row = &mut row_tail[(i - k - 1) * w..(i - k) * w];
+                merge(row, pivot, k + 1, |j| {
+                    set(col_tail, (j - k - 1) * w, i);
+                });
+            }
+        }
+    }
+
+    /// The structure left by [`CompiledLu::choose_rows`] (rows as given)
+    /// with its rows in pivot order ([`Self::order`]): row `i`'s bit set
+    /// is that of row `order[i]`; the columns' sets cleared (to be
+    /// rebuilt).
+    fn permute_rows(&mut self) {
+        let w = self.words;
+        self.spare.clear();
+        for &r in &self.order {
+            self.spare
+                .extend_from_slice(&self.row_bits[r * w..(r + 1) * w]);
+        }
+        std::mem::swap(&mut self.spare, &mut self.row_bits);
+        self.col_bits.fill(0);
+    }
+}
+
+/// The number of set bits of `words` from bit `from` on.
+fn count(words: &[u64], from: usize) -> usize {
+    let first = from / 64;
+    words
+        .iter()
+        .enumerate()
+        .skip(first)
+        .map(|(w, &x)| {
+            let x = if w == first {
+                x & (u64::MAX << (from % 64))
+            } else {
+                x
+            };
+            x.count_ones() as usize
+        })
+        .sum()
+}
+
+/// The set bits of `words` from bit `from` on, in order.
+fn bits(words: &[u64], from: usize) -> Bits<'_> {
+    let index = from / 64;
+    let word = words
+        .get(index)
+        .map_or(0, |&w| w & (u64::MAX << (from % 64)));
+    Bits { words, index, word }
+}
+
+/// Iterator of [`bits`].
+struct Bits<'a> {
+    words: &'a [u64],
+    index: usize,
+    word: u64,
+}
+
+impl Iterator for Bits<'_> {
+    type Item = usize;
+
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        while self.word == 0 {
+            self.index += 1;
+            self.word = *self.words.get(self.index)?;
+        }
+        let bit = self.word.trailing_zeros() as usize;
+        self.word &= self.word - 1;
+        Some(self.index * 64 + bit)
+    }
+}
+
+/// Sets in `row` the bits of `pivot` from bit `from` on, calling `fill`
+/// with each bit newly set (in order).
+#[inline]
+fn merge(row: &mut [u64], pivot: &[u64], from: usize, mut fill: impl FnMut(usize)) {
+    let first = from / 64;
+    let mut mask = u64::MAX << (from % 64);
+    for (w, (r, &p)) in row.iter_mut().zip(pivot).enumerate().skip(first) {
+        let p = p & mask;
+        mask = u64::MAX;
+        let mut new = p & !*r;
+        *r |= p;
+        while new != 0 {
+            fill(w * 64 + new.trailing_zeros() as usize);
+            new &= new - 1;
+        }
+    }
+}
+
+/// Rows `a` and `b` (different) of the row-major `d` of `m` columns.
+fn two_rows(d: &mut [f64], m: usize, a: usize, b: usize) -> (&mut [f64], &mut [f64]) {
+    if a < b {
+        let (x, y) = d.split_at_mut(b * m);
+        (&mut x[a * m..(a + 1) * m], &mut y[..m])
+    } else {
+        let (x, y) = d.split_at_mut(a * m);
+        (&mut y[..m], &mut x[b * m..(b + 1) * m])
+    }
+}
+
+/// Sets bit `i` of the bit set starting at word `start` of `words`.
+#[inline]
+fn set(words: &mut [u64], start: usize, i: usize) {
+    words[start + i / 64] |= 1 << (i % 64);
 }
 
 /// A pivot failed its check: factor with faer instead.
@@ -161,12 +343,13 @@ impl CompiledLu {
     /// Compiles the LU of the `m × m` reduced structure (`col_ptr`,
     /// `row_idx`, CSC) with column order `fwd` (ordered position →
     /// column) and row order `row_perm` (pivot position → row), reusing
-    /// this value's storage. The first compilation allocates, with room
-    /// for programs of twice its size; a later one (a fallback's new row
-    /// order) only when `grow`, else it returns `false` and leaves the
-    /// program as it was when the new one does not fit.
+    /// this value's storage and the scratch `sc`. The first compilation
+    /// allocates, with room for programs of twice its size; a later one (a
+    /// fallback's new row order) only when `grow`, else it returns `false`
+    /// and leaves the program as it was when the new one does not fit.
     pub(crate) fn compile(
         &mut self,
+        sc: &mut CompileScratch,
         col_ptr: &[usize],
         row_idx: &[usize],
         fwd: &[usize],
@@ -176,49 +359,99 @@ impl CompiledLu {
         let m = fwd.len();
         assert!(u32::try_from(m * m).is_ok(), "dimension {m} beyond u32");
         let first = !self.is_compiled() || self.m != m;
-        let sc = &mut self.scratch;
+        if sc.slot.len() < m * m {
+            sc.slot.resize(m * m, u32::MAX);
+        }
+        debug_assert!(sc.slot.iter().all(|&s| s == u32::MAX));
         sc.row_pos.resize(m, 0);
         sc.col_pos.resize(m, 0);
-        sc.nz.clear();
-        sc.nz.resize(m * m, false);
-        sc.slot.resize(m * m, u32::MAX);
-        sc.rows.reserve(m);
-        sc.cols.reserve(m);
         for (i, &r) in row_perm.iter().enumerate() {
             sc.row_pos[r] = i;
         }
         for (c, &j) in fwd.iter().enumerate() {
             sc.col_pos[j] = c;
         }
-        // Symbolic elimination on a dense boolean matrix of P·A·Q, and the
-        // program's sizes.
-        let nz = &mut sc.nz;
-        for j in 0..m {
-            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                nz[sc.row_pos[r] * m + sc.col_pos[j]] = true;
-            }
+        let chosen = sc.chosen && sc.order == row_perm;
+        if chosen {
+            // The structure of the row choice's elimination along this
+            // order: the same fill, its rows in pivot order (the columns'
+            // sets rebuilt below).
+            sc.permute_rows();
+        } else {
+            sc.symbolic(m, col_ptr, row_idx);
         }
-        let mut n_upd = 0;
-        // Each pivot's rows and columns are final when it is reached
-        // (only earlier pivots fill them): kept for the program below.
-        sc.rows.clear();
-        sc.cols.clear();
-        sc.ends.clear();
-        for k in 0..m {
-            let (r0, c0) = (sc.rows.len(), sc.cols.len());
-            sc.rows.extend((k + 1..m).filter(|&i| nz[i * m + k]));
-            sc.cols.extend((k + 1..m).filter(|&j| nz[k * m + j]));
-            let (rows, cols) = (&sc.rows[r0..], &sc.cols[c0..]);
-            for &i in rows {
-                for &j in cols {
-                    nz[i * m + j] = true;
+        sc.chosen = false;
+        let fits = self.compile_with(sc, m, col_ptr, row_idx, chosen, first, grow);
+        if fits {
+            self.row_perm.clear();
+            self.row_perm.extend_from_slice(row_perm);
+        } else {
+            // The slot map back to `u32::MAX` where it was set, the
+            // structure (a program's emission does it as it reads them).
+            let w = sc.words;
+            for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+                for j in bits(row, 0) {
+                    sc.slot[i * m + j] = u32::MAX;
                 }
             }
-            n_upd += rows.len() * cols.len();
-            sc.ends.push((sc.rows.len(), sc.cols.len()));
         }
-        let (n_l, n_u) = (sc.rows.len(), sc.cols.len());
-        let n_slots = nz.iter().filter(|&&z| z).count();
+        debug_assert!(sc.slot.iter().all(|&s| s == u32::MAX));
+        fits
+    }
+
+    /// [`Self::compile`] once the scratch holds the pivot positions of the
+    /// rows and columns and the rows' bit sets of the structure, the
+    /// columns' too unless `rebuild`.
+    #[allow(clippy::too_many_arguments)]
+    fn compile_with(
+        &mut self,
+        sc: &mut CompileScratch,
+        m: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        rebuild: bool,
+        first: bool,
+        grow: bool,
+    ) -> bool {
+        let w = sc.words;
+        let slot = &mut sc.slot;
+        // The values' slots, in their CSC order (a factorisation copies
+        // them in one block), then the fill's, row-major.
+        let mut slots = 0u32;
+        for j in 0..m {
+            let c = sc.col_pos[j];
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                slot[sc.row_pos[r] * m + c] = slots;
+                slots += 1;
+            }
+        }
+        self.values = slots as usize;
+        // In one pass over the structure, row-major: the columns' bit sets
+        // when rebuilt, and pivot `k`'s rows of `L` (below the diagonal)
+        // and columns of `U` (right of it) counted.
+        sc.count.clear();
+        sc.count.resize(2 * m, 0);
+        let (l_count, u_count) = sc.count.split_at_mut(m);
+        for (i, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+            let target = &mut slot[i * m..(i + 1) * m];
+            for j in bits(row, 0) {
+                if rebuild {
+                    set(&mut sc.col_bits, j * w, i);
+                }
+                if target[j] == u32::MAX {
+                    target[j] = slots;
+                    slots += 1;
+                }
+                if j < i {
+                    l_count[j] += 1;
+                }
+            }
+            u_count[i] = count(row, i + 1);
+        }
+        let n_l: usize = l_count.iter().sum();
+        let n_u: usize = u_count.iter().sum();
+        let n_upd: usize = l_count.iter().zip(u_count.iter()).map(|(l, u)| l * u).sum();
+        let n_slots = slots as usize;
         if first {
             // Room for a later row order's program of up to twice the size.
             let dense = m * m;
@@ -242,26 +475,7 @@ impl CompiledLu {
             return false;
         }
         self.m = m;
-        // Slots: the values' in their CSC order (a factorisation copies
-        // them in one block), then the fill-in's, row-major.
-        let slot = &mut sc.slot;
-        slot.clear();
-        slot.resize(m * m, u32::MAX);
-        let mut slots = 0u32;
-        for j in 0..m {
-            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
-                slot[sc.row_pos[r] * m + sc.col_pos[j]] = slots;
-                slots += 1;
-            }
-        }
-        self.values = slots as usize;
-        for (s, &z) in slot.iter_mut().zip(nz.iter()) {
-            if z && *s == u32::MAX {
-                *s = slots;
-                slots += 1;
-            }
-        }
-        self.slots = slots as usize;
+        self.slots = n_slots;
         self.pivot.clear();
         self.l_ptr.clear();
         self.l_slots.clear();
@@ -271,42 +485,53 @@ impl CompiledLu {
         self.l_ptr.push(0);
         self.u_ptr.push(0);
         self.lower.clear();
-        let (mut r0, mut c0) = (0, 0);
-        for (k, &(r1, c1)) in sc.ends.iter().enumerate() {
+        for k in 0..m {
             // A structurally zero pivot gets no slot: it never verifies,
             // faer reports the singularity.
+            // Each position of the structure is read for the last time
+            // where it is emitted (a pivot here, `L` below, `U` with the
+            // backward sweep's stream), and its slot cleared there.
             self.pivot.push(slot[k * m + k]);
-            let (rows, cols) = (&sc.rows[r0..r1], &sc.cols[c0..c1]);
-            (r0, c0) = (r1, c1);
-            self.l_slots.extend(rows.iter().map(|&i| slot[i * m + k]));
-            self.u_slots.extend(cols.iter().map(|&j| slot[k * m + j]));
-            for &i in rows {
-                self.updates.extend(cols.iter().map(|&j| slot[i * m + j]));
-                self.lower.push(i as u32, k as u32, slot[i * m + k]);
+            slot[k * m + k] = u32::MAX;
+            sc.cols.clear();
+            sc.cols
+                .extend(bits(&sc.row_bits[k * w..(k + 1) * w], k + 1).map(|j| j as u32));
+            let pivot_row = &slot[k * m..(k + 1) * m];
+            self.u_slots
+                .extend(sc.cols.iter().map(|&j| pivot_row[j as usize]));
+            for i in bits(&sc.col_bits[k * w..(k + 1) * w], k + 1) {
+                let target = &slot[i * m..(i + 1) * m];
+                let s = target[k];
+                self.l_slots.push(s);
+                self.updates
+                    .extend(sc.cols.iter().map(|&j| target[j as usize]));
+                self.lower.rows.push(i as u32);
+                self.lower.vals.push(s);
+                slot[i * m + k] = u32::MAX;
             }
+            self.lower.end_run(k as u32);
             self.l_ptr.push(self.l_slots.len() as u32);
             self.u_ptr.push(self.u_slots.len() as u32);
         }
+        // `U` above the diagonal, last column first, each column's rows in
+        // order.
         self.upper.clear();
         for j in (0..m).rev() {
-            for i in 0..j {
-                if nz[i * m + j] {
-                    self.upper.push(i as u32, j as u32, slot[i * m + j]);
-                }
+            for i in bits(&sc.col_bits[j * w..(j + 1) * w], 0).take_while(|&i| i < j) {
+                self.upper.rows.push(i as u32);
+                self.upper
+                    .vals
+                    .push(std::mem::replace(&mut slot[i * m + j], u32::MAX));
             }
+            self.upper.end_run(j as u32);
         }
         self.lower.seal();
         self.upper.seal();
-        self.row_perm.clear();
-        self.row_perm.extend_from_slice(row_perm);
         self.a.clear();
         self.a.resize(self.slots, 0.0);
         let widest = self.u_ptr.windows(2).map(|p| p[1] - p[0]).max();
         self.u_row.clear();
         self.u_row.resize(widest.unwrap_or(0) as usize, 0.0);
-        // The scratch (dense m × m arrays) is not needed again: a pattern
-        // is compiled once.
-        self.scratch = Scratch::default();
         true
     }
 
@@ -315,30 +540,58 @@ impl CompiledLu {
     /// order `fwd`: at each column, among the rows whose entry is at least
     /// [`ROW_CHOICE_THRESHOLD`] of the column's largest, the one with the
     /// fewest entries right of the column (the least fill; ties to the
-    /// larger entry). An elimination of the first values on dense arrays
-    /// that visits only the pivot rows' and columns' entries (the LU's own
-    /// updates, kept rows counted as they fill), once per compilation. `None` when a column has no usable entry (faer's order
-    /// is then used). Writes the order into `order`; allocation-free once
-    /// the scratch has this dimension.
-    pub(crate) fn choose_rows(
-        &mut self,
+    /// larger entry, then to the first row). An elimination of the first
+    /// values on the dense array of the scratch `sc` that visits only the
+    /// structure (each column's rows left and the pivot row's columns from
+    /// their bit sets, the LU's own updates; kept rows counted as they
+    /// fill), once per compilation. `None` when a column has no usable
+    /// entry (faer's order is then used). Writes the order into the
+    /// scratch; allocation-free once the scratch has this dimension.
+    pub(crate) fn choose_rows<'s>(
+        sc: &'s mut CompileScratch,
         col_ptr: &[usize],
         row_idx: &[usize],
         fwd: &[usize],
         values: &[f64],
-    ) -> Option<&[usize]> {
+    ) -> Option<&'s [usize]> {
         let m = fwd.len();
-        let sc = &mut self.scratch;
-        sc.dense.clear();
-        sc.dense.resize(m * m, 0.0);
-        sc.nz.clear();
-        sc.nz.resize(m * m, false);
+        if sc.dense.len() < m * m {
+            sc.dense.resize(m * m, 0.0);
+        }
+        debug_assert!(sc.dense.iter().all(|&v| v.to_bits() == 0));
+        sc.clear_bits(m);
+        let found = Self::eliminate(sc, m, col_ptr, row_idx, fwd, values);
+        sc.chosen = found;
+        // The dense values back to zero where they were set: the
+        // structure.
+        let w = sc.words;
+        for (r, row) in sc.row_bits.chunks_exact(w.max(1)).take(m).enumerate() {
+            for c in bits(row, 0) {
+                sc.dense[r * m + c] = 0.0;
+            }
+        }
+        debug_assert!(sc.dense.iter().all(|&v| v.to_bits() == 0));
+        found.then_some(&sc.order[..])
+    }
+
+    /// The elimination of [`Self::choose_rows`] into `sc.order`, once the
+    /// scratch has empty bit sets; `false` when a column has no usable
+    /// entry.
+    fn eliminate(
+        sc: &mut CompileScratch,
+        m: usize,
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        values: &[f64],
+    ) -> bool {
+        let w = sc.words;
         sc.used.clear();
-        sc.used.resize(m, false);
+        sc.used.resize(w, 0);
         sc.order.clear();
         sc.count.clear();
         sc.count.resize(m, 0);
-        let (d, nz, count) = (&mut sc.dense, &mut sc.nz, &mut sc.count);
+        let (d, count) = (&mut sc.dense, &mut sc.count);
         // Rows as given, columns in order: d[r·m + c].
         for (c, &j) in fwd.iter().enumerate() {
             for (&r, &v) in row_idx[col_ptr[j]..col_ptr[j + 1]]
@@ -346,24 +599,33 @@ impl CompiledLu {
                 .zip(&values[col_ptr[j]..col_ptr[j + 1]])
             {
                 d[r * m + c] = v;
-                nz[r * m + c] = true;
                 count[r] += 1;
+                set(&mut sc.row_bits, r * w, c);
+                set(&mut sc.col_bits, c * w, r);
             }
         }
         for k in 0..m {
-            // The rows left with an entry in column k; `count` becomes
-            // each row's entries right of it.
+            // The rows left with an entry in column k, in order (the
+            // column is final: only earlier pivots fill it); `count`
+            // becomes each row's entries right of it.
             sc.rows.clear();
             let mut column = 0.0f64;
-            for r in 0..m {
-                if !sc.used[r] && nz[r * m + k] {
+            for (x, (&c, &u)) in sc.col_bits[k * w..(k + 1) * w]
+                .iter()
+                .zip(&sc.used)
+                .enumerate()
+            {
+                let mut b = c & !u;
+                while b != 0 {
+                    let r = x * 64 + b.trailing_zeros() as usize;
+                    b &= b - 1;
                     sc.rows.push(r);
                     count[r] -= 1;
                     column = column.max(d[r * m + k].abs());
                 }
             }
             if !(column > 0.0 && column.is_finite()) {
-                return None;
+                return false;
             }
             let mut best: Option<(usize, usize, f64)> = None;
             for &r in &sc.rows {
@@ -376,27 +638,57 @@ impl CompiledLu {
                     best = Some((r, c, v));
                 }
             }
-            let (p, _, _) = best?;
-            sc.used[p] = true;
+            let Some((p, _, _)) = best else {
+                return false;
+            };
+            set(&mut sc.used, 0, p);
             sc.order.push(p);
+            // The pivot row's columns right of k and their values (the
+            // updates of step k change other rows only).
+            let pivot = &sc.row_bits[p * w..(p + 1) * w];
             sc.cols.clear();
-            sc.cols.extend((k + 1..m).filter(|&j| nz[p * m + j]));
+            sc.pivot_row.clear();
+            for j in bits(pivot, k + 1) {
+                sc.cols.push(j as u32);
+                sc.pivot_row.push(d[p * m + j]);
+            }
+            sc.pivot_bits.clear();
+            sc.pivot_bits.extend_from_slice(pivot);
             let inv = d[p * m + k].recip();
-            for &i in &sc.rows {
-                if i == p {
-                    continue;
-                }
-                let l = d[i * m + k] * inv;
-                for &j in &sc.cols {
-                    d[i * m + j] -= l * d[p * m + j];
-                    if !nz[i * m + j] {
-                        nz[i * m + j] = true;
-                        count[i] += 1;
-                    }
+            // The other rows, two at a time (the pivot row's values read
+            // once for both; each entry takes the same operations).
+            sc.rows.retain(|&i| i != p);
+            let (pairs, last) = sc.rows.as_chunks::<2>();
+            for &[i1, i2] in pairs {
+                let (t1, t2) = two_rows(d, m, i1, i2);
+                let (l1, l2) = (t1[k] * inv, t2[k] * inv);
+                for (&j, &u) in sc.cols.iter().zip(&sc.pivot_row) {
+                    t1[j as usize] -= l1 * u;
+                    t2[j as usize] -= l2 * u;
                 }
             }
+            if let [i] = *last {
+                let target = &mut d[i * m..(i + 1) * m];
+                let l = target[k] * inv;
+                for (&j, &u) in sc.cols.iter().zip(&sc.pivot_row) {
+                    target[j as usize] -= l * u;
+                }
+            }
+            for &i in &sc.rows {
+                let col_bits = &mut sc.col_bits;
+                let count_i = &mut count[i];
+                merge(
+                    &mut sc.row_bits[i * w..(i + 1) * w],
+                    &sc.pivot_bits,
+                    k + 1,
+                    |j| {
+                        *count_i += 1;
+                        set(col_bits, j * w, i);
+                    },
+                );
+            }
         }
-        Some(&self.scratch.order)
+        true
     }
 
     /// Whether a program has been compiled.
@@ -530,5 +822,286 @@ impl CompiledLu {
     #[inline]
     pub(crate) fn value(&self, s: u32) -> f64 {
         self.a[s as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The program of the dense compilation this module had before its
+    /// scratch was kept (symbolic elimination on a dense `m × m` boolean
+    /// matrix): values, slots, pivots, `L`'s and `U`'s slots, updates and
+    /// the two streams.
+    #[derive(Debug, PartialEq)]
+    struct Program {
+        values: usize,
+        slots: usize,
+        pivot: Vec<u32>,
+        l_ptr: Vec<u32>,
+        l_slots: Vec<u32>,
+        u_ptr: Vec<u32>,
+        u_slots: Vec<u32>,
+        updates: Vec<u32>,
+        lower: Runs,
+        upper: Runs,
+    }
+
+    /// A stream's runs, entries (rows, slots) and pieces.
+    type Runs = (Vec<(u32, u32)>, Vec<u32>, Vec<u32>, Vec<crate::lu::Piece>);
+
+    fn runs(s: &Stream<u32>) -> Runs {
+        (
+            s.runs.clone(),
+            s.rows.clone(),
+            s.vals.clone(),
+            s.pieces.clone(),
+        )
+    }
+
+    fn program(lu: &CompiledLu) -> Program {
+        Program {
+            values: lu.values,
+            slots: lu.slots,
+            pivot: lu.pivot.clone(),
+            l_ptr: lu.l_ptr.clone(),
+            l_slots: lu.l_slots.clone(),
+            u_ptr: lu.u_ptr.clone(),
+            u_slots: lu.u_slots.clone(),
+            updates: lu.updates.clone(),
+            lower: runs(&lu.lower),
+            upper: runs(&lu.upper),
+        }
+    }
+
+    fn dense_compile(
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        rows: &[usize],
+    ) -> Program {
+        let m = fwd.len();
+        let (mut row_pos, mut col_pos) = (vec![0; m], vec![0; m]);
+        for (i, &r) in rows.iter().enumerate() {
+            row_pos[r] = i;
+        }
+        for (c, &j) in fwd.iter().enumerate() {
+            col_pos[j] = c;
+        }
+        let mut nz = vec![false; m * m];
+        for j in 0..m {
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                nz[row_pos[r] * m + col_pos[j]] = true;
+            }
+        }
+        let mut pivots = Vec::new();
+        for k in 0..m {
+            let rows: Vec<usize> = (k + 1..m).filter(|&i| nz[i * m + k]).collect();
+            let cols: Vec<usize> = (k + 1..m).filter(|&j| nz[k * m + j]).collect();
+            for &i in &rows {
+                for &j in &cols {
+                    nz[i * m + j] = true;
+                }
+            }
+            pivots.push((rows, cols));
+        }
+        let mut slot = vec![u32::MAX; m * m];
+        let mut slots = 0u32;
+        for j in 0..m {
+            for &r in &row_idx[col_ptr[j]..col_ptr[j + 1]] {
+                slot[row_pos[r] * m + col_pos[j]] = slots;
+                slots += 1;
+            }
+        }
+        let values = slots as usize;
+        for (s, &z) in slot.iter_mut().zip(&nz) {
+            if z && *s == u32::MAX {
+                *s = slots;
+                slots += 1;
+            }
+        }
+        let mut p = Program {
+            values,
+            slots: slots as usize,
+            pivot: Vec::new(),
+            l_ptr: vec![0],
+            l_slots: Vec::new(),
+            u_ptr: vec![0],
+            u_slots: Vec::new(),
+            updates: Vec::new(),
+            lower: Default::default(),
+            upper: Default::default(),
+        };
+        let mut lower = Stream::default();
+        for (k, (rows, cols)) in pivots.iter().enumerate() {
+            p.pivot.push(slot[k * m + k]);
+            p.l_slots.extend(rows.iter().map(|&i| slot[i * m + k]));
+            p.u_slots.extend(cols.iter().map(|&j| slot[k * m + j]));
+            for &i in rows {
+                p.updates.extend(cols.iter().map(|&j| slot[i * m + j]));
+                lower.push(i as u32, k as u32, slot[i * m + k]);
+            }
+            p.l_ptr.push(p.l_slots.len() as u32);
+            p.u_ptr.push(p.u_slots.len() as u32);
+        }
+        let mut upper = Stream::default();
+        for j in (0..m).rev() {
+            for i in 0..j {
+                if nz[i * m + j] {
+                    upper.push(i as u32, j as u32, slot[i * m + j]);
+                }
+            }
+        }
+        lower.seal();
+        upper.seal();
+        p.lower = runs(&lower);
+        p.upper = runs(&upper);
+        p
+    }
+
+    /// The row choice on dense arrays, as this module made it before.
+    fn dense_rows(
+        col_ptr: &[usize],
+        row_idx: &[usize],
+        fwd: &[usize],
+        values: &[f64],
+    ) -> Option<Vec<usize>> {
+        let m = fwd.len();
+        let (mut d, mut nz) = (vec![0.0; m * m], vec![false; m * m]);
+        let (mut used, mut count, mut order) = (vec![false; m], vec![0usize; m], Vec::new());
+        for (c, &j) in fwd.iter().enumerate() {
+            for e in col_ptr[j]..col_ptr[j + 1] {
+                let r = row_idx[e];
+                d[r * m + c] = values[e];
+                nz[r * m + c] = true;
+                count[r] += 1;
+            }
+        }
+        for k in 0..m {
+            let mut rows = Vec::new();
+            let mut column = 0.0f64;
+            for r in 0..m {
+                if !used[r] && nz[r * m + k] {
+                    rows.push(r);
+                    count[r] -= 1;
+                    column = column.max(d[r * m + k].abs());
+                }
+            }
+            if !(column > 0.0 && column.is_finite()) {
+                return None;
+            }
+            let mut best: Option<(usize, usize, f64)> = None;
+            for &r in &rows {
+                let v = d[r * m + k].abs();
+                if v < ROW_CHOICE_THRESHOLD * column {
+                    continue;
+                }
+                let c = count[r];
+                if best.is_none_or(|(_, bc, b)| c < bc || (c == bc && v > b)) {
+                    best = Some((r, c, v));
+                }
+            }
+            let (p, _, _) = best?;
+            used[p] = true;
+            order.push(p);
+            let cols: Vec<usize> = (k + 1..m).filter(|&j| nz[p * m + j]).collect();
+            let inv = d[p * m + k].recip();
+            for &i in &rows {
+                if i == p {
+                    continue;
+                }
+                let l = d[i * m + k] * inv;
+                for &j in &cols {
+                    d[i * m + j] -= l * d[p * m + j];
+                    if !nz[i * m + j] {
+                        nz[i * m + j] = true;
+                        count[i] += 1;
+                    }
+                }
+            }
+        }
+        Some(order)
+    }
+
+    /// A sparse `m × m` CSC structure with values (a diagonal with some
+    /// entries left out, a few entries a column, ties of values), and a
+    /// column order.
+    fn case(m: usize, seed: u64) -> (Vec<usize>, Vec<usize>, Vec<f64>, Vec<usize>) {
+        let mut s = seed;
+        let mut next = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) as usize
+        };
+        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
+        for j in 0..m {
+            let mut rows: Vec<usize> = (0..3).map(|_| next() % m).collect();
+            if next() % 4 != 0 {
+                rows.push(j);
+            }
+            rows.sort_unstable();
+            rows.dedup();
+            for r in rows {
+                row_idx.push(r);
+                // Few distinct magnitudes: ties of the row choice.
+                values.push([1.0, -2.0, 0.5, 2.0][next() % 4]);
+            }
+            col_ptr.push(row_idx.len());
+        }
+        let mut fwd: Vec<usize> = (0..m).collect();
+        for i in (1..m).rev() {
+            fwd.swap(i, next() % (i + 1));
+        }
+        (col_ptr, row_idx, values, fwd)
+    }
+
+    #[test]
+    fn programs_and_row_choices_equal_the_dense_ones() {
+        // One scratch for every case and dimension (one word of bits and
+        // several), as a solver keeps it.
+        let mut sc = CompileScratch::default();
+        let (mut chosen, mut symbolic) = (0, 0);
+        for (m, seed) in [
+            (1, 1),
+            (5, 2),
+            (19, 3),
+            (63, 4),
+            (64, 5),
+            (65, 6),
+            (130, 7),
+            (40, 8),
+            (200, 9),
+        ] {
+            let (col_ptr, row_idx, values, fwd) = case(m, seed);
+            let dense = dense_rows(&col_ptr, &row_idx, &fwd, &values);
+            let ours = CompiledLu::choose_rows(&mut sc, &col_ptr, &row_idx, &fwd, &values)
+                .map(<[usize]>::to_vec);
+            assert_eq!(ours, dense, "m = {m}: the row choice");
+            // The chosen order (compiled from the row choice's structure)
+            // and others (a symbolic elimination of their own).
+            let reverse: Vec<usize> = (0..m).rev().collect();
+            let orders = dense.iter().cloned().chain([reverse]);
+            for rows in orders {
+                let mut lu = CompiledLu::default();
+                if ours.as_deref() == Some(&rows[..]) {
+                    CompiledLu::choose_rows(&mut sc, &col_ptr, &row_idx, &fwd, &values);
+                    chosen += 1;
+                } else {
+                    symbolic += 1;
+                }
+                assert!(lu.compile(&mut sc, &col_ptr, &row_idx, &fwd, &rows, true));
+                assert_eq!(
+                    program(&lu),
+                    dense_compile(&col_ptr, &row_idx, &fwd, &rows),
+                    "m = {m}"
+                );
+                assert_eq!(lu.row_perm, rows);
+            }
+        }
+        assert!(
+            chosen >= 3 && symbolic >= 6,
+            "{chosen} chosen, {symbolic} symbolic"
+        );
     }
 }

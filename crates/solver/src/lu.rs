@@ -1,6 +1,6 @@
 //! The sparse LU of one Jacobian pattern: its CSC structure, faer's
-//! symbolic analysis (COLAMD column ordering), faer's simplicial numeric LU
-//! with partial pivoting, and the triangular solves with those factors.
+//! COLAMD column ordering, faer's simplicial numeric LU with partial
+//! pivoting, and the triangular solves with those factors.
 //!
 //! # Singleton rows
 //!
@@ -39,8 +39,14 @@
 //!
 //! # Why faer's simplicial LU, called directly
 //!
-//! * The symbolic analysis is forced to the *simplicial* LU
-//!   ([`SupernodalThreshold::FORCE_SIMPLICIAL`]). faer 0.24.4's supernodal
+//! * The LU is faer's *simplicial* one, and its symbolic analysis faer's
+//!   COLAMD ordering alone ([`colamd::order`] with the default parameters
+//!   of faer's symbolic LU, whose column permutation it is: with the
+//!   simplicial LU forced, `factorize_symbolic_lu` adds only an
+//!   elimination tree and column counts, which the simplicial numeric LU
+//!   does not use; calling COLAMD alone saved a third of the 84 M
+//!   instructions of the 191 patterns of `bench/peer/hexapod_drop.toml`).
+//!   faer 0.24.4's supernodal
 //!   numeric LU allocates fresh per-supernode work vectors on every call
 //!   (`contrib_work` in `factorize_supernodal_numeric_lu`), so it could
 //!   never be allocation-free; on the 20–60 unknown, very sparse systems of
@@ -104,15 +110,15 @@
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::perm::{Perm, PermRef};
 use faer::sparse::linalg::LuError;
-use faer::sparse::linalg::SupernodalThreshold;
+use faer::sparse::linalg::colamd;
+use faer::sparse::linalg::lu::LuSymbolicParams;
 use faer::sparse::linalg::lu::simplicial::{
     SimplicialLu, factorize_simplicial_numeric_lu, factorize_simplicial_numeric_lu_scratch,
 };
-use faer::sparse::linalg::lu::{LuSymbolicParams, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat, SymbolicSparseColMatRef};
 
 use crate::SolverError;
-use crate::compiled::{CompiledLu, MAX_PERTURBED};
+use crate::compiled::{CompileScratch, CompiledLu, MAX_PERTURBED};
 
 /// Which path a factorisation took (see [`crate::compiled`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -223,33 +229,95 @@ fn zero_signature(values: &[f64]) -> u64 {
     h
 }
 
+/// Sorts `entries` (`(row, col)`, each below `n`, else it panics)
+/// column-major, rows in order within a column, and removes the
+/// duplicates: a stable counting sort by row, then by column, `O(len + n)`
+/// (a comparison sort cost 0.3 M instructions a pattern on
+/// `bench/peer/hexapod_drop.toml`, 1 600 entries of 150 unknowns).
+fn sort_entries(n: usize, entries: &mut Vec<(usize, usize)>) {
+    let mut start = vec![0usize; n + 1];
+    let mut col_start = vec![0usize; n + 1];
+    for &(row, col) in entries.iter() {
+        assert!(
+            row < n && col < n,
+            "Jacobian pattern entry ({row}, {col}) is out of range for dimension {n}"
+        );
+        start[row + 1] += 1;
+        col_start[col + 1] += 1;
+    }
+    let mut by_row = vec![(0, 0); entries.len()];
+    for j in 0..n {
+        start[j + 1] += start[j];
+        col_start[j + 1] += col_start[j];
+    }
+    for &e in entries.iter() {
+        by_row[start[e.0]] = e;
+        start[e.0] += 1;
+    }
+    let mut start = col_start;
+    for &e in &by_row {
+        entries[start[e.1]] = e;
+        start[e.1] += 1;
+    }
+    entries.dedup();
+}
+
+/// The COLAMD column ordering of `structure` (ordered position →
+/// column), as faer's symbolic LU computes it with its default
+/// parameters (`factorize_symbolic_lu` with a simplicial LU keeps it as
+/// it is; the elimination tree and column counts it computes besides are
+/// not used here).
+fn colamd_order(structure: SymbolicSparseColMatRef<'_, usize>) -> Vec<usize> {
+    let n = structure.ncols();
+    let (mut fwd, mut inv) = (vec![0usize; n], vec![0usize; n]);
+    let mut mem = MemBuffer::new(colamd::order_scratch::<usize>(
+        n,
+        n,
+        structure.compute_nnz(),
+    ));
+    colamd::order(
+        &mut fwd,
+        &mut inv,
+        structure,
+        LuSymbolicParams::default().colamd_params,
+        MemStack::new(&mut mem),
+    )
+    .unwrap_or_else(|e| panic!("faer COLAMD ordering failed: {e:?}"));
+    fwd
+}
+
 impl Pattern {
     /// The structure of `entries` (any order, duplicates allowed), its
     /// singleton rows taken out and the column ordering of the rest, as
     /// pattern `id`; [`Self::factors`] is to be set by the caller (storage
     /// of dimension [`Self::m`]). Allocates.
+    ///
+    /// Linear in the entries and `n` but for COLAMD and the dense slot
+    /// map's fill: on `bench/peer/hexapod_drop.toml` (191 patterns, 150
+    /// unknowns, 1 600 entries), 207 M → 133 M instructions (callgrind) with
+    /// the counting sort, faer's COLAMD alone and fewer passes over the
+    /// entries; of those, COLAMD 58 M and the slot map's fill 17 M (a
+    /// `rep stosb` that callgrind counts byte by byte: 90 kB a pattern, a few
+    /// microseconds).
     pub(crate) fn build(id: usize, n: usize, entries: &mut Vec<(usize, usize)>) -> Self {
-        for &(row, col) in entries.iter() {
-            assert!(
-                row < n && col < n,
-                "Jacobian pattern entry ({row}, {col}) is out of range for dimension {n}"
-            );
-        }
-        // Column-major order, rows sorted within a column, no duplicates.
-        entries.sort_unstable_by_key(|&(row, col)| (col, row));
-        entries.dedup();
+        // Column-major order, rows sorted within a column, no duplicates
+        // (entries out of range panic).
+        sort_entries(n, entries);
         let nnz = entries.len();
         assert!(
             nnz < u32::MAX as usize,
             "Jacobian pattern has too many entries ({nnz})"
         );
 
-        // Singleton rows, in row order; a column is claimed once.
+        // Singleton rows, in row order; a column is claimed once. (And
+        // each column's entries: the full structure's column pointers.)
         let mut row_count = vec![0usize; n];
         let mut row_col = vec![0usize; n];
+        let mut full_ptr = vec![0usize; n + 1];
         for &(row, col) in entries.iter() {
             row_count[row] += 1;
             row_col[row] = col;
+            full_ptr[col + 1] += 1;
         }
         const NONE: usize = usize::MAX;
         let mut single_of_row = vec![NONE; n];
@@ -274,57 +342,45 @@ impl Pattern {
         for (c, &col) in kept_cols.iter().enumerate() {
             reduced_col[col] = c;
         }
+        // An eliminated column's entries other than its singleton's are
+        // in kept rows (a second singleton row of the column is kept).
+        let n_couplings: usize = singles.iter().map(|&(_, col)| full_ptr[col + 1] - 1).sum();
+        let reduced_nnz = nnz - singles.len() - n_couplings;
+        for j in 0..n {
+            full_ptr[j + 1] += full_ptr[j];
+        }
 
-        // The reduced CSC structure (entries stay in column-major order).
+        // In one pass: the reduced CSC structure (entries stay in
+        // column-major order), the slots, the full structure's rows.
         let mut col_ptr = vec![0usize; m + 1];
-        let mut row_idx = Vec::with_capacity(nnz);
-        for &(row, col) in entries.iter() {
-            if single_of_row[row] == NONE && single_of_col[col] == NONE {
-                col_ptr[reduced_col[col] + 1] += 1;
-                row_idx.push(reduced_row[row]);
-            }
-        }
-        for j in 0..m {
-            col_ptr[j + 1] += col_ptr[j];
-        }
-        let reduced_nnz = row_idx.len();
+        let mut row_idx = Vec::with_capacity(reduced_nnz);
+        let mut full_rows = Vec::with_capacity(nnz);
         let mut slot = vec![u32::MAX; n * n];
-        let mut couplings = Vec::new();
-        let mut k = 0;
+        let mut couplings = Vec::with_capacity(n_couplings);
         for &(row, col) in entries.iter() {
+            full_rows.push(row);
             let s = if single_of_row[row] != NONE {
                 reduced_nnz + single_of_row[row]
             } else if single_of_col[col] != NONE {
                 couplings.push((row, single_of_col[col]));
                 reduced_nnz + singles.len() + couplings.len() - 1
             } else {
-                k += 1;
-                k - 1
+                col_ptr[reduced_col[col] + 1] += 1;
+                row_idx.push(reduced_row[row]);
+                row_idx.len() - 1
             };
             slot[row * n + col] = s as u32;
+        }
+        debug_assert_eq!(row_idx.len(), reduced_nnz);
+        for j in 0..m {
+            col_ptr[j + 1] += col_ptr[j];
         }
 
         // The full pattern's COLAMD ordering, restricted to the kept
         // columns.
-        let params = LuSymbolicParams {
-            supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SIMPLICIAL,
-            ..Default::default()
-        };
-        let mut full_ptr = vec![0usize; n + 1];
-        for &(_, col) in entries.iter() {
-            full_ptr[col + 1] += 1;
-        }
-        for j in 0..n {
-            full_ptr[j + 1] += full_ptr[j];
-        }
-        let full_rows: Vec<usize> = entries.iter().map(|e| e.0).collect();
         let full = SymbolicSparseColMatRef::new_checked(n, n, &full_ptr, None, &full_rows);
-        let symbolic = factorize_symbolic_lu(full, params)
-            .unwrap_or_else(|e| panic!("faer symbolic LU failed: {e:?}"));
-        let fwd: Vec<usize> = symbolic
-            .col_perm()
-            .arrays()
-            .0
+        let full_order = colamd_order(full);
+        let fwd: Vec<usize> = full_order
             .iter()
             .filter(|&&c| single_of_col[c] == NONE)
             .map(|&c| reduced_col[c])
@@ -409,7 +465,7 @@ pub(crate) struct Stream<T> {
     pub(crate) pieces: Vec<Piece>,
     /// `(column j, end)` of each column's entries as pushed:
     /// `entries[end of the previous..end]`; non-empty columns only.
-    runs: Vec<(u32, u32)>,
+    pub(crate) runs: Vec<(u32, u32)>,
     /// The entries' rows.
     pub(crate) rows: Vec<u32>,
     /// The entries' values.
@@ -470,6 +526,17 @@ impl<T> Stream<T> {
         self.runs.clear();
         self.rows.clear();
         self.vals.clear();
+    }
+
+    /// Closes column `j`'s run: the entries pushed since the last run
+    /// (directly into [`Self::rows`] and [`Self::vals`]) are column `j`'s,
+    /// a run when there are any. The same as [`Self::push`] for each of
+    /// them.
+    pub(crate) fn end_run(&mut self, j: u32) {
+        let end = self.rows.len() as u32;
+        if self.runs.last().map_or(0, |&(_, e)| e) < end {
+            self.runs.push((j, end));
+        }
     }
 
     /// Appends entry `(i, v)` of column `j` (a column's entries must be
@@ -677,11 +744,18 @@ impl Factors {
     /// of faer's factorisation of these values just made when `faer_rows`,
     /// else nothing is compiled. Allocates, as a pattern's registration
     /// does.
-    fn add_program(&mut self, pattern: &mut Pattern, reduced: &[f64], zeros: u64, faer_rows: bool) {
+    fn add_program(
+        &mut self,
+        sc: &mut CompileScratch,
+        pattern: &mut Pattern,
+        reduced: &[f64],
+        zeros: u64,
+        faer_rows: bool,
+    ) {
         let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
         let fwd = pattern.col_perm.arrays().0;
         let mut program = CompiledLu::default();
-        let rows = match program.choose_rows(col_ptr, row_idx, fwd, reduced) {
+        let rows = match CompiledLu::choose_rows(sc, col_ptr, row_idx, fwd, reduced) {
             Some(order) => {
                 self.row_choice.clear();
                 self.row_choice.extend_from_slice(order);
@@ -690,7 +764,7 @@ impl Factors {
             None if faer_rows => &self.row_perm,
             None => return,
         };
-        program.compile(col_ptr, row_idx, fwd, rows, true);
+        program.compile(sc, col_ptr, row_idx, fwd, rows, true);
         pattern.programs.push((zeros, program));
     }
 
@@ -752,7 +826,10 @@ impl Factors {
 
     /// Numeric LU of `values` (the layout of `pattern`'s slots), reusing its
     /// column ordering; the eliminated rows' pivots and columns are copied
-    /// into `pattern`. `mem` must hold [`Self::scratch`]. Allocation-free.
+    /// into `pattern`. `mem` must hold [`Self::scratch`]; `sc` is the
+    /// scratch of a compilation (the pattern's first factorisation with
+    /// `compiled`, or a set of exact zeros' second fallback, which allocate
+    /// the program). Allocation-free otherwise.
     ///
     /// # Errors
     /// [`SolverError::Singular`] when faer finds no structurally non-zero
@@ -763,6 +840,7 @@ impl Factors {
         pattern: &mut Pattern,
         values: &[f64],
         mem: &mut MemBuffer,
+        sc: &mut CompileScratch,
         compiled: bool,
     ) -> Result<FactorPath, SolverError> {
         let n = self.n;
@@ -786,7 +864,7 @@ impl Factors {
         if compiled && n > 0 && pattern.programs.is_empty() {
             // The pattern's first program, before any factorisation; where
             // the row choice finds no pivot, faer's LU below and its rows.
-            self.add_program(pattern, reduced, zeros, false);
+            self.add_program(sc, pattern, reduced, zeros, false);
         }
         let known = pattern.programs.iter().position(|(z, _)| *z == zeros);
         if compiled && n > 0 && !pattern.programs.is_empty() {
@@ -905,7 +983,7 @@ impl Factors {
                 // mostly a passing cancellation; recompiling on such values
                 // was measured dearer, 1.6 M instructions a time on the
                 // hexapod walk).
-                self.add_program(pattern, reduced, zeros, true);
+                self.add_program(sc, pattern, reduced, zeros, true);
             }
         }
         self.owner = Some(pattern.id);
@@ -1200,7 +1278,7 @@ const WOODBURY_CHECK: f64 = 1e-13;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use faer::sparse::linalg::lu::NumericLu;
+    use faer::sparse::linalg::lu::{NumericLu, factorize_symbolic_lu};
     use faer::{Conj, MatMut, Par};
 
     /// A stream's pieces hold every entry once, in order, segments only
@@ -1338,7 +1416,13 @@ mod tests {
                 ));
             let mut factors = Factors::new(pattern.m);
             factors
-                .factor(&mut pattern, &values, &mut mem, false)
+                .factor(
+                    &mut pattern,
+                    &values,
+                    &mut mem,
+                    &mut CompileScratch::default(),
+                    false,
+                )
                 .expect("nonsingular");
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
             let mut ours = b.clone();
@@ -1379,6 +1463,12 @@ mod tests {
         }
     }
 
+    thread_local! {
+        /// One compilation scratch per test, reused by all its patterns
+        /// and dimensions (as a solver's is).
+        static SCRATCH: std::cell::RefCell<CompileScratch> = Default::default();
+    }
+
     /// Solution of `pattern`'s system with `values` and right-hand side
     /// `b`, through `factors` (compiled path or not), with its path.
     fn solve_with(
@@ -1389,8 +1479,8 @@ mod tests {
         mem: &mut MemBuffer,
         compiled: bool,
     ) -> (Vec<f64>, FactorPath) {
-        let path = factors
-            .factor(pattern, values, mem, compiled)
+        let path = SCRATCH
+            .with_borrow_mut(|sc| factors.factor(pattern, values, mem, sc, compiled))
             .expect("nonsingular");
         let mut x = b.to_vec();
         factors.solve(pattern, &mut x);
@@ -1653,7 +1743,13 @@ mod tests {
         let mut mem = MemBuffer::new(Factors::scratch(1));
         let mut factors = Factors::new(0);
         factors
-            .factor(&mut pattern, &values, &mut mem, false)
+            .factor(
+                &mut pattern,
+                &values,
+                &mut mem,
+                &mut CompileScratch::default(),
+                false,
+            )
             .unwrap();
         let mut x = vec![1.0, 2.0, 3.0, 4.0];
         factors.solve(&mut pattern, &mut x);

@@ -5,15 +5,17 @@
 //! # Allocation behaviour
 //!
 //! The first solve of a pattern key allocates: the CSC structure, the dense
-//! slot map, faer's symbolic LU (column approximate minimum degree ordering),
+//! slot map, faer's COLAMD ordering (column approximate minimum degree),
 //! the pattern's numeric-LU storage (grown to the dense worst case, see
-//! [`crate::lu`]), and, when the pattern needs more than any earlier one,
-//! the residual/step vectors, the Jacobian value array and the `MemBuffer`
-//! scratch. After that, solving a system with an already seen key performs
+//! [`crate::lu`]), its compiled program, and, when the pattern needs more
+//! than any earlier one, the residual/step vectors, the Jacobian value
+//! array, the `MemBuffer` scratch and the compilation's scratch (kept, see
+//! [`crate::compiled`]). After that, solving a system with an already seen key performs
 //! **no heap allocation** (checked by `tests/no_alloc.rs`).
 
 use faer::dyn_stack::{MemBuffer, StackReq};
 
+use crate::compiled::CompileScratch;
 use crate::lu::{FactorPath, Factors, Pattern};
 use crate::{JacobianSink, NewtonSystem, SolverError};
 
@@ -172,6 +174,9 @@ struct Workspace {
     r_trial: Vec<f64>,
     mem: MemBuffer,
     mem_req: StackReq,
+    /// Scratch of the compiled LU's compilations (grown to the largest
+    /// reduced dimension compiled, see `CompileScratch`).
+    compile: CompileScratch,
     numeric_factorizations: u64,
     /// Factorisations by the compiled LU.
     compiled_factorizations: u64,
@@ -183,8 +188,10 @@ struct Workspace {
 }
 
 impl Clone for Workspace {
-    /// The buffers' values (scratch; overwritten before use) and a fresh
-    /// scratch arena of the same size (faer's `MemBuffer` is not `Clone`).
+    /// The buffers' values (scratch; overwritten before use), a fresh
+    /// scratch arena of the same size (faer's `MemBuffer` is not `Clone`)
+    /// and an empty compilation scratch (grown by the clone's first
+    /// compilation, which allocates its program anyway).
     fn clone(&self) -> Self {
         Self {
             values: self.values.clone(),
@@ -194,6 +201,7 @@ impl Clone for Workspace {
             r_trial: self.r_trial.clone(),
             mem: MemBuffer::new(self.mem_req),
             mem_req: self.mem_req,
+            compile: CompileScratch::default(),
             numeric_factorizations: self.numeric_factorizations,
             compiled_factorizations: self.compiled_factorizations,
             lu_fallbacks: self.lu_fallbacks,
@@ -275,6 +283,7 @@ impl NewtonSolver {
                 r_trial: Vec::new(),
                 mem: MemBuffer::new(StackReq::EMPTY),
                 mem_req: StackReq::EMPTY,
+                compile: CompileScratch::default(),
                 numeric_factorizations: 0,
                 compiled_factorizations: 0,
                 lu_fallbacks: 0,
@@ -527,6 +536,7 @@ impl NewtonSolver {
             pattern,
             &self.ws.values,
             &mut self.ws.mem,
+            &mut self.ws.compile,
             self.params.compiled_lu,
         )?;
         if let Some(dx) = dx {
@@ -755,7 +765,13 @@ impl Workspace {
                 return Err(SolverError::NonFinite { iter: full });
             }
             negate(&mut self.dx, &self.r);
-            let fp = factors.factor(pattern, &self.values, &mut self.mem, params.compiled_lu)?;
+            let fp = factors.factor(
+                pattern,
+                &self.values,
+                &mut self.mem,
+                &mut self.compile,
+                params.compiled_lu,
+            )?;
             match fp {
                 FactorPath::Compiled => self.compiled_factorizations += 1,
                 FactorPath::Fallback => self.lu_fallbacks += 1,

@@ -53,7 +53,7 @@
 //!   this project the simplicial (left-looking, Gilbert–Peierls) LU is also
 //!   the faster one (`cargo bench -p fbd-suite --bench factorization`).
 //! * The numeric LU is faer's
-//!   [`simplicial::factorize_simplicial_numeric_lu`], called on a
+//!   [`factorize_simplicial_numeric_lu`], called on a
 //!   [`SimplicialLu`] owned here, so that its `L` and `U` factors are at
 //!   hand. After each factorisation both factors are copied once into two
 //!   streams of `(row, value)` entries in column runs ([`Stream`]), `L`'s

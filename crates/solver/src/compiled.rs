@@ -335,6 +335,35 @@ fn set(words: &mut [u64], start: usize, i: usize) {
     words[start + i / 64] |= 1 << (i % 64);
 }
 
+/// The row choice's rule at one column ([`CompiledLu::choose_rows`]):
+/// among the candidate `rows` (ascending) whose entry `value(r)` is at
+/// least [`ROW_CHOICE_THRESHOLD`] of the column's largest, `column`, the
+/// one with the fewest entries right of the column (`count`), ties to the
+/// larger entry, then to the first. `None` when the column is empty, zero
+/// or not finite.
+fn pick_row(
+    rows: &[usize],
+    value: impl Fn(usize) -> f64,
+    count: &[usize],
+    column: f64,
+) -> Option<usize> {
+    if !(column > 0.0 && column.is_finite()) {
+        return None;
+    }
+    let mut best: Option<(usize, usize, f64)> = None;
+    for &r in rows {
+        let v = value(r).abs();
+        if v < ROW_CHOICE_THRESHOLD * column {
+            continue;
+        }
+        let c = count[r];
+        if best.is_none_or(|(_, bc, b)| c < bc || (c == bc && v > b)) {
+            best = Some((r, c, v));
+        }
+    }
+    best.map(|(r, _, _)| r)
+}
+
 /// A pivot failed its check: factor with faer instead.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) struct PivotFailed;
@@ -624,21 +653,7 @@ impl CompiledLu {
                     column = column.max(d[r * m + k].abs());
                 }
             }
-            if !(column > 0.0 && column.is_finite()) {
-                return false;
-            }
-            let mut best: Option<(usize, usize, f64)> = None;
-            for &r in &sc.rows {
-                let v = d[r * m + k].abs();
-                if v < ROW_CHOICE_THRESHOLD * column {
-                    continue;
-                }
-                let c = count[r];
-                if best.is_none_or(|(_, bc, b)| c < bc || (c == bc && v > b)) {
-                    best = Some((r, c, v));
-                }
-            }
-            let Some((p, _, _)) = best else {
+            let Some(p) = pick_row(&sc.rows, |r| d[r * m + k], count, column) else {
                 return false;
             };
             set(&mut sc.used, 0, p);
@@ -987,21 +1002,7 @@ mod tests {
                     column = column.max(d[r * m + k].abs());
                 }
             }
-            if !(column > 0.0 && column.is_finite()) {
-                return None;
-            }
-            let mut best: Option<(usize, usize, f64)> = None;
-            for &r in &rows {
-                let v = d[r * m + k].abs();
-                if v < ROW_CHOICE_THRESHOLD * column {
-                    continue;
-                }
-                let c = count[r];
-                if best.is_none_or(|(_, bc, b)| c < bc || (c == bc && v > b)) {
-                    best = Some((r, c, v));
-                }
-            }
-            let (p, _, _) = best?;
+            let p = pick_row(&rows, |r| d[r * m + k], &count, column)?;
             used[p] = true;
             order.push(p);
             let cols: Vec<usize> = (k + 1..m).filter(|&j| nz[p * m + j]).collect();

@@ -1281,6 +1281,16 @@ mod tests {
     use faer::sparse::linalg::lu::{NumericLu, factorize_symbolic_lu};
     use faer::{Conj, MatMut, Par};
 
+    /// New storage for `pattern` with its factorisation by faer's
+    /// pivoting LU (the reference path).
+    fn faer_factors(pattern: &mut Pattern, values: &[f64], mem: &mut MemBuffer) -> Factors {
+        let mut factors = Factors::new(pattern.m);
+        factors
+            .factor(pattern, values, mem, &mut CompileScratch::default(), false)
+            .expect("nonsingular");
+        factors
+    }
+
     /// A stream's pieces hold every entry once, in order, segments only
     /// of consecutive rows and at least `SEGMENT_MIN` long, and its sweep
     /// is the entry-by-entry sweep bit for bit (columns of every mix of
@@ -1414,16 +1424,7 @@ mod tests {
                         symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
                     ),
                 ));
-            let mut factors = Factors::new(pattern.m);
-            factors
-                .factor(
-                    &mut pattern,
-                    &values,
-                    &mut mem,
-                    &mut CompileScratch::default(),
-                    false,
-                )
-                .expect("nonsingular");
+            let mut factors = faer_factors(&mut pattern, &values, &mut mem);
             let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).cos()).collect();
             let mut ours = b.clone();
             factors.solve(&mut pattern, &mut ours);
@@ -1741,16 +1742,7 @@ mod tests {
             values[pattern.slot[i * n + (i + 1) % n] as usize] = (i + 1) as f64;
         }
         let mut mem = MemBuffer::new(Factors::scratch(1));
-        let mut factors = Factors::new(0);
-        factors
-            .factor(
-                &mut pattern,
-                &values,
-                &mut mem,
-                &mut CompileScratch::default(),
-                false,
-            )
-            .unwrap();
+        let mut factors = faer_factors(&mut pattern, &values, &mut mem);
         let mut x = vec![1.0, 2.0, 3.0, 4.0];
         factors.solve(&mut pattern, &mut x);
         // Row i: (i + 1)·x[i + 1] = b[i].

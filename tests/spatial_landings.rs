@@ -87,21 +87,32 @@ fn landings_that_needed_the_second_active_set_attempt_complete_exactly() {
 /// A landing on many points at once (run 522: at t = 1.444 s the robot,
 /// lying on its hips and knees, rocks: the hips and four knees lift off
 /// and come down again, sliding, within the step, while feet turn from
-/// sliding to sticking) whose step has no exact solution down to Δt/64
-/// closes at Δt/128: the ladder of substeps goes on to Δt/256 (the default
-/// `max_substeps`), every row obeys the contact laws, and the retry is
-/// reported. (Runs 468, 522, 782 and 839 needed Δt/128 in earlier builds:
+/// sliding to sticking) whose step has no exact solution down to Δt/32
+/// closes at Δt/64: every row obeys the contact laws and the retry is
+/// reported. With the ladder of substeps cut at Δt/32 (`max_substeps`,
+/// 256 by default) the run stops at that step with the error naming it,
+/// the point and the law its best solution breaks, the rows before it
+/// kept. (Runs 468, 522, 782 and 839 needed Δt/128 in earlier builds:
 /// which step of a chaotic landing needs it moves with the round-off; the
 /// reference-LU rung, after the substeps, is kept for steps that only
 /// faer's pivoting LU closes; no run of the sweep needs it now.)
 #[test]
-fn a_landing_closed_below_dt_over_64_completes_exactly() {
+fn a_landing_closed_at_dt_over_64_completes_exactly_and_stops_without() {
     let (model, summary, _) = complete_exactly(522);
     assert_eq!(model.max_substeps, 256);
-    let deep: Vec<_> = summary.retries.iter().filter(|r| r.substeps > 64).collect();
+    let deep: Vec<_> = summary.retries.iter().filter(|r| r.substeps > 32).collect();
     assert_eq!(deep.len(), 1, "{:?}", summary.retries);
-    assert_eq!((deep[0].step, deep[0].substeps), (722, 128));
+    assert_eq!((deep[0].step, deep[0].substeps), (722, 64));
     assert!(!deep[0].reference_lu);
+    let mut cut = landing(522);
+    cut.max_substeps = 32;
+    let (rows, summary) = run_collect(&cut);
+    let error = summary.error.expect("stops at step 722").to_string();
+    assert!(
+        error.starts_with("step 722 (t = 1.444000 s): no exact solution down to Δt/32: "),
+        "{error}"
+    );
+    assert_eq!(rows.len(), 722);
 }
 
 /// A robot on its knees with feet braced against the ground (run 0,

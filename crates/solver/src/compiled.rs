@@ -79,11 +79,15 @@
 //! `C` is singular, the check fails, a pivot is structurally zero or not
 //! finite, or more than [`MAX_PERTURBED`] pivots fail, the caller factors
 //! with faer's pivoting LU (the reference path) and counts the fallback;
-//! the program stays for the next factorisation. A pattern keeps one
-//! program per set of exact zeros among its values (a complementarity
-//! branch switched inside the pattern), compiled at that set's second
-//! fallback ([`crate::lu`]'s `zero_signature`, at most `MAX_PROGRAMS`). Results equal faer's to
-//! round-off (different order of the same sums), not bit for bit.
+//! the program stays for the next factorisation, and is compiled again on
+//! the values of its second fallback in a row (`RECOMPILE_AFTER`: its row
+//! order no longer fits the values). A pattern keeps one program per set
+//! of exact zeros among its values (a complementarity branch switched
+//! inside the pattern), compiled at that set's second fallback
+//! ([`crate::lu`]'s `zero_signature`); beyond `MAX_PROGRAMS` a new set
+//! takes the place of the least recently tried program but the first.
+//! Results equal faer's to round-off (different order of the same sums),
+//! not bit for bit.
 //! Measured on the first 100 runs of
 //! `examples/sweep_hexapod_landing_1000.toml` (stride 1, 2 cores): 9 in
 //! 10 fallbacks avoided, the sweep's wall time 14 s → 12 s; the hexapod

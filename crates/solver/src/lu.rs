@@ -185,16 +185,43 @@ pub(crate) struct Pattern {
     /// The compiled numeric LUs of this pattern, each with the
     /// [`zero_signature`] of the values it was compiled on (empty until
     /// the first factorisation with the compiled path enabled; at most
-    /// [`MAX_PROGRAMS`]).
+    /// [`MAX_PROGRAMS`], see there).
     programs: Vec<(u64, CompiledLu)>,
+    /// Per program, the factorisation of this pattern that last tried it
+    /// (a clock of [`Self::factorizations`]): the least recently tried
+    /// one after the first gives its place to a new set of zeros when
+    /// [`MAX_PROGRAMS`] are kept.
+    program_use: Vec<u64>,
+    /// Factorisations of this pattern by the compiled path: the clock of
+    /// [`Self::program_use`].
+    factorizations: u64,
+    /// Per program, its fallbacks to faer's LU in a row (on its own set of
+    /// zeros): at [`RECOMPILE_AFTER`] it is compiled again on the values
+    /// it failed on, once.
+    program_fails: Vec<u32>,
+    /// Per program, whether it was compiled again so (then it stays).
+    program_renewed: Vec<bool>,
     /// The zero signatures that fell back to faer's LU once, without a
     /// program of their own (compiled at their second fallback).
     failed: Vec<u64>,
 }
 
 /// The most compiled programs one pattern keeps (see [`Factors::factor`]):
-/// one per set of exact zeros among its values, the first ones met.
+/// one per set of exact zeros among its values; a new set beyond them
+/// takes the place of the least recently tried program (never the first,
+/// which factors the sets of zeros without a program of their own).
 pub(crate) const MAX_PROGRAMS: usize = 8;
+
+/// A program that fell back to faer's LU on its own set of zeros this
+/// many times in a row is compiled again on the values of the last
+/// fallback (its row order chosen on those values), once (values that
+/// alternate between two regimes would otherwise recompile it again and
+/// again): a failed pivot that
+/// passes — a cancellation to round-off for one iterate — costs one
+/// fallback, while a row order that the values have left behind (on a
+/// contact-rich landing, one program fell back 20 times, its
+/// perturbed pivots' correction failing its accuracy check) is replaced.
+pub(crate) const RECOMPILE_AFTER: u32 = 2;
 
 /// A hash of which of `values` are exactly zero. A complementarity row
 /// switches its branch inside one sparsity pattern by turning entries to
@@ -414,6 +441,10 @@ impl Pattern {
             chords_since: 0,
             last_chords: 0,
             programs: Vec::new(),
+            program_use: Vec::new(),
+            factorizations: 0,
+            program_fails: Vec::new(),
+            program_renewed: Vec::new(),
             failed: Vec::new(),
         }
     }
@@ -751,6 +782,7 @@ impl Factors {
         reduced: &[f64],
         zeros: u64,
         faer_rows: bool,
+        replace: Option<usize>,
     ) {
         let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
         let fwd = pattern.col_perm.arrays().0;
@@ -765,7 +797,33 @@ impl Factors {
             None => return,
         };
         program.compile(sc, col_ptr, row_idx, fwd, rows, true);
-        pattern.programs.push((zeros, program));
+        let stamp = pattern.factorizations;
+        let place = match replace {
+            Some(i) => i,
+            None if pattern.programs.len() < MAX_PROGRAMS => {
+                pattern.programs.push((zeros, CompiledLu::default()));
+                pattern.program_use.push(stamp);
+                pattern.program_fails.push(0);
+                pattern.program_renewed.push(false);
+                pattern.programs.len() - 1
+            }
+            // The least recently tried program after the first gives its
+            // place.
+            None => {
+                pattern
+                    .program_use
+                    .iter()
+                    .enumerate()
+                    .skip(1)
+                    .min_by_key(|&(_, &t)| t)
+                    .expect("MAX_PROGRAMS > 1")
+                    .0
+            }
+        };
+        pattern.programs[place] = (zeros, program);
+        pattern.program_use[place] = stamp;
+        pattern.program_fails[place] = 0;
+        pattern.program_renewed[place] = replace.is_some();
     }
 
     /// Grows faer's storage to that of a dense `n × n` LU by two
@@ -828,8 +886,9 @@ impl Factors {
     /// column ordering; the eliminated rows' pivots and columns are copied
     /// into `pattern`. `mem` must hold [`Self::scratch`]; `sc` is the
     /// scratch of a compilation (the pattern's first factorisation with
-    /// `compiled`, or a set of exact zeros' second fallback, which allocate
-    /// the program). Allocation-free otherwise.
+    /// `compiled`, a set of exact zeros' second fallback, or a program's
+    /// [`RECOMPILE_AFTER`]-th fallback in a row, which allocate the
+    /// program). Allocation-free otherwise.
     ///
     /// # Errors
     /// [`SolverError::Singular`] when faer finds no structurally non-zero
@@ -864,11 +923,14 @@ impl Factors {
         if compiled && n > 0 && pattern.programs.is_empty() {
             // The pattern's first program, before any factorisation; where
             // the row choice finds no pivot, faer's LU below and its rows.
-            self.add_program(sc, pattern, reduced, zeros, false);
+            self.add_program(sc, pattern, reduced, zeros, false, None);
         }
         let known = pattern.programs.iter().position(|(z, _)| *z == zeros);
         if compiled && n > 0 && !pattern.programs.is_empty() {
-            let program = &mut pattern.programs[known.unwrap_or(0)].1;
+            let index = known.unwrap_or(0);
+            pattern.factorizations += 1;
+            pattern.program_use[index] = pattern.factorizations;
+            let program = &mut pattern.programs[index].1;
             if program
                 .factor(reduced, &mut self.pivot_inv, &mut self.perturbed)
                 .is_ok()
@@ -896,6 +958,7 @@ impl Factors {
                     self.owner = Some(pattern.id);
                     pattern.solves_since = 0;
                     pattern.chords_since = 0;
+                    pattern.program_fails[index] = 0;
                     return Ok(if self.perturbed.is_empty() {
                         FactorPath::Compiled
                     } else {
@@ -977,13 +1040,20 @@ impl Factors {
             } else {
                 path == FactorPath::Faer
             };
-            if compiled && known.is_none() && recurring && pattern.programs.len() < MAX_PROGRAMS {
-                // A fallback of a known set of zeros keeps its program: the
-                // next factorisation tries it again (a failed pivot then is
-                // mostly a passing cancellation; recompiling on such values
+            if compiled && known.is_none() && recurring {
+                self.add_program(sc, pattern, reduced, zeros, true, None);
+            }
+            if let Some(i) = known.filter(|_| compiled && path == FactorPath::Fallback) {
+                // A fallback of a known set of zeros keeps its program for
+                // the next factorisation (a failed pivot then is mostly a
+                // passing cancellation; recompiling at each such fallback
                 // was measured dearer, 1.6 M instructions a time on the
-                // hexapod walk).
-                self.add_program(sc, pattern, reduced, zeros, true);
+                // hexapod walk) until it has failed `RECOMPILE_AFTER`
+                // times in a row; then it is compiled again, once.
+                pattern.program_fails[i] += 1;
+                if pattern.program_fails[i] >= RECOMPILE_AFTER && !pattern.program_renewed[i] {
+                    self.add_program(sc, pattern, reduced, zeros, true, Some(i));
+                }
             }
         }
         self.owner = Some(pattern.id);
@@ -1713,6 +1783,141 @@ mod tests {
         for (d, path) in paths.iter().enumerate().skip(4) {
             assert_ne!(*path, FactorPath::Fallback, "draw {d}");
         }
+    }
+
+    /// The solution of `values` by the compiled path (its path) and by
+    /// faer's LU agree to round-off.
+    fn compiled_matches_faer(
+        factors: &mut Factors,
+        pattern: &mut Pattern,
+        values: &[f64],
+        b: &[f64],
+        mem: &mut MemBuffer,
+        what: &str,
+    ) -> FactorPath {
+        let (ours, path) = solve_with(factors, pattern, values, b, mem, true);
+        let (theirs, _) = solve_with(factors, pattern, values, b, mem, false);
+        let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+        for (i, (o, t)) in ours.iter().zip(&theirs).enumerate() {
+            assert!(
+                (o - t).abs() <= 1e-9 * scale,
+                "{what} ({path:?}), x[{i}]: ours {o} faer {t}"
+            );
+        }
+        path
+    }
+
+    #[test]
+    fn more_sets_of_zeros_than_programs_take_the_least_recent_place() {
+        // MAX_PROGRAMS + 3 sets of exact zeros (rows `x_i = 1`: every row
+        // with a diagonal entry outside the set's block of 8 rows, modulo
+        // the number of sets), each met twice in a row (compiled at its
+        // second fallback), then all again: the first program (no zeros)
+        // stays, the pattern never keeps more than MAX_PROGRAMS, and the
+        // sets compiled last factor by their programs; every solution
+        // equals faer's to round-off.
+        let n = 96;
+        let triplets = matrix(n, 6);
+        let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
+        let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
+        let sets = MAX_PROGRAMS + 3;
+        let draw = |d: u64, set: Option<usize>| {
+            let mut values = vec![0.0; nnz];
+            for (k, &(i, j, v)) in triplets.iter().enumerate() {
+                let x = ((k as u64 * 7919 + d * 104_729) as f64 * 0.618).sin();
+                let lifted = i % 3 != 1 && set.is_some_and(|s| (i / 8) % sets != s);
+                let v = match (lifted, i == j) {
+                    (true, true) => 1.0,
+                    (true, false) => 0.0,
+                    (false, _) => v * (1.0 + 0.1 * x),
+                };
+                values[slot[i * n + j] as usize] += v;
+            }
+            values
+        };
+        let mut d = 0;
+        let mut next = |set: Option<usize>, pattern: &mut Pattern, factors: &mut Factors| {
+            d += 1;
+            let what = format!("draw {d}, set {set:?}");
+            compiled_matches_faer(factors, pattern, &draw(d, set), &b, &mut mem, &what)
+        };
+        assert_eq!(next(None, &mut pattern, &mut factors), FactorPath::Compiled);
+        for set in 0..sets {
+            for _ in 0..2 {
+                assert_eq!(
+                    next(Some(set), &mut pattern, &mut factors),
+                    FactorPath::Fallback,
+                    "set {set} before its program"
+                );
+            }
+            assert!(pattern.programs.len() <= MAX_PROGRAMS);
+        }
+        assert_eq!(pattern.programs.len(), MAX_PROGRAMS);
+        // The first program and the last MAX_PROGRAMS − 1 sets' remain.
+        assert_ne!(next(None, &mut pattern, &mut factors), FactorPath::Fallback);
+        for set in sets + 1 - MAX_PROGRAMS..sets {
+            assert_ne!(
+                next(Some(set), &mut pattern, &mut factors),
+                FactorPath::Fallback,
+                "set {set} kept its program"
+            );
+        }
+    }
+
+    #[test]
+    fn a_program_that_keeps_failing_is_compiled_again() {
+        // 2 × 2 blocks [[a, 1], [1, a]] compiled on a = 10 (diagonal
+        // pivots), then factored on draws with a = 1e-12: each block's
+        // first pivot fails, more than MAX_PERTURBED in all, and faer's LU
+        // factors it. The second such fallback in a row compiles the
+        // program again on those values (the other row first); the next
+        // such draws factor by it.
+        let n = 48;
+        let mut triplets = Vec::new();
+        for i in (0..n).step_by(2) {
+            triplets.extend([
+                (i, i, 10.0),
+                (i, i + 1, 1.0),
+                (i + 1, i, 1.0),
+                (i + 1, i + 1, 10.0),
+            ]);
+        }
+        let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
+        let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
+        let draw = |d: u64, small: bool| {
+            let mut values = vec![0.0; nnz];
+            for (k, &(i, j, v)) in triplets.iter().enumerate() {
+                let x = 1.0 + 0.1 * ((k as u64 * 7919 + d * 104_729) as f64 * 0.618).sin();
+                let v = if i == j && small { 1e-12 * x } else { v * x };
+                values[slot[i * n + j] as usize] = v;
+            }
+            values
+        };
+        let mut path = |d: u64, small: bool, pattern: &mut Pattern, factors: &mut Factors| {
+            let what = format!("draw {d}, small diagonal {small}");
+            compiled_matches_faer(factors, pattern, &draw(d, small), &b, &mut mem, &what)
+        };
+        assert_eq!(
+            path(0, false, &mut pattern, &mut factors),
+            FactorPath::Compiled
+        );
+        assert_eq!(
+            path(1, true, &mut pattern, &mut factors),
+            FactorPath::Fallback
+        );
+        assert_eq!(pattern.programs.len(), 1, "one set of zeros: one program");
+        assert_eq!(
+            path(2, true, &mut pattern, &mut factors),
+            FactorPath::Fallback,
+            "the second fallback in a row compiles it again"
+        );
+        for d in 3..6 {
+            assert_ne!(
+                path(d, true, &mut pattern, &mut factors),
+                FactorPath::Fallback
+            );
+        }
+        assert_eq!(pattern.programs.len(), 1);
     }
 
     #[test]

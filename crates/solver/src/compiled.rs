@@ -85,7 +85,8 @@
 //! of exact zeros among its values (a complementarity branch switched
 //! inside the pattern), compiled at that set's second fallback
 //! ([`crate::lu`]'s `zero_signature`); beyond `MAX_PROGRAMS` a new set
-//! takes the place of the least recently tried program but the first.
+//! takes the place of the least recently tried program but the first,
+//! compiled again in its storage.
 //! Results equal faer's to round-off (different order of the same sums),
 //! not bit for bit.
 //! Measured on the first 100 runs of

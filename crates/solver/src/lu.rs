@@ -773,8 +773,10 @@ impl Factors {
     /// chosen by threshold Markowitz on these values (less fill than
     /// faer's partial pivoting); where that finds no pivot, the row order
     /// of faer's factorisation of these values just made when `faer_rows`,
-    /// else nothing is compiled. Allocates, as a pattern's registration
-    /// does.
+    /// else nothing is compiled. In place of program `replace`, else of a
+    /// new one, or of the least recently tried but the first when
+    /// [`MAX_PROGRAMS`] are kept. A new program allocates, as a pattern's
+    /// registration does; a replaced one only when it outgrows its storage.
     fn add_program(
         &mut self,
         sc: &mut CompileScratch,
@@ -786,7 +788,6 @@ impl Factors {
     ) {
         let (col_ptr, row_idx) = (pattern.structure.col_ptr(), pattern.structure.row_idx());
         let fwd = pattern.col_perm.arrays().0;
-        let mut program = CompiledLu::default();
         let rows = match CompiledLu::choose_rows(sc, col_ptr, row_idx, fwd, reduced) {
             Some(order) => {
                 self.row_choice.clear();
@@ -796,7 +797,6 @@ impl Factors {
             None if faer_rows => &self.row_perm,
             None => return,
         };
-        program.compile(sc, col_ptr, row_idx, fwd, rows, true);
         let stamp = pattern.factorizations;
         let place = match replace {
             Some(i) => i,
@@ -820,7 +820,12 @@ impl Factors {
                     .0
             }
         };
-        pattern.programs[place] = (zeros, program);
+        // A program replaced is compiled again in its own storage (room
+        // for one of twice its first size): the replacements of a long run
+        // allocate only when a program outgrows it.
+        let program = &mut pattern.programs[place];
+        program.0 = zeros;
+        program.1.compile(sc, col_ptr, row_idx, fwd, rows, true);
         pattern.program_use[place] = stamp;
         pattern.program_fails[place] = 0;
         pattern.program_renewed[place] = replace.is_some();
@@ -1842,6 +1847,16 @@ mod tests {
             compiled_matches_faer(factors, pattern, &draw(d, set), &b, &mut mem, &what)
         };
         assert_eq!(next(None, &mut pattern, &mut factors), FactorPath::Compiled);
+        // Each program's storage once MAX_PROGRAMS are kept: a replaced
+        // program is compiled again in it (no allocation).
+        let storage = |pattern: &Pattern| -> Vec<*const u32> {
+            pattern
+                .programs
+                .iter()
+                .map(|p| p.1.lower.vals.as_ptr())
+                .collect()
+        };
+        let mut kept = None;
         for set in 0..sets {
             for _ in 0..2 {
                 assert_eq!(
@@ -1851,8 +1866,12 @@ mod tests {
                 );
             }
             assert!(pattern.programs.len() <= MAX_PROGRAMS);
+            if kept.is_none() && pattern.programs.len() == MAX_PROGRAMS {
+                kept = Some(storage(&pattern));
+            }
         }
         assert_eq!(pattern.programs.len(), MAX_PROGRAMS);
+        assert_eq!(kept, Some(storage(&pattern)), "replaced in place");
         // The first program and the last MAX_PROGRAMS − 1 sets' remain.
         assert_ne!(next(None, &mut pattern, &mut factors), FactorPath::Fallback);
         for set in sets + 1 - MAX_PROGRAMS..sets {

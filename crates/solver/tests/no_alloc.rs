@@ -1,9 +1,9 @@
 //! After the first solve of a pattern, `NewtonSolver::solve` must not touch
 //! the heap: not in the Newton loop, not in faer's numeric refactorisation,
 //! not in the triangular solves (faer's storage is grown at its first use,
-//! and a pattern's program for a new set of exact zeros, or one compiled
-//! again, once, after failing its pivots twice in a row, is compiled like
-//! a new pattern).
+//! and a pattern's program for a new set of exact zeros is compiled like
+//! a new pattern; one compiled again, once, after failing its pivots twice
+//! in a row reuses its storage unless it outgrows it).
 //!
 //! The global allocator is `System` wrapped by `stats_alloc`'s `StatsAlloc`,
 //! which counts every allocation, reallocation and deallocation in atomic
@@ -101,9 +101,10 @@ fn second_solve_of_a_pattern_does_not_allocate() {
     // fails its pivots and faer's LU factors instead. faer's L/U vectors
     // are sized for the worst case at its first use, a set of exact zeros
     // that falls back twice gets a program of its own, and a program that
-    // falls back twice in a row is compiled again on those values, once
-    // (all allocate, as a new pattern does: the first two rounds); from
-    // then on the same cases never touch the heap.
+    // falls back twice in a row is compiled again on those values, once,
+    // in its own storage (these allocate, as a new pattern does, or may:
+    // the first two rounds); from then on the same cases never touch the
+    // heap.
     let mut piv = Pivoting::new(40);
     let mut z = vec![0.0; 40];
     solver

@@ -1728,6 +1728,30 @@ mod tests {
         assert!(corrected >= 20, "only {corrected} corrected factorisations");
     }
 
+    /// Draw `d` of the values of `triplets` in `pattern`'s slots, each
+    /// entry scaled by up to ±10 %, with the rows `lifted` turned into
+    /// `x_i = 1` (their other entries exact zeros: a complementarity row
+    /// switched branch).
+    fn lifted_values(
+        triplets: &[(usize, usize, f64)],
+        pattern: &Pattern,
+        n: usize,
+        d: u64,
+        lifted: impl Fn(usize) -> bool,
+    ) -> Vec<f64> {
+        let mut values = vec![0.0; pattern.nnz()];
+        for (k, &(i, j, v)) in triplets.iter().enumerate() {
+            let x = ((k as u64 * 7919 + d * 104_729) as f64 * 0.618).sin();
+            let v = match (lifted(i), i == j) {
+                (true, true) => 1.0,
+                (true, false) => 0.0,
+                (false, _) => v * (1.0 + 0.1 * x),
+            };
+            values[pattern.slot[i * n + j] as usize] += v;
+        }
+        values
+    }
+
     #[test]
     fn each_set_of_exact_zeros_gets_its_program() {
         // A complementarity row switching branch inside one pattern: rows
@@ -1738,24 +1762,12 @@ mod tests {
         let n = 64;
         let triplets = matrix(n, 4);
         let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
-        let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
-        let draw = |d: u64, switched: bool| {
-            let mut values = vec![0.0; nnz];
-            for (k, &(i, j, v)) in triplets.iter().enumerate() {
-                let x = ((k as u64 * 7919 + d * 104_729) as f64 * 0.618).sin();
-                let lifted = switched && i % 6 == 0;
-                let v = match (lifted, i == j) {
-                    (true, true) => 1.0,
-                    (true, false) => 0.0,
-                    (false, _) => v * (1.0 + 0.1 * x),
-                };
-                values[slot[i * n + j] as usize] += v;
-            }
-            values
+        let draw = |d: u64, switched: bool, pattern: &Pattern| {
+            lifted_values(&triplets, pattern, n, d, |i| switched && i % 6 == 0)
         };
         let mut paths = Vec::new();
         for d in 0..12 {
-            let values = draw(d, d % 2 == 1);
+            let values = draw(d, d % 2 == 1, &pattern);
             let (ours, path) = solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, true);
             let (theirs, _) = solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, false);
             let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
@@ -1824,27 +1836,18 @@ mod tests {
         let n = 96;
         let triplets = matrix(n, 6);
         let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
-        let (slot, nnz) = (pattern.slot.clone(), pattern.nnz());
         let sets = MAX_PROGRAMS + 3;
-        let draw = |d: u64, set: Option<usize>| {
-            let mut values = vec![0.0; nnz];
-            for (k, &(i, j, v)) in triplets.iter().enumerate() {
-                let x = ((k as u64 * 7919 + d * 104_729) as f64 * 0.618).sin();
-                let lifted = i % 3 != 1 && set.is_some_and(|s| (i / 8) % sets != s);
-                let v = match (lifted, i == j) {
-                    (true, true) => 1.0,
-                    (true, false) => 0.0,
-                    (false, _) => v * (1.0 + 0.1 * x),
-                };
-                values[slot[i * n + j] as usize] += v;
-            }
-            values
+        let draw = |d: u64, set: Option<usize>, pattern: &Pattern| {
+            lifted_values(&triplets, pattern, n, d, |i| {
+                i % 3 != 1 && set.is_some_and(|s| (i / 8) % sets != s)
+            })
         };
         let mut d = 0;
         let mut next = |set: Option<usize>, pattern: &mut Pattern, factors: &mut Factors| {
             d += 1;
             let what = format!("draw {d}, set {set:?}");
-            compiled_matches_faer(factors, pattern, &draw(d, set), &b, &mut mem, &what)
+            let values = draw(d, set, pattern);
+            compiled_matches_faer(factors, pattern, &values, &b, &mut mem, &what)
         };
         assert_eq!(next(None, &mut pattern, &mut factors), FactorPath::Compiled);
         // Each program's storage once MAX_PROGRAMS are kept: a replaced

@@ -182,28 +182,35 @@ pub(crate) struct Pattern {
     pub(crate) chords_since: usize,
     /// Chord steps of the last solve after its last factorisation.
     last_chords: usize,
-    /// The compiled numeric LUs of this pattern, each with the
-    /// [`zero_signature`] of the values it was compiled on (empty until
-    /// the first factorisation with the compiled path enabled; at most
+    /// The compiled numeric LUs of this pattern (empty until the first
+    /// factorisation with the compiled path enabled; at most
     /// [`MAX_PROGRAMS`], see there).
-    programs: Vec<(u64, CompiledLu)>,
-    /// Per program, the factorisation of this pattern that last tried it
-    /// (a clock of [`Self::factorizations`]): the least recently tried
-    /// one after the first gives its place to a new set of zeros when
-    /// [`MAX_PROGRAMS`] are kept.
-    program_use: Vec<u64>,
+    programs: Vec<Program>,
     /// Factorisations of this pattern by the compiled path: the clock of
-    /// [`Self::program_use`].
+    /// [`Program::last_use`].
     factorizations: u64,
-    /// Per program, its fallbacks to faer's LU in a row (on its own set of
-    /// zeros): at [`RECOMPILE_AFTER`] it is compiled again on the values
-    /// it failed on, once.
-    program_fails: Vec<u32>,
-    /// Per program, whether it was compiled again so (then it stays).
-    program_renewed: Vec<bool>,
     /// The zero signatures that fell back to faer's LU once, without a
     /// program of their own (compiled at their second fallback).
     failed: Vec<u64>,
+}
+
+/// One compiled program of a pattern and its bookkeeping.
+#[derive(Clone, Default)]
+struct Program {
+    /// The [`zero_signature`] of the values it was compiled on.
+    zeros: u64,
+    lu: CompiledLu,
+    /// The factorisation of its pattern that last tried it (a clock of
+    /// [`Pattern::factorizations`]): the least recently tried one after
+    /// the first gives its place to a new set of zeros when
+    /// [`MAX_PROGRAMS`] are kept.
+    last_use: u64,
+    /// Its fallbacks to faer's LU in a row (on its own set of zeros): at
+    /// [`RECOMPILE_AFTER`] it is compiled again on the values it failed
+    /// on, once.
+    fails: u32,
+    /// Whether it was compiled again so (then it stays).
+    renewed: bool,
 }
 
 /// The most compiled programs one pattern keeps (see [`Factors::factor`]):
@@ -441,10 +448,7 @@ impl Pattern {
             chords_since: 0,
             last_chords: 0,
             programs: Vec::new(),
-            program_use: Vec::new(),
             factorizations: 0,
-            program_fails: Vec::new(),
-            program_renewed: Vec::new(),
             failed: Vec::new(),
         }
     }
@@ -801,21 +805,18 @@ impl Factors {
         let place = match replace {
             Some(i) => i,
             None if pattern.programs.len() < MAX_PROGRAMS => {
-                pattern.programs.push((zeros, CompiledLu::default()));
-                pattern.program_use.push(stamp);
-                pattern.program_fails.push(0);
-                pattern.program_renewed.push(false);
+                pattern.programs.push(Program::default());
                 pattern.programs.len() - 1
             }
             // The least recently tried program after the first gives its
             // place.
             None => {
                 pattern
-                    .program_use
+                    .programs
                     .iter()
                     .enumerate()
                     .skip(1)
-                    .min_by_key(|&(_, &t)| t)
+                    .min_by_key(|(_, p)| p.last_use)
                     .expect("MAX_PROGRAMS > 1")
                     .0
             }
@@ -824,11 +825,11 @@ impl Factors {
         // for one of twice its first size): the replacements of a long run
         // allocate only when a program outgrows it.
         let program = &mut pattern.programs[place];
-        program.0 = zeros;
-        program.1.compile(sc, col_ptr, row_idx, fwd, rows, true);
-        pattern.program_use[place] = stamp;
-        pattern.program_fails[place] = 0;
-        pattern.program_renewed[place] = replace.is_some();
+        program.lu.compile(sc, col_ptr, row_idx, fwd, rows, true);
+        program.zeros = zeros;
+        program.last_use = stamp;
+        program.fails = 0;
+        program.renewed = replace.is_some();
     }
 
     /// Grows faer's storage to that of a dense `n × n` LU by two
@@ -930,12 +931,12 @@ impl Factors {
             // the row choice finds no pivot, faer's LU below and its rows.
             self.add_program(sc, pattern, reduced, zeros, false, None);
         }
-        let known = pattern.programs.iter().position(|(z, _)| *z == zeros);
+        let known = pattern.programs.iter().position(|p| p.zeros == zeros);
         if compiled && n > 0 && !pattern.programs.is_empty() {
             let index = known.unwrap_or(0);
             pattern.factorizations += 1;
-            pattern.program_use[index] = pattern.factorizations;
-            let program = &mut pattern.programs[index].1;
+            pattern.programs[index].last_use = pattern.factorizations;
+            let program = &mut pattern.programs[index].lu;
             if program
                 .factor(reduced, &mut self.pivot_inv, &mut self.perturbed)
                 .is_ok()
@@ -963,7 +964,7 @@ impl Factors {
                     self.owner = Some(pattern.id);
                     pattern.solves_since = 0;
                     pattern.chords_since = 0;
-                    pattern.program_fails[index] = 0;
+                    pattern.programs[index].fails = 0;
                     return Ok(if self.perturbed.is_empty() {
                         FactorPath::Compiled
                     } else {
@@ -1055,8 +1056,9 @@ impl Factors {
                 // was measured dearer, 1.6 M instructions a time on the
                 // hexapod walk) until it has failed `RECOMPILE_AFTER`
                 // times in a row; then it is compiled again, once.
-                pattern.program_fails[i] += 1;
-                if pattern.program_fails[i] >= RECOMPILE_AFTER && !pattern.program_renewed[i] {
+                let program = &mut pattern.programs[i];
+                program.fails += 1;
+                if program.fails >= RECOMPILE_AFTER && !program.renewed {
                     self.add_program(sc, pattern, reduced, zeros, true, Some(i));
                 }
             }
@@ -1856,7 +1858,7 @@ mod tests {
             pattern
                 .programs
                 .iter()
-                .map(|p| p.1.lower.vals.as_ptr())
+                .map(|p| p.lu.lower.vals.as_ptr())
                 .collect()
         };
         let mut kept = None;

@@ -892,9 +892,10 @@ impl Factors {
     /// column ordering; the eliminated rows' pivots and columns are copied
     /// into `pattern`. `mem` must hold [`Self::scratch`]; `sc` is the
     /// scratch of a compilation (the pattern's first factorisation with
-    /// `compiled`, a set of exact zeros' second fallback, or a program's
-    /// [`RECOMPILE_AFTER`]-th fallback in a row, which allocate the
-    /// program). Allocation-free otherwise.
+    /// `compiled` or a set of exact zeros' second fallback, which allocate
+    /// the program, or a program's [`RECOMPILE_AFTER`]-th fallback in a
+    /// row, which allocates only when the program outgrows its storage).
+    /// Allocation-free otherwise.
     ///
     /// # Errors
     /// [`SolverError::Singular`] when faer finds no structurally non-zero
@@ -1602,21 +1603,16 @@ mod tests {
             );
             for eps in [0.0, 1e-3, 0.05] {
                 let values = values_at(eps);
-                let (ours, path) =
-                    solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, true);
-                assert_eq!(path, FactorPath::Compiled, "n = {n}, eps = {eps}");
-                let (theirs, path) =
-                    solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, false);
-                assert_eq!(path, FactorPath::Faer);
-                let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-                for i in 0..n {
-                    assert!(
-                        (ours[i] - theirs[i]).abs() <= 1e-12 * scale,
-                        "n = {n}, eps = {eps}, x[{i}]: compiled {} faer {}",
-                        ours[i],
-                        theirs[i]
-                    );
-                }
+                let what = format!("n = {n}, eps = {eps}");
+                let path = compiled_matches_faer(
+                    &mut factors,
+                    &mut pattern,
+                    (&values, &b),
+                    &mut mem,
+                    1e-12,
+                    &what,
+                );
+                assert_eq!(path, FactorPath::Compiled, "{what}");
             }
         }
     }
@@ -1710,20 +1706,16 @@ mod tests {
                 );
                 for d in 1..40 {
                     let values = draw(d);
-                    let (ours, path) =
-                        solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, true);
-                    let (theirs, _) =
-                        solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, false);
+                    let what = format!("n = {n}, draw {d}");
+                    let path = compiled_matches_faer(
+                        &mut factors,
+                        &mut pattern,
+                        (&values, &b),
+                        &mut mem,
+                        1e-9,
+                        &what,
+                    );
                     corrected += usize::from(path == FactorPath::Corrected);
-                    let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-                    for i in 0..n {
-                        assert!(
-                            (ours[i] - theirs[i]).abs() <= 1e-9 * scale,
-                            "n = {n}, draw {d} ({path:?}), x[{i}]: ours {} faer {}",
-                            ours[i],
-                            theirs[i]
-                        );
-                    }
                 }
             }
         }
@@ -1770,18 +1762,15 @@ mod tests {
         let mut paths = Vec::new();
         for d in 0..12 {
             let values = draw(d, d % 2 == 1, &pattern);
-            let (ours, path) = solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, true);
-            let (theirs, _) = solve_with(&mut factors, &mut pattern, &values, &b, &mut mem, false);
-            let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-            for i in 0..n {
-                assert!(
-                    (ours[i] - theirs[i]).abs() <= 1e-9 * scale,
-                    "draw {d} ({path:?}), x[{i}]: ours {} faer {}",
-                    ours[i],
-                    theirs[i]
-                );
-            }
-            paths.push(path);
+            let what = format!("draw {d}");
+            paths.push(compiled_matches_faer(
+                &mut factors,
+                &mut pattern,
+                (&values, &b),
+                &mut mem,
+                1e-9,
+                &what,
+            ));
         }
         assert_eq!(
             paths[0],
@@ -1804,22 +1793,24 @@ mod tests {
         }
     }
 
-    /// The solution of `values` by the compiled path (its path) and by
-    /// faer's LU agree to round-off.
+    /// The solution of `values` by the compiled path (its path returned)
+    /// and by faer's LU (the reference path) agree to `tol` of the
+    /// largest entry.
     fn compiled_matches_faer(
         factors: &mut Factors,
         pattern: &mut Pattern,
-        values: &[f64],
-        b: &[f64],
+        (values, b): (&[f64], &[f64]),
         mem: &mut MemBuffer,
+        tol: f64,
         what: &str,
     ) -> FactorPath {
         let (ours, path) = solve_with(factors, pattern, values, b, mem, true);
-        let (theirs, _) = solve_with(factors, pattern, values, b, mem, false);
+        let (theirs, reference) = solve_with(factors, pattern, values, b, mem, false);
+        assert_eq!(reference, FactorPath::Faer, "{what}");
         let scale = theirs.iter().fold(1.0f64, |m, v| m.max(v.abs()));
         for (i, (o, t)) in ours.iter().zip(&theirs).enumerate() {
             assert!(
-                (o - t).abs() <= 1e-9 * scale,
+                (o - t).abs() <= tol * scale,
                 "{what} ({path:?}), x[{i}]: ours {o} faer {t}"
             );
         }
@@ -1849,7 +1840,7 @@ mod tests {
             d += 1;
             let what = format!("draw {d}, set {set:?}");
             let values = draw(d, set, pattern);
-            compiled_matches_faer(factors, pattern, &values, &b, &mut mem, &what)
+            compiled_matches_faer(factors, pattern, (&values, &b), &mut mem, 1e-9, &what)
         };
         assert_eq!(next(None, &mut pattern, &mut factors), FactorPath::Compiled);
         // Each program's storage once MAX_PROGRAMS are kept: a replaced
@@ -1919,7 +1910,14 @@ mod tests {
         };
         let mut path = |d: u64, small: bool, pattern: &mut Pattern, factors: &mut Factors| {
             let what = format!("draw {d}, small diagonal {small}");
-            compiled_matches_faer(factors, pattern, &draw(d, small), &b, &mut mem, &what)
+            compiled_matches_faer(
+                factors,
+                pattern,
+                (&draw(d, small), &b),
+                &mut mem,
+                1e-9,
+                &what,
+            )
         };
         assert_eq!(
             path(0, false, &mut pattern, &mut factors),

@@ -303,8 +303,8 @@ impl Model {
                 // 15–31 unknowns) costs about eight chord steps here;
                 // renewing the kept one at that cost cut the instructions
                 // per step of the `bench/peer` cases by 2–4 % (callgrind;
-                // 4 and 12 within 2 % of it, 20 less). Not for the 3D
-                // hexapod, whose larger LU made every renewal a loss.
+                // 4 and 12 within 2 % of it, 20 less). The 3D models
+                // renew at 24 (`crate::engine::surface::newton_params`).
                 refactor_cost: 8.0,
                 ..NewtonParams::default()
             },

@@ -471,10 +471,14 @@ impl Pattern {
 
     /// The renewal rule of `NewtonParams::refactor_cost` (`cost`, in chord
     /// steps; `0` never renews): whether the next solve should start with
-    /// a refactorisation rather than chord steps with the kept one.
+    /// a refactorisation rather than chord steps with the kept one. Never
+    /// after a solve of a single chord step: no solve takes fewer steps (a
+    /// fresh factorisation still takes its Newton step), so a renewal
+    /// could only add its cost.
     pub(crate) fn renew(&self, cost: f64) -> bool {
         cost > 0.0
             && self.solves_since > 0
+            && self.last_chords > 1
             && self.last_chords as f64 * self.solves_since as f64 > cost + self.chords_since as f64
     }
 }
@@ -1940,6 +1944,43 @@ mod tests {
             );
         }
         assert_eq!(pattern.programs.len(), 1);
+    }
+
+    /// The renewal rule's bookkeeping: once a solve costs more chord steps
+    /// than the average per solve since the factorisation, renewal
+    /// included, the next solve renews it — unless that solve took a single
+    /// chord step, the fewest a solve can take when the guess is not the
+    /// solution (a robot standing still: most solves take none).
+    #[test]
+    fn a_single_chord_step_never_renews() {
+        let mut entries = vec![(0, 0), (1, 1)];
+        let mut pattern = Pattern::build(0, 2, &mut entries);
+        assert!(!pattern.renew(4.0), "no solve since the factorisation");
+        for _ in 0..10 {
+            pattern.solved(0);
+        }
+        // One chord step after ten solves without: 1·11 > 4 + 1, but no
+        // factorisation could have saved it.
+        pattern.chords_since += 1;
+        pattern.solved(1);
+        assert!(!pattern.renew(4.0), "renewed after a single chord step");
+        // A solve of two: 2·12 > 4 + 3, renew; not with the rule off.
+        pattern.chords_since += 2;
+        pattern.solved(2);
+        assert!(pattern.renew(4.0));
+        assert!(!pattern.renew(0.0));
+        // Fresh, two chord steps a solve: 2·1 ≤ 4 + 2, then 2·2 ≤ 4 + 4,
+        // then 2·3 ≤ 4 + 6: the average cost never falls below two.
+        let mut fresh = Pattern::build(0, 2, &mut vec![(0, 0), (1, 1)]);
+        for _ in 0..3 {
+            fresh.chords_since += 2;
+            fresh.solved(2);
+            assert!(!fresh.renew(4.0));
+        }
+        // A solve of four tips it: 4·4 > 4 + 10.
+        fresh.chords_since += 4;
+        fresh.solved(4);
+        assert!(fresh.renew(4.0));
     }
 
     #[test]

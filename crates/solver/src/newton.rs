@@ -97,8 +97,10 @@ pub struct NewtonParams {
     /// the average cost per solve since the last factorisation,
     /// `(refactor_cost + chord steps since) / solves since` — the
     /// renewal rule that minimises the average cost per solve when the
-    /// running cost grows. `0` disables it (the factorisation is renewed
-    /// only when a chord step contracts too little). Default: `0`.
+    /// running cost grows — except after a solve of a single chord step,
+    /// which no factorisation could make cheaper. `0` disables it (the
+    /// factorisation is renewed only when a chord step contracts too
+    /// little). Default: `0`.
     pub refactor_cost: f64,
     /// **The compiled LU** (`crate::compiled`): each pattern's numeric LU
     /// compiled, at its first factorisation, into a flat list of

@@ -396,6 +396,38 @@ pub fn system<'a, M: SurfaceEngine>(
     (sys, &mut data.solver, &mut data.z)
 }
 
+/// Newton's parameters of every model on a 3D surface (the paper's
+/// hexapod and every imported robot).
+pub fn newton_params() -> fbd_solver::NewtonParams {
+    fbd_solver::NewtonParams {
+        chord_steps: 6,
+        // The planar engine's tolerance. The angular momentum of a free
+        // robot drifts by the residual's moments: 1.8e-9 relative over
+        // 2000 steps at this tolerance, 1e-10 at a tolerance of 1e-10
+        // (`tests/spatial_flight.rs`), which costs 30 % more iterations on
+        // a walk.
+        residual_tol: 1e-9,
+        // The complementarity rows are semismooth: near a point that just
+        // starts or stops sliding, or lands while it slides, Newton's
+        // iterates cross branches and converge linearly for a while, and a
+        // step may have to be cut far down before the residual's max-norm
+        // decreases.
+        max_iterations: 50,
+        max_backtracks: 30,
+        // Renewing a stale factorisation when it costs more chord steps
+        // than about 24 (the compiled LU made a refactorisation of the
+        // hexapod's ~150 unknowns cheap enough): the `bench/peer` walk
+        // takes 5,707 Newton iterations instead of 7,657 and 9.8 % fewer
+        // instructions per step (callgrind); standing, the height map and
+        // the 1000 landings (every 25th, −2.4 % instructions in all, within
+        // their spread between builds) are not slower. 8 and 16 do as well
+        // on the walk, and 12 cost the landings 4 % more, 32 and 48 less on
+        // the walk (−9.3 %, −6.8 %).
+        refactor_cost: 24.0,
+        ..fbd_solver::NewtonParams::default()
+    }
+}
+
 /// The equations of the trial states and their scales ([`system`]).
 pub fn prepare_rows<M: SurfaceEngine>(model: &M, data: &mut RunData<M>) {
     let surface = model.ground();

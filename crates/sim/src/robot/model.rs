@@ -194,13 +194,7 @@ impl RobotSim {
             effort: robot.joints.iter().map(|j| j.effort).collect(),
             contact_bumper: vec![0.0; contact_specs.len()],
             contact_specs,
-            newton: NewtonParams {
-                chord_steps: 6,
-                residual_tol: 1e-9,
-                max_iterations: 50,
-                max_backtracks: 30,
-                ..NewtonParams::default()
-            },
+            newton: crate::engine::surface::newton_params(),
             steps: (p.duration / p.dt).round() as usize + 1,
             initial_states,
             max_substeps: 256,

@@ -245,23 +245,7 @@ impl SpatialModel {
         let model = Self {
             params: p.clone(),
             steps: (p.duration / p.dt).round() as usize + 1,
-            newton: NewtonParams {
-                chord_steps: 6,
-                // The planar engine's tolerance. The angular momentum of a
-                // free robot drifts by the residual's moments: 1.8e-9
-                // relative over 2000 steps at this tolerance, 1e-10 at a
-                // tolerance of 1e-10 (`tests/spatial_flight.rs`), which
-                // costs 30 % more iterations on a walk.
-                residual_tol: 1e-9,
-                // The complementarity rows are semismooth: near a point
-                // that just starts or stops sliding, or lands while it
-                // slides, Newton's iterates cross branches and converge
-                // linearly for a while, and a step may have to be cut far
-                // down before the residual's max-norm decreases.
-                max_iterations: 50,
-                max_backtracks: 30,
-                ..NewtonParams::default()
-            },
+            newton: crate::engine::surface::newton_params(),
             contact_bumper,
             initial_states,
             max_substeps: 256,

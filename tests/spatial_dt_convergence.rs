@@ -12,7 +12,7 @@
 //! The events: those of the touchdown (before 0.5 s) are the same number
 //! at every Δt, to within five. The robot then settles by rocking on the
 //! ring of its six hip points, each rock about a tenth of the tilt and a
-//! third of the time of the one before (18.6, 1.39, 0.11, 0.011 mrad), to
+//! third of the time of the one before (18.5, 1.39, 0.11, 0.011 mrad), to
 //! rest at a finite time: infinitely many rocks in finite time, as a plate
 //! dropped almost flat (Zeno), each a round of hip touchdowns, lift-offs
 //! and the slips they jolt. A finer Δt resolves more rocks, about one more

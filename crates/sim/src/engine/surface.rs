@@ -414,15 +414,15 @@ pub fn newton_params() -> fbd_solver::NewtonParams {
         // decreases.
         max_iterations: 50,
         max_backtracks: 30,
-        // Renewing a stale factorisation when it costs more chord steps
-        // than about 24 (the compiled LU made a refactorisation of the
-        // hexapod's ~150 unknowns cheap enough): the `bench/peer` walk
-        // takes 5,707 Newton iterations instead of 7,657 and 9.8 % fewer
-        // instructions per step (callgrind); standing, the height map and
-        // the 1000 landings (every 25th, −2.4 % instructions in all, within
-        // their spread between builds) are not slower. 8 and 16 do as well
-        // on the walk, and 12 cost the landings 4 % more, 32 and 48 less on
-        // the walk (−9.3 %, −6.8 %).
+        // Renewing a stale factorisation when the solves since it have
+        // cost more than 24 chord steps a renewal (the compiled LU made a
+        // refactorisation of the hexapod's ~150 unknowns cheap enough):
+        // the `bench/peer` walk takes 5,707 Newton iterations instead of
+        // 7,657 and 9.8 % fewer instructions a step (callgrind; 8, 12 and
+        // 16 within 1 % of it, 32 and 48 −9.3 % and −6.8 %). Standing is
+        // unchanged, the height map −0.8 %, and 120 of the 1000
+        // landings (`--shard 0/25`, `1/25`, `2/25`) −1.3 % in all: −2.4 %,
+        // +3.4 % and −3.7 %, the spread of their chaotic paths.
         refactor_cost: 24.0,
         ..fbd_solver::NewtonParams::default()
     }

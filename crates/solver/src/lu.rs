@@ -1599,12 +1599,7 @@ mod tests {
                 values
             };
             let first = values_at(0.0);
-            let (_, path) = solve_with(&mut factors, &mut pattern, &first, &b, &mut mem, true);
-            assert_eq!(
-                path,
-                FactorPath::Compiled,
-                "the first factorisation compiles and runs the program"
-            );
+            first_compiles(&mut factors, &mut pattern, &first, &b, &mut mem);
             for eps in [0.0, 1e-3, 0.05] {
                 let values = values_at(eps);
                 let what = format!("n = {n}, eps = {eps}");
@@ -1701,13 +1696,7 @@ mod tests {
                     }
                     values
                 };
-                let (_, path) =
-                    solve_with(&mut factors, &mut pattern, &draw(0), &b, &mut mem, true);
-                assert_eq!(
-                    path,
-                    FactorPath::Compiled,
-                    "the first factorisation compiles and runs the program"
-                );
+                first_compiles(&mut factors, &mut pattern, &draw(0), &b, &mut mem);
                 for d in 1..40 {
                     let values = draw(d);
                     let what = format!("n = {n}, draw {d}");
@@ -1800,6 +1789,22 @@ mod tests {
     /// The solution of `values` by the compiled path (its path returned)
     /// and by faer's LU (the reference path) agree to `tol` of the
     /// largest entry.
+    /// The pattern's first factorisation compiles its program and runs it.
+    fn first_compiles(
+        factors: &mut Factors,
+        pattern: &mut Pattern,
+        values: &[f64],
+        b: &[f64],
+        mem: &mut MemBuffer,
+    ) {
+        let (_, path) = solve_with(factors, pattern, values, b, mem, true);
+        assert_eq!(
+            path,
+            FactorPath::Compiled,
+            "the first factorisation compiles and runs the program"
+        );
+    }
+
     fn compiled_matches_faer(
         factors: &mut Factors,
         pattern: &mut Pattern,

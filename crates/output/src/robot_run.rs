@@ -344,7 +344,7 @@ impl RunFiles for RobotFiles<'_> {
             steps_planned: run.steps_planned,
             stride: robot.config.output.stride,
             contact_points: sim.mech.contacts.iter().map(|c| c.name.clone()).collect(),
-            stability_check_seconds: None,
+            stability_check_seconds: Some(sim.stability_check_seconds),
             peak_normal_force: true,
         };
         let events = events.into_iter().map(|(_, _, e)| e).collect();

@@ -45,6 +45,10 @@ pub struct RobotSim {
     /// Regularisation added to each contact point's position rows: 0
     /// (every point of an imported robot is a foot or a sphere).
     pub contact_bumper: Vec<f64>,
+    /// Wall time (s) of the start-up stability check of the joint
+    /// controller (`pd_stability`) in [`RobotSim::new`], as the hexapod's
+    /// (`SpatialModel::stability_check_seconds`); zero without one.
+    pub stability_check_seconds: f64,
     /// The (unused) ground of a run in flight.
     pub(crate) no_ground: fbd_contact::Surface,
 }
@@ -153,7 +157,9 @@ impl RobotSim {
                 )?;
             }
         }
+        let start = std::time::Instant::now();
         pd_stability(robot, p)?;
+        let stability_check_seconds = start.elapsed().as_secs_f64();
         let contacts: Vec<usize> = if p.terrain.is_some() {
             (0..robot.contacts.len()).collect()
         } else {
@@ -200,6 +206,7 @@ impl RobotSim {
             max_substeps: 256,
             cycle_tolerance: 1e-7 * total_mass * p.gravity.abs().max(1.0),
             complementarity: true,
+            stability_check_seconds,
             no_ground: fbd_contact::Surface::default(),
             mech,
         })

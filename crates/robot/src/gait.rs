@@ -1034,14 +1034,17 @@ mod tests {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../../examples/robots/lab_hexapod.urdf");
         let model = crate::urdf::load(&path, Up::Z, &ContactChoice::CollisionSpheres).unwrap();
-        let mut q = vec![0.0; model.joint_count()];
-        for (j, joint) in model.joints.iter().enumerate() {
-            if joint.name.ends_with("_femur_joint") {
-                q[j] = 20f64.to_radians();
-            } else if joint.name.ends_with("_tibia_joint") {
-                q[j] = -20f64.to_radians();
-            }
-        }
+        // Femurs 20° up, tibias 20° down, the rest at zero.
+        let degrees = |name: &str| match name.rsplit('_').nth(1) {
+            Some("femur") => 20.0,
+            Some("tibia") => -20.0,
+            _ => 0.0f64,
+        };
+        let q: Vec<f64> = model
+            .joints
+            .iter()
+            .map(|joint| degrees(&joint.name).to_radians())
+            .collect();
         let feet: Vec<usize> = (0..model.contacts.len())
             .filter(|&c| model.contacts[c].name.ends_with("_foot_sphere"))
             .collect();

@@ -570,7 +570,7 @@ pub struct GaitPlan {
     /// The last targets (the IK's warm start).
     q: Vec<f64>,
     /// The last targets' rates and time: the warm start of a call at most
-    /// `WARM_RATE_SPAN` later is `q + (t − t_last)·qd`.
+    /// `WARM_RATE_SPAN` later is `q + h·qd + h²/2·qdd`, `h = t − t_last`.
     qd: Vec<f64>,
     /// The change of the rates over the last call's step forward divided
     /// by its length (rad/s², zero after a longer step), for the warm
@@ -597,10 +597,10 @@ const EVENT_SNAP: f64 = 1e-9;
 const IK_STOP: f64 = 0.01;
 
 /// The longest step forward in time (s) over which [`GaitPlan::targets`]
-/// starts the IK from the last targets moved on at their rates (a joint
-/// off by `~θ̈·Δt²/2`, one Newton iteration from the tolerance at a
-/// controller's Δt) rather than from the last targets: longer steps, or
-/// steps back, start from the last targets.
+/// starts the IK from the last targets moved on at their rates, to second
+/// order (a joint then off by about `θ⃛·Δt³/6`, one Newton iteration from
+/// the tolerance at a controller's Δt), rather than from the last targets
+/// themselves: longer steps, and steps back, start from those.
 const WARM_RATE_SPAN: f64 = 0.01;
 
 /// `sin x / x`.

@@ -47,7 +47,8 @@ pub struct RobotSim {
     pub contact_bumper: Vec<f64>,
     /// Wall time (s) of the start-up stability check of the joint
     /// controller (`pd_stability`) in [`RobotSim::new`], as the hexapod's
-    /// (`SpatialModel::stability_check_seconds`); zero without one.
+    /// (`SpatialModel::stability_check_seconds`); next to nothing for a
+    /// run without a controller, which has no gains to check.
     pub stability_check_seconds: f64,
     /// The (unused) ground of a run in flight.
     pub(crate) no_ground: fbd_contact::Surface,

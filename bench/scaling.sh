@@ -14,6 +14,7 @@
 #   THREADS="1 2 8 16" bash bench/scaling.sh
 #   PROFILE=quick bash bench/scaling.sh    # the quick profile's binary
 #   FBD=path/to/fbd bash bench/scaling.sh  # a binary built elsewhere (no cargo)
+#   SWEEP=big.toml bash bench/scaling.sh   # another batch (a sweep file)
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
 root="$(cd "$here/.." && pwd)"
@@ -24,7 +25,7 @@ else
     (cd "$root" && cargo build -q --profile "$profile" --bin fbd)
     fbd="${CARGO_TARGET_DIR:-$root/target}/$profile/fbd"
 fi
-sweep="$here/scaling_walk.toml"
+sweep="$(cd "$(dirname "${SWEEP:-$here/scaling_walk.toml}")" && pwd)/$(basename "${SWEEP:-scaling_walk.toml}")"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 

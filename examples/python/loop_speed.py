@@ -2,6 +2,7 @@
 run` of the same motion, and the vector environment for N = 1, 2, 8.
 
     python examples/python/loop_speed.py [--fbd target/release/fbd] [--repeat 3]
+    python examples/python/loop_speed.py --vector 1,2,4,8,16   # other N
 
 The motion: examples/hexapod_stand.toml (the hexapod dropped 5 cm onto
 flat ground, PD-held joints, 1 s = 1001 steps at Δt = 1 ms), run four ways
@@ -16,7 +17,7 @@ that give the same trajectory bit for bit (the script checks it):
   ``sim.step(steps=20)``, 50 times (a 50 Hz policy over 1 kHz physics).
 
 Then ``fbd/HexapodWalk-v0``'s vector entry point with N = 1, 2, 8
-sub-environments (zero actions, 50 steps of 20 physics steps each), and N
+(``--vector``) sub-environments (zero actions, 50 steps of 20 physics steps each), and N
 serial environments for comparison: environment steps per second and
 physics steps per second. Prints the best of ``--repeat`` runs of each.
 """
@@ -109,13 +110,29 @@ def main() -> None:
     p.add_argument("--fbd", help="the fbd binary (for `fbd run`)")
     p.add_argument("--repeat", type=int, default=3)
     p.add_argument("--skip-vector", action="store_true")
+    p.add_argument("--skip-loop", action="store_true", help="only the vector environment")
+    p.add_argument("--vector", default="1,2,8", help="the vector environment's N, comma-separated (default 1,2,8)")
     args = p.parse_args()
     best = lambda f: max((f() for _ in range(args.repeat)), key=lambda x: x[0])  # noqa: E731
+    print(f"load average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    if not args.skip_loop:
+        loop(args, best)
+    if args.skip_vector:
+        return
+    print()
+    print("| HexapodWalk-v0, N sub-environments | vector env: env steps/s (physics steps/s) | N serial envs: env steps/s |")
+    print("|---|---|---|")
+    for n in (int(x) for x in args.vector.split(",")):
+        v = max(vector(n, False) for _ in range(args.repeat))
+        s = max(vector(n, True) for _ in range(args.repeat))
+        print(f"| N = {n} | {v:,.0f} ({20 * v:,.0f}) | {s:,.0f} ({20 * s:,.0f}) |")
+
+
+def loop(args, best) -> None:
     s_run, q_run = best(builtin)
     s_tau, q_tau = best(torques_every_step)
     s_pd, q_pd = best(targets_every_20)
     same = np.array_equal(q_run, q_tau) and np.array_equal(q_run, q_pd)
-    print(f"load average: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     print("| 1 kHz hexapod loop (examples/hexapod_stand.toml, 1000 steps) | steps/s |")
     print("|---|---|")
     if args.fbd:
@@ -124,15 +141,6 @@ def main() -> None:
     print(f"| Python: torques every step (NumPy PD, `sim.step(tau)`) | {s_tau:,.0f} |")
     print(f"| Python: PD targets every 20 steps (`sim.step(steps=20)`) | {s_pd:,.0f} |")
     print(f"final states of the three equal bit for bit: {same}")
-    if args.skip_vector:
-        return
-    print()
-    print("| HexapodWalk-v0, N sub-environments | vector env: env steps/s (physics steps/s) | N serial envs: env steps/s |")
-    print("|---|---|---|")
-    for n in (1, 2, 8):
-        v = max(vector(n, False) for _ in range(args.repeat))
-        s = max(vector(n, True) for _ in range(args.repeat))
-        print(f"| N = {n} | {v:,.0f} ({20 * v:,.0f}) | {s:,.0f} ({20 * s:,.0f}) |")
 
 
 if __name__ == "__main__":

@@ -157,10 +157,13 @@ pub fn load_robot(
     let err =
         |e: fbd_scenario::ConfigError, from_text| crate::errors::config_error(py, &e, from_text);
     if let Ok(d) = obj.cast::<PyDict>() {
-        let table = to_table(d, "")?;
-        if table.get("model").and_then(|m| m.as_str()) != Some(fbd_scenario::robot::MODEL) {
+        // Only `model` decides (the whole dict is converted once, by
+        // whichever loader takes it).
+        let model: Option<String> = d.get_item("model")?.and_then(|m| m.extract().ok());
+        if model.as_deref() != Some(fbd_scenario::robot::MODEL) {
             return Ok(None);
         }
+        let table = to_table(d, "")?;
         let text = toml::to_string(&table)
             .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))?;
         return load_str(&text, std::path::Path::new(DICT_SOURCE))

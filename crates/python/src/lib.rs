@@ -17,6 +17,7 @@ mod config;
 mod errors;
 mod hexapod;
 mod kinematics;
+mod observe;
 mod robot;
 mod run;
 mod simulator;
@@ -40,6 +41,8 @@ fn _fbd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<simulator::Simulator>()?;
     m.add_class::<simulator::SimulatorState>()?;
     m.add_function(wrap_pyfunction!(simulator::step_many, m)?)?;
+    m.add_function(wrap_pyfunction!(simulator::observe_many, m)?)?;
+    m.add_function(wrap_pyfunction!(simulator::set_pd_targets_many, m)?)?;
     m.add_function(wrap_pyfunction!(simulator::_state_from_log, m)?)?;
     m.add_function(wrap_pyfunction!(simulator::_simulator_from_state, m)?)?;
     m.add(

@@ -19,6 +19,7 @@ use pyo3::types::{PyBytes, PyDict, PyList, PyString};
 use rayon::prelude::*;
 
 use crate::errors::{config_error, guard, simulation_error};
+use crate::observe::state_code;
 
 /// What a Newton failure after the caller's own torques most often means.
 const EXTERNAL_TORQUE_HINT: &str = "; the torques given to step() are applied explicitly: \
@@ -362,6 +363,49 @@ impl Simulator {
             Plant::Robot(m, _) => m.params.dt,
         }
     }
+    /// Sets PD targets `position` with gains `kp`, `kd` (numbers or one
+    /// per joint), `rates` (default 0) and `torque_limit`, each checked
+    /// (`set_pd_targets`, `set_pd_targets_many`).
+    fn pd_targets_of(
+        &mut self,
+        position: Vec<f64>,
+        kp: &Bound<'_, PyAny>,
+        kd: &Bound<'_, PyAny>,
+        rates: Option<&Bound<'_, PyAny>>,
+        torque_limit: Option<f64>,
+    ) -> PyResult<()> {
+        let kp = self.vector(kp, "kp")?;
+        let kd = self.vector(kd, "kd")?;
+        let velocity = match rates {
+            Some(r) if !r.is_none() => self.vector(r, "rates")?,
+            _ => vec![0.0; position.len()],
+        };
+        if let Some(l) = torque_limit
+            && !(l.is_finite() && l > 0.0)
+        {
+            return Err(PyValueError::new_err(format!(
+                "torque_limit: must be positive and finite, got {l}"
+            )));
+        }
+        for (name, v) in [("kp", &kp), ("kd", &kd)] {
+            if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+                return Err(PyValueError::new_err(format!(
+                    "{name}: must be finite and ≥ 0"
+                )));
+            }
+        }
+        if position.iter().chain(&velocity).any(|x| !x.is_finite()) {
+            return Err(PyValueError::new_err("targets and rates must be finite"));
+        }
+        self.pd = Some(PdTargets {
+            kp,
+            kd,
+            torque_limit,
+            position,
+            velocity,
+        });
+        Ok(())
+    }
 
     fn vector(&self, v: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
         let n = self.sim.joints();
@@ -518,14 +562,6 @@ fn action_ref(a: &Logged) -> Action<'_> {
     }
 }
 
-fn state_code(c: fbd_contact::StateCode) -> u8 {
-    match c {
-        fbd_contact::StateCode::St1 => 1,
-        fbd_contact::StateCode::St2 => 2,
-        fbd_contact::StateCode::St3 => 3,
-    }
-}
-
 #[pymethods]
 impl Simulator {
     #[new]
@@ -644,37 +680,7 @@ impl Simulator {
         torque_limit: Option<f64>,
     ) -> PyResult<()> {
         let position = self.vector(targets, "targets")?;
-        let kp = self.vector(kp, "kp")?;
-        let kd = self.vector(kd, "kd")?;
-        let velocity = match rates {
-            Some(r) if !r.is_none() => self.vector(r, "rates")?,
-            _ => vec![0.0; position.len()],
-        };
-        if let Some(l) = torque_limit
-            && !(l.is_finite() && l > 0.0)
-        {
-            return Err(PyValueError::new_err(format!(
-                "torque_limit: must be positive and finite, got {l}"
-            )));
-        }
-        for (name, v) in [("kp", &kp), ("kd", &kd)] {
-            if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
-                return Err(PyValueError::new_err(format!(
-                    "{name}: must be finite and ≥ 0"
-                )));
-            }
-        }
-        if position.iter().chain(&velocity).any(|x| !x.is_finite()) {
-            return Err(PyValueError::new_err("targets and rates must be finite"));
-        }
-        self.pd = Some(PdTargets {
-            kp,
-            kd,
-            torque_limit,
-            position,
-            velocity,
-        });
-        Ok(())
+        self.pd_targets_of(position, kp, kd, rates, torque_limit)
     }
 
     /// Stops PD tracking: `step()` without torques uses the configured
@@ -1120,101 +1126,7 @@ impl Simulator {
     /// Every readout as NumPy arrays, a dict (names and layouts in
     /// docs/reference.md, "fbd.Simulator observations").
     fn observe<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let r = &self.readout;
-        let d = PyDict::new(py);
-        d.set_item("t", r.t)?;
-        d.set_item("k", r.k)?;
-        d.set_item("q", PyArray1::from_slice(py, &r.q))?;
-        d.set_item("qdot", PyArray1::from_slice(py, &r.qdot))?;
-        let b = &r.bodies;
-        d.set_item(
-            "body_position",
-            self.arr3(py, &b.iter().map(|b| b.position).collect::<Vec<_>>()),
-        )?;
-        let rot = Array3::from_shape_fn((b.len(), 3, 3), |(i, j, k)| b[i].rotation[j][k]);
-        d.set_item("body_rotation", PyArray3::from_owned_array(py, rot))?;
-        d.set_item(
-            "body_velocity",
-            self.arr3(py, &b.iter().map(|b| b.velocity).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "body_angular_velocity",
-            self.arr3(
-                py,
-                &b.iter().map(|b| b.angular_velocity).collect::<Vec<_>>(),
-            ),
-        )?;
-        let j = &r.joints;
-        d.set_item(
-            "joint_angle",
-            PyArray1::from_vec(py, j.iter().map(|j| j.angle).collect()),
-        )?;
-        d.set_item(
-            "joint_rate",
-            PyArray1::from_vec(py, j.iter().map(|j| j.rate).collect()),
-        )?;
-        d.set_item(
-            "joint_torque",
-            PyArray1::from_vec(py, j.iter().map(|j| j.torque).collect()),
-        )?;
-        let l = &r.legs;
-        d.set_item(
-            "leg",
-            PyArray1::from_vec(py, l.iter().map(|l| l.leg as i64).collect()),
-        )?;
-        d.set_item(
-            "hip_force",
-            self.arr3(py, &l.iter().map(|l| l.hip_force).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "hip_moment",
-            self.arr3(py, &l.iter().map(|l| l.hip_moment).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "knee_force",
-            self.arr3(py, &l.iter().map(|l| l.knee_force).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "knee_moment",
-            self.arr3(py, &l.iter().map(|l| l.knee_moment).collect::<Vec<_>>()),
-        )?;
-        let c = &r.contacts;
-        d.set_item(
-            "contact_position",
-            self.arr3(py, &c.iter().map(|c| c.position).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "contact_state",
-            PyArray1::from_vec(py, c.iter().map(|c| state_code(c.state)).collect()),
-        )?;
-        d.set_item(
-            "contact_force",
-            self.arr3(py, &c.iter().map(|c| c.force).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "contact_normal_force",
-            PyArray1::from_vec(py, c.iter().map(|c| c.normal_force).collect()),
-        )?;
-        d.set_item(
-            "contact_normal",
-            self.arr3(py, &c.iter().map(|c| c.normal).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "contact_slip_velocity",
-            self.arr3(py, &c.iter().map(|c| c.slip_velocity).collect::<Vec<_>>()),
-        )?;
-        let x = &r.reactions;
-        d.set_item(
-            "reaction_force",
-            self.arr3(py, &x.iter().map(|x| x.force).collect::<Vec<_>>()),
-        )?;
-        d.set_item(
-            "reaction_moment",
-            self.arr3(py, &x.iter().map(|x| x.moment).collect::<Vec<_>>()),
-        )?;
-        d.set_item("kinetic", r.kinetic)?;
-        d.set_item("potential", r.potential)?;
-        Ok(d)
+        crate::observe::observe(py, &self.readout)
     }
 
     /// Events so far, as `fbd.run` lists them: contact, joint-limit and
@@ -1282,6 +1194,71 @@ pub fn _simulator_from_state(
         sim.pd = Some(p);
     }
     Ok(sim)
+}
+
+/// The simulators of a Python list, borrowed.
+fn borrow_all<'py>(sims: &Bound<'py, PyList>) -> PyResult<Vec<PyRef<'py, Simulator>>> {
+    sims.iter()
+        .map(|s| -> PyResult<PyRef<'py, Simulator>> {
+            let b = s.cast_into::<Simulator>()?;
+            Ok(b.try_borrow()?)
+        })
+        .collect()
+}
+
+/// `observe_many(sims, names=None)`: the readouts of `observe()` of every
+/// simulator of the list, each field stacked into one array with a
+/// leading axis of `len(sims)` (scalars such as `t` give shape
+/// `(len(sims),)`), a dict of the fields `names` (default: every one).
+/// The simulators must be of one model (each field of one shape). Row i
+/// equals `sims[i].observe()[name]`, bit for bit.
+#[pyfunction]
+#[pyo3(signature = (sims, names=None))]
+pub fn observe_many<'py>(
+    py: Python<'py>,
+    sims: &Bound<'py, PyList>,
+    names: Option<Vec<String>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let refs = borrow_all(sims)?;
+    let readouts: Vec<&Readout> = refs.iter().map(|r| &r.readout).collect();
+    crate::observe::observe_many(py, &readouts, names)
+}
+
+/// `set_pd_targets_many(sims, targets, kp, kd, torque_limit=None)`: row i
+/// of `targets` (shape `(len(sims), joints)`, rad) as the PD targets of
+/// simulator i, with the gains `kp`, `kd` (numbers or one per joint) and
+/// `torque_limit` shared by all, exactly as `sims[i].set_pd_targets(
+/// targets[i], kp, kd, torque_limit=torque_limit)` would (rates 0).
+#[pyfunction]
+#[pyo3(signature = (sims, targets, kp, kd, torque_limit=None))]
+pub fn set_pd_targets_many<'py>(
+    sims: &Bound<'py, PyList>,
+    targets: PyReadonlyArray2<'py, f64>,
+    kp: &Bound<'py, PyAny>,
+    kd: &Bound<'py, PyAny>,
+    torque_limit: Option<f64>,
+) -> PyResult<()> {
+    let t = targets.as_array();
+    if t.nrows() != sims.len() {
+        return Err(PyValueError::new_err(format!(
+            "targets: expected {} rows, one per simulator, got {}",
+            sims.len(),
+            t.nrows()
+        )));
+    }
+    for (i, s) in sims.iter().enumerate() {
+        let b = s.cast_into::<Simulator>()?;
+        let mut sim = b.try_borrow_mut()?;
+        let row: Vec<f64> = t.row(i).to_vec();
+        if row.len() != sim.sim.joints() {
+            return Err(PyValueError::new_err(format!(
+                "targets: expected {} columns, one per joint",
+                sim.sim.joints()
+            )));
+        }
+        sim.pd_targets_of(row, kp, kd, None, torque_limit)?;
+    }
+    Ok(())
 }
 
 /// `step_many(sims, torques=None, steps=1)`: steps every simulator of the

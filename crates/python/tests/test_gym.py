@@ -54,22 +54,29 @@ def test_hexapod_walk_layout_and_determinism():
     assert a[-1][-1] == 1.0, "truncated at the time limit (0.2 s, 10 actions)"
 
 
-def serial_next_step(envs, actions_seq, seed):
-    """N serial environments driven with the NEXT_STEP autoreset rule."""
+def serial_next_step(envs, actions_seq, seed, infos=None):
+    """N serial environments driven with the NEXT_STEP autoreset rule
+    (each step's infos appended to ``infos``, a list per step of a list
+    per environment, None for a reset)."""
     obs = [e.reset(seed=seed + i)[0] for i, e in enumerate(envs)]
     out = [np.stack(obs)]
     done = [False] * len(envs)
     for actions in actions_seq:
         step = []
+        step_infos = []
         for i, e in enumerate(envs):
             if done[i]:
                 o, _ = e.reset()
                 r, te, tr = 0.0, False, False
+                step_infos.append(None)
             else:
-                o, r, te, tr, _ = e.step(actions[i])
+                o, r, te, tr, info = e.step(actions[i])
+                step_infos.append(info)
             done[i] = te or tr
             step.append(np.concatenate([o, [r, te, tr]]))
         out.append(np.stack(step))
+        if infos is not None:
+            infos.append(step_infos)
     return out
 
 
@@ -82,17 +89,65 @@ def test_vector_env_equals_serial_envs(name, steps):
     seq = rng.uniform(-1, 1, size=(steps,) + venv.action_space.shape)
     obs, _ = venv.reset(seed=11)
     got = [obs]
+    got_infos = []
     resets = 0
     for actions in seq:
-        o, r, te, tr, _ = venv.step(actions)
+        o, r, te, tr, info = venv.step(actions)
         got.append(np.column_stack([o, r, te, tr]))
+        got_infos.append(info)
         resets += int(np.sum(te | tr))
     assert resets >= n, "episodes ended and were reset within the test"
     envs = [gymnasium.make(name, episode_seconds=0.08).unwrapped for _ in range(n)]
-    want = serial_next_step(envs, seq, 11)
+    want_infos = []
+    want = serial_next_step(envs, seq, 11, want_infos)
     for x, y in zip(got, want):
         np.testing.assert_array_equal(x, y)
+    # The infos too: each key with its mask, as Gymnasium's vector
+    # environments lay them out, equal to the serial environment's.
+    for info, serial in zip(got_infos, want_infos):
+        keys = {k for s in serial if s for k in s}
+        assert {k for k in info if not k.startswith("_")} == keys
+        for key in keys:
+            for i, s in enumerate(serial):
+                has = s is not None and key in s
+                assert bool(info[f"_{key}"][i]) == has, (key, i)
+                if has:
+                    assert info[key][i] == s[key], (key, i)
     venv.close()
+
+
+@pytest.mark.parametrize("name", ["fbd/HexapodWalk-v0", "fbd/PlanarStand-v0"])
+def test_observe_many_and_set_pd_targets_many_equal_one_by_one(name):
+    from fbd import _fbd
+
+    envs = [gymnasium.make(name).unwrapped for _ in range(3)]
+    for i, e in enumerate(envs):
+        e.reset(seed=20 + i)
+        e.step(e.action_space.sample() * 0.1)
+    sims = [e.sim for e in envs]
+    batch = _fbd.observe_many(sims)
+    for i, sim in enumerate(sims):
+        one = sim.observe()
+        assert set(one) == set(batch)
+        for key, value in one.items():
+            got = batch[key][i]
+            assert np.asarray(got).dtype == np.asarray(value).dtype, key
+            np.testing.assert_array_equal(got, value, err_msg=key)
+    assert set(_fbd.observe_many(sims, ["q", "t"])) == {"q", "t"}
+    with pytest.raises(ValueError, match="no field"):
+        _fbd.observe_many(sims, ["nonsense"])
+    joints = len(sims[0].joint_names)
+    targets = np.random.default_rng(2).uniform(-0.1, 0.1, size=(3, joints))
+    _fbd.set_pd_targets_many(sims, targets, 100.0, 2.0, torque_limit=50.0)
+    for i, sim in enumerate(sims):
+        got = sim.pd_targets
+        np.testing.assert_array_equal(got["targets"], targets[i])
+        np.testing.assert_array_equal(got["kp"], np.full(joints, 100.0))
+        assert got["torque_limit"] == 50.0
+    with pytest.raises(ValueError, match="rows"):
+        _fbd.set_pd_targets_many(sims, targets[:2], 100.0, 2.0)
+    with pytest.raises(ValueError, match="kp"):
+        _fbd.set_pd_targets_many(sims, targets, -1.0, 2.0)
 
 
 def test_vector_env_pickles():

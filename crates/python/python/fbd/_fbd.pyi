@@ -51,6 +51,14 @@ def step_many(
     torques: Optional[npt.NDArray[np.float64]] = None,
     steps: int = 1,
 ) -> List[Optional[BaseException]]: ...
+def observe_many(sims: List["Simulator"], names: Optional[List[str]] = None) -> Dict[str, Any]: ...
+def set_pd_targets_many(
+    sims: List["Simulator"],
+    targets: npt.NDArray[np.float64],
+    kp: Any,
+    kd: Any,
+    torque_limit: Optional[float] = None,
+) -> None: ...
 
 class Simulator:
     """The planar model, the 24-DOF hexapod or an imported robot

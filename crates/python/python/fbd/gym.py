@@ -149,27 +149,46 @@ class _FbdEnv(gymnasium.Env):
         self._error: Optional[str] = None
 
     # -- the task --------------------------------------------------------
+    # Each rule is written once, on a batch: ``o`` holds the fields
+    # ``OBSERVED`` of ``_fbd.observe_many`` (a leading axis of N
+    # simulators), ``before`` the N states ``q`` before the period; a
+    # single environment is the batch of one, and the vector environment
+    # evaluates its N sub-environments in one call of each.
+    #: The fields of ``Simulator.observe()`` the task reads.
+    OBSERVED: Tuple[str, ...] = ("t", "q")
+
     def _config(self) -> Dict[str, Any]:  # pragma: no cover - abstract
         raise NotImplementedError
 
-    def _targets(self, action: np.ndarray) -> np.ndarray:  # pragma: no cover
+    def _targets(self, a: np.ndarray) -> np.ndarray:  # pragma: no cover
+        """PD targets of the actions ``a`` (N, actions), clipped to [−1, 1]."""
         raise NotImplementedError
 
-    def _observe(self, o: Dict[str, Any]) -> np.ndarray:  # pragma: no cover
+    def _observe(self, o: Dict[str, np.ndarray]) -> np.ndarray:  # pragma: no cover
+        """The observations, shape (N, size)."""
         raise NotImplementedError
 
-    def _reward(self, o: Dict[str, Any], before: np.ndarray) -> Tuple[float, Dict[str, Any]]:  # pragma: no cover
+    def _reward(self, o: Dict[str, np.ndarray], before: np.ndarray) -> Tuple[np.ndarray, Dict[str, np.ndarray]]:  # pragma: no cover
+        """The rewards (N,) and the info entries (each (N,))."""
         raise NotImplementedError
 
-    def _terminated(self, o: Dict[str, Any]) -> bool:  # pragma: no cover
+    def _terminated(self, o: Dict[str, np.ndarray]) -> np.ndarray:  # pragma: no cover
+        """Whether each episode ended, (N,) bool."""
         raise NotImplementedError
+
+    def _gains(self) -> Tuple[Any, Any, Optional[float]]:
+        """``kp``, ``kd`` and the torque limit of the PD targets."""
+        return self.KP, self.KD, self.TORQUE_LIMIT
 
     # -- the loop --------------------------------------------------------
+    def _observation(self) -> np.ndarray:
+        return self._observe(_fbd.observe_many([self.sim], list(self.OBSERVED)))[0]
+
     def _start(self) -> Tuple[np.ndarray, Dict[str, Any]]:
         self.sim = _fbd.Simulator(self._config())
         self._error = None
         self._new_simulator()
-        return self._observe(self.sim.observe()), {}
+        return self._observation(), {}
 
     def _new_simulator(self) -> None:
         """After a new simulator is built (indices of its points)."""
@@ -181,20 +200,21 @@ class _FbdEnv(gymnasium.Env):
     def _apply(self, action: Any) -> np.ndarray:
         """Sets the PD targets of ``action``; the state before the step."""
         a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
-        self.sim.set_pd_targets(self._targets(a), self.KP, self.KD, torque_limit=self.TORQUE_LIMIT)
+        kp, kd, limit = self._gains()
+        self.sim.set_pd_targets(self._targets(a[None])[0], kp, kd, torque_limit=limit)
         return self.sim.q
 
     def _finish(self, before: np.ndarray, error: Optional[BaseException]):
         if error is not None:
             self._error = str(error)
-        o = self.sim.observe()
-        obs = self._observe(o)
+        o = _fbd.observe_many([self.sim], list(self.OBSERVED))
+        obs = self._observe(o)[0]
         if self._error is not None:
             return obs, 0.0, True, False, {"error": self._error}
-        reward, info = self._reward(o, before)
-        terminated = self._terminated(o)
+        reward, info = self._reward(o, before[None])
+        terminated = bool(self._terminated(o)[0])
         truncated = (not terminated) and self.sim.t - self._t0 >= self.episode_seconds - 0.5 * self.dt
-        return obs, reward, terminated, truncated, info
+        return obs, float(reward[0]), terminated, truncated, {k: float(v[0]) for k, v in info.items()}
 
     def step(self, action: Any):
         if self.sim is None:
@@ -206,6 +226,17 @@ class _FbdEnv(gymnasium.Env):
         except SimulationError as e:
             error = e
         return self._finish(before, error)
+
+
+def _rotate_back(rot: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """``rotᵀ·v`` of N rotations (N, 3, 3) and vectors (N, 3), each row
+    summed in the same order whatever N."""
+    return rot[:, 0, :] * v[:, 0:1] + rot[:, 1, :] * v[:, 1:2] + rot[:, 2, :] * v[:, 2:3]
+
+
+def _sum_squares(x: np.ndarray) -> np.ndarray:
+    """``Σ x²`` along the last axis of (N, m), each row on its own."""
+    return np.add.reduce(x * x, axis=1)
 
 
 def _stance_deg() -> List[float]:
@@ -264,42 +295,63 @@ class HexapodWalkEnv(_FbdEnv):
         self._tips = np.array([names.index(f"tip{leg}") for leg in range(1, 7)])
         self._hips = np.array([i for i, n in enumerate(names) if n.startswith("hip")], dtype=int)
 
+    OBSERVED = (
+        "t",
+        "q",
+        "body_rotation",
+        "body_velocity",
+        "body_angular_velocity",
+        "joint_angle",
+        "joint_rate",
+        "joint_torque",
+        "contact_state",
+        "contact_normal_force",
+        "contact_slip_velocity",
+    )
+
     def _targets(self, a: np.ndarray) -> np.ndarray:
         return self.stance + self.ACTION_SCALE * a
 
-    def _observe(self, o: Dict[str, Any]) -> np.ndarray:
-        rot = o["body_rotation"][0]
-        v = rot.T @ o["body_velocity"][0]
-        w = rot.T @ o["body_angular_velocity"][0]
-        states = o["contact_state"][self._tips].astype(np.float64) - 1.0
-        phase = 2.0 * math.pi * o["t"] / self.GAIT_PERIOD
+    def _observe(self, o: Dict[str, np.ndarray]) -> np.ndarray:
+        rot = o["body_rotation"][:, 0]
+        v = _rotate_back(rot, o["body_velocity"][:, 0])
+        w = _rotate_back(rot, o["body_angular_velocity"][:, 0])
+        states = o["contact_state"][:, self._tips].astype(np.float64) - 1.0
+        phase = [2.0 * math.pi * t / self.GAIT_PERIOD for t in o["t"].tolist()]
+        clock = np.array([[math.sin(x), math.cos(x)] for x in phase]).reshape(len(phase), 2)
+        q = o["q"]
         return np.concatenate(
             [
-                [o["q"][1]],
-                o["q"][3:6],
+                q[:, 1:2],
+                q[:, 3:6],
                 v,
                 w,
                 o["joint_angle"],
                 o["joint_rate"],
                 states,
-                o["contact_normal_force"][self._tips],
-                [math.sin(phase), math.cos(phase)],
-            ]
+                o["contact_normal_force"][:, self._tips],
+                clock,
+            ],
+            axis=1,
         )
 
-    def _reward(self, o: Dict[str, Any], before: np.ndarray) -> Tuple[float, Dict[str, Any]]:
+    def _reward(self, o: Dict[str, np.ndarray], before: np.ndarray) -> Tuple[np.ndarray, Dict[str, np.ndarray]]:
         period = self.frame_skip * self.dt
-        forward = -(o["q"][2] - before[2]) / period
-        effort = self.EFFORT * float(np.sum(o["joint_torque"] ** 2))
-        sliding = o["contact_state"][self._tips] == 3
-        slip = self.SLIP * float(np.sum(np.linalg.norm(o["contact_slip_velocity"][self._tips][sliding], axis=1)))
-        info = {"forward_speed": forward, "effort": effort, "slip": slip}
-        return forward - effort - slip, info
+        forward = -(o["q"][:, 2] - before[:, 2]) / period
+        effort = self.EFFORT * _sum_squares(o["joint_torque"])
+        slip_v = o["contact_slip_velocity"][:, self._tips]
+        speed = np.sqrt(np.add.reduce(slip_v * slip_v, axis=2))
+        sliding = o["contact_state"][:, self._tips] == 3
+        slip = self.SLIP * np.add.reduce(np.where(sliding, speed, 0.0), axis=1)
+        return forward - effort - slip, {"forward_speed": forward, "effort": effort, "slip": slip}
 
-    def _terminated(self, o: Dict[str, Any]) -> bool:
-        up = o["body_rotation"][0][1, 1]
-        hips_down = bool(np.any(o["contact_state"][self._hips] != 1)) if len(self._hips) else False
-        return bool(o["q"][1] < 0.12 or hips_down or up < 0.5)
+    def _terminated(self, o: Dict[str, np.ndarray]) -> np.ndarray:
+        up = o["body_rotation"][:, 0, 1, 1]
+        if len(self._hips):
+            hips_down = np.any(o["contact_state"][:, self._hips] != 1, axis=1)
+        else:
+            hips_down = np.zeros(len(up), dtype=bool)
+        return (o["q"][:, 1] < 0.12) | hips_down | (up < 0.5)
 
 
 def _hexapod_tips_y(q: np.ndarray) -> np.ndarray:
@@ -339,43 +391,57 @@ class PlanarStandEnv(_FbdEnv):
             "terrain": {"kind": "flat", "height": 0.0, "mu_static": mu, "mu_dynamic": 0.8 * mu},
         }
 
+    OBSERVED = ("t", "q", "qdot", "joint_torque", "contact_state", "contact_normal_force")
+
     def _targets(self, a: np.ndarray) -> np.ndarray:
         return self.stance + self.ACTION_SCALE * a
 
-    def _observe(self, o: Dict[str, Any]) -> np.ndarray:
+    def _observe(self, o: Dict[str, np.ndarray]) -> np.ndarray:
         tips = [0, 1]
         return np.concatenate(
-            [o["q"], o["qdot"], o["contact_state"][tips].astype(np.float64) - 1.0, o["contact_normal_force"][tips]]
+            [
+                o["q"],
+                o["qdot"],
+                o["contact_state"][:, tips].astype(np.float64) - 1.0,
+                o["contact_normal_force"][:, tips],
+            ],
+            axis=1,
         )
 
-    def _reward(self, o: Dict[str, Any], before: np.ndarray) -> Tuple[float, Dict[str, Any]]:
-        height = abs(o["q"][1] - self.HEIGHT) / 0.1
-        effort = 1e-4 * float(np.sum(o["joint_torque"] ** 2))
+    def _reward(self, o: Dict[str, np.ndarray], before: np.ndarray) -> Tuple[np.ndarray, Dict[str, np.ndarray]]:
+        height = np.abs(o["q"][:, 1] - self.HEIGHT) / 0.1
+        effort = 1e-4 * _sum_squares(o["joint_torque"])
         return 1.0 - height - effort, {"height_error": height, "effort": effort}
 
-    def _terminated(self, o: Dict[str, Any]) -> bool:
+    def _terminated(self, o: Dict[str, np.ndarray]) -> np.ndarray:
         q = o["q"]
-        return bool(q[1] < 0.25 or abs(q[2]) > math.radians(45.0))
+        return (q[:, 1] < 0.25) | (np.abs(q[:, 2]) > math.radians(45.0))
 
 
-def _quaternion(r: np.ndarray) -> np.ndarray:
-    """The unit quaternion ``(w, x, y, z)`` (``w ≥ 0``) of rotation ``r``."""
-    t = float(np.trace(r))
-    if t > 0.0:
-        s = 2.0 * math.sqrt(1.0 + t)
-        q = [0.25 * s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
-    elif r[0, 0] > r[1, 1] and r[0, 0] > r[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + r[0, 0] - r[1, 1] - r[2, 2])
-        q = [(r[2, 1] - r[1, 2]) / s, 0.25 * s, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s]
-    elif r[1, 1] > r[2, 2]:
-        s = 2.0 * math.sqrt(1.0 + r[1, 1] - r[0, 0] - r[2, 2])
-        q = [(r[0, 2] - r[2, 0]) / s, (r[0, 1] + r[1, 0]) / s, 0.25 * s, (r[1, 2] + r[2, 1]) / s]
-    else:
-        s = 2.0 * math.sqrt(1.0 + r[2, 2] - r[0, 0] - r[1, 1])
-        q = [(r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, 0.25 * s]
-    q = np.array(q)
-    q /= np.linalg.norm(q)
-    return -q if q[0] < 0.0 else q
+def _quaternions(r: np.ndarray) -> np.ndarray:
+    """The unit quaternions ``(w, x, y, z)`` (``w ≥ 0``) of N rotations
+    ``r`` (N, 3, 3), shape (N, 4): Shepperd's method, each row on its own."""
+    r00, r11, r22 = r[:, 0, 0], r[:, 1, 1], r[:, 2, 2]
+    t = r00 + r11 + r22
+    with np.errstate(all="ignore"):  # the branches not taken
+        s = 2.0 * np.sqrt(1.0 + t)
+        q0 = [0.25 * s, (r[:, 2, 1] - r[:, 1, 2]) / s, (r[:, 0, 2] - r[:, 2, 0]) / s, (r[:, 1, 0] - r[:, 0, 1]) / s]
+        s = 2.0 * np.sqrt(1.0 + r00 - r11 - r22)
+        q1 = [(r[:, 2, 1] - r[:, 1, 2]) / s, 0.25 * s, (r[:, 0, 1] + r[:, 1, 0]) / s, (r[:, 0, 2] + r[:, 2, 0]) / s]
+        s = 2.0 * np.sqrt(1.0 + r11 - r00 - r22)
+        q2 = [(r[:, 0, 2] - r[:, 2, 0]) / s, (r[:, 0, 1] + r[:, 1, 0]) / s, 0.25 * s, (r[:, 1, 2] + r[:, 2, 1]) / s]
+        s = 2.0 * np.sqrt(1.0 + r22 - r00 - r11)
+        q3 = [(r[:, 1, 0] - r[:, 0, 1]) / s, (r[:, 0, 2] + r[:, 2, 0]) / s, (r[:, 1, 2] + r[:, 2, 1]) / s, 0.25 * s]
+    first = t > 0.0
+    second = ~first & (r00 > r11) & (r00 > r22)
+    third = ~first & ~second & (r11 > r22)
+    q = np.select(
+        [first[:, None], second[:, None], third[:, None]],
+        [np.stack(q0, axis=1), np.stack(q1, axis=1), np.stack(q2, axis=1)],
+        np.stack(q3, axis=1),
+    )
+    q = q / np.sqrt(np.add.reduce(q * q, axis=1))[:, None]
+    return np.where(q[:, 0:1] < 0.0, -q, q)
 
 
 class RobotEnv(_FbdEnv):
@@ -488,48 +554,62 @@ class RobotEnv(_FbdEnv):
             except SimulationError:
                 self.sim.reset()  # the configuration's own initial state
         self._t0 = self.sim.t
-        return self._observe(self.sim.observe()), {}
+        return self._observation(), {}
 
     def step(self, action: Any):
         if not self._started:
             raise RuntimeError("call reset() before step()")
         return super().step(action)
 
-    def _apply(self, action: Any) -> np.ndarray:
-        a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
-        self.sim.set_pd_targets(self._targets(a), self.kp, self.kd, torque_limit=self.TORQUE_LIMIT)
-        return self.sim.q
+    OBSERVED = (
+        "t",
+        "q",
+        "qdot",
+        "body_rotation",
+        "body_angular_velocity",
+        "joint_angle",
+        "joint_rate",
+        "joint_torque",
+        "contact_state",
+        "contact_normal_force",
+    )
+
+    def _gains(self) -> Tuple[Any, Any, Optional[float]]:
+        return self.kp, self.kd, self.TORQUE_LIMIT
 
     def _targets(self, a: np.ndarray) -> np.ndarray:
         return self.stance + self.action_scale * a
 
-    def _observe(self, o: Dict[str, Any]) -> np.ndarray:
-        rot = np.asarray(o["body_rotation"][0])
-        v = rot.T @ o["qdot"][0:3]
-        w = rot.T @ o["body_angular_velocity"][0]
+    def _observe(self, o: Dict[str, np.ndarray]) -> np.ndarray:
+        rot = o["body_rotation"][:, 0]
+        v = _rotate_back(rot, o["qdot"][:, 0:3])
+        w = _rotate_back(rot, o["body_angular_velocity"][:, 0])
         states = o["contact_state"].astype(np.float64) - 1.0
         return np.concatenate(
             [
-                [o["q"][1]],
-                _quaternion(rot),
+                o["q"][:, 1:2],
+                _quaternions(rot),
                 v,
                 w,
                 o["joint_angle"],
                 o["joint_rate"],
                 states,
                 o["contact_normal_force"],
-            ]
+            ],
+            axis=1,
         ).astype(np.float64)
 
-    def _reward(self, o: Dict[str, Any], before: np.ndarray) -> Tuple[float, Dict[str, Any]]:
+    def _reward(self, o: Dict[str, np.ndarray], before: np.ndarray) -> Tuple[np.ndarray, Dict[str, np.ndarray]]:
         period = self.frame_skip * self.dt
-        forward = float(np.dot(o["q"][0:3] - before[0:3], self.forward)) / period
-        effort = self.effort * float(np.sum(o["joint_torque"] ** 2))
+        d = o["q"][:, 0:3] - before[:, 0:3]
+        f = self.forward
+        forward = (d[:, 0] * f[0] + d[:, 1] * f[1] + d[:, 2] * f[2]) / period
+        effort = self.effort * _sum_squares(o["joint_torque"])
         return forward - effort, {"forward_speed": forward, "effort": effort}
 
-    def _terminated(self, o: Dict[str, Any]) -> bool:
-        up = float(o["body_rotation"][0][1, 1])
-        return bool(o["q"][1] < self.fall_fraction * self.height0 or up < self.cos_tilt)
+    def _terminated(self, o: Dict[str, np.ndarray]) -> np.ndarray:
+        up = o["body_rotation"][:, 0, 1, 1]
+        return (o["q"][:, 1] < self.fall_fraction * self.height0) | (up < self.cos_tilt)
 
 
 class _FbdVectorEnv(VectorEnv):
@@ -573,27 +653,70 @@ class _FbdVectorEnv(VectorEnv):
     def step(self, actions: Any):
         actions = np.asarray(actions, dtype=np.float64)
         n = self.num_envs
-        obs: List[Optional[np.ndarray]] = [None] * n
-        rewards = np.zeros(n, dtype=np.float64)
-        terminated = np.zeros(n, dtype=np.bool_)
-        truncated = np.zeros(n, dtype=np.bool_)
-        infos: List[Dict[str, Any]] = [{} for _ in range(n)]
-        stepping, before = [], {}
-        for i, env in enumerate(self.envs):
-            if self._autoreset[i]:
-                obs[i], infos[i] = env.reset()
-            else:
-                before[i] = env._apply(actions[i])
-                stepping.append(i)
-        if stepping:
-            errors = _fbd.step_many([self.envs[i].sim for i in stepping], None, self.envs[0].frame_skip)
-            for i, err in zip(stepping, errors):
-                obs[i], rewards[i], terminated[i], truncated[i], infos[i] = self.envs[i]._finish(before[i], err)
-        merged: Dict[str, Any] = {}
-        for i, info in enumerate(infos):
-            merged = self._add_info(merged, info, i)
+        if not self._autoreset.any():
+            # Every sub-environment steps (the common case).
+            obs, rewards, terminated, truncated, infos = self._step_batch(np.arange(n), actions)
+        else:
+            rewards = np.zeros(n, dtype=np.float64)
+            terminated = np.zeros(n, dtype=np.bool_)
+            truncated = np.zeros(n, dtype=np.bool_)
+            obs = np.zeros((n,) + self.single_observation_space.shape, dtype=np.float64)
+            infos: Dict[str, Any] = {}
+            for i in np.flatnonzero(self._autoreset):
+                obs[i], info = self.envs[i].reset()
+                infos = self._add_info(infos, info, i)
+            stepping = np.flatnonzero(~self._autoreset)
+            if stepping.size:
+                o, r, te, tr, batch_infos = self._step_batch(stepping, actions[stepping])
+                obs[stepping], rewards[stepping], terminated[stepping], truncated[stepping] = o, r, te, tr
+                for key, values in batch_infos.items():
+                    if key.startswith("_"):
+                        continue
+                    column = np.zeros(n, dtype=values.dtype) if values.dtype != object else np.full(n, None, dtype=object)
+                    column[stepping] = values
+                    mask = np.zeros(n, dtype=np.bool_)
+                    mask[stepping] = batch_infos[f"_{key}"]
+                    infos[key], infos[f"_{key}"] = column, mask
         self._autoreset = np.logical_or(terminated, truncated)
-        return np.stack(obs), rewards, terminated, truncated, merged
+        return obs, rewards, terminated, truncated, infos
+
+    def _step_batch(self, stepping: np.ndarray, actions: np.ndarray):
+        """One control period of the sub-environments ``stepping`` with
+        ``actions`` (one row each): the task's rules once for the whole
+        batch, each row as its environment alone would compute it, bit for
+        bit. Returns the batch's observations, rewards, terminated,
+        truncated and infos (with their ``_key`` masks)."""
+        task = self.envs[0]
+        envs = [self.envs[i] for i in stepping]
+        sims = [e.sim for e in envs]
+        kp, kd, limit = task._gains()
+        a = np.clip(actions, -1.0, 1.0)
+        _fbd.set_pd_targets_many(sims, np.ascontiguousarray(task._targets(a)), kp, kd, torque_limit=limit)
+        before = _fbd.observe_many(sims, ["q"])["q"]
+        errors = _fbd.step_many(sims, None, task.frame_skip)
+        o = _fbd.observe_many(sims, list(task.OBSERVED))
+        obs = task._observe(o)
+        reward, info = task._reward(o, before)
+        terminated = task._terminated(o)
+        t0 = np.array([e._t0 for e in envs])
+        truncated = ~terminated & (o["t"] - t0 >= task.episode_seconds - 0.5 * task.dt)
+        ok = np.ones(len(envs), dtype=np.bool_)
+        infos: Dict[str, Any] = {}
+        if any(err is not None for err in errors):
+            messages = np.full(len(envs), None, dtype=object)
+            for k, (env, err) in enumerate(zip(envs, errors)):
+                if err is not None:
+                    env._error = str(err)
+                    messages[k] = env._error
+                    ok[k] = False
+            infos["error"], infos["_error"] = messages, ~ok
+            reward = np.where(ok, reward, 0.0)
+            terminated = terminated | ~ok
+            truncated = truncated & ok
+            info = {k: np.where(ok, v, 0.0) for k, v in info.items()}
+        for key, values in info.items():
+            infos[key], infos[f"_{key}"] = values, ok.copy()
+        return obs, reward, terminated, truncated, infos
 
     def close_extras(self, **kwargs: Any) -> None:
         for env in self.envs:

@@ -580,6 +580,25 @@ pub struct GaitPlan {
     position0: [f64; 3],
     phi0: [f64; 3],
     height: f64,
+    /// Targets recorded along a run's steps ([`GaitPlan::record_samples`]),
+    /// shared by the plan's clones.
+    samples: Option<std::sync::Arc<SampledTargets>>,
+}
+
+/// Joint targets of a plan stepped from `t = 0` at every step `dt` of a
+/// run, kept at every `stride`-th step (`targets[i]` at `t = i·stride·dt`):
+/// what the run's controller will command there, bit for bit, recorded
+/// once by a caller that steps the plan anyway (the configuration's reach
+/// check) for a later one that samples poses (the start-up stability
+/// check), which then needs no inverse kinematics of its own.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampledTargets {
+    /// The run's step (s).
+    pub dt: f64,
+    /// Steps between two samples.
+    pub stride: usize,
+    /// The targets (rad, in the order of the model's joints).
+    pub targets: Vec<Vec<f64>>,
 }
 
 /// Events (lift-off, touchdown) within this fraction of a period of a time
@@ -759,11 +778,29 @@ impl GaitPlan {
             position0: position,
             phi0: phi,
             height,
+            samples: None,
         };
         let mut q = q0.to_vec();
         let mut qd = vec![0.0; q0.len()];
         plan.targets(0.0, &mut q, &mut qd)?;
         Ok(plan)
+    }
+
+    /// Keeps `samples` with the plan and its clones (see
+    /// [`SampledTargets`]).
+    pub fn record_samples(&mut self, samples: SampledTargets) {
+        self.samples = Some(std::sync::Arc::new(samples));
+    }
+
+    /// Drops the recorded targets: a stability check then solves the
+    /// poses it samples itself (`tests/gait_samples.rs` compares the two).
+    pub fn forget_samples(&mut self) {
+        self.samples = None;
+    }
+
+    /// The targets recorded by [`GaitPlan::record_samples`], if any.
+    pub fn samples(&self) -> Option<&SampledTargets> {
+        self.samples.as_deref()
     }
 
     /// The contact indices of the named contact points, in order (for

@@ -571,8 +571,8 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         }
         let time = config.time.clone();
         let gait = config.gait.get_or_insert_with(Default::default);
-        let plan = resolve_gait(gait, &model, &base, init.phi_deg, &q, &file)?;
-        check_reach(&plan, &time, &file)?;
+        let mut plan = resolve_gait(gait, &model, &base, init.phi_deg, &q, &file)?;
+        check_reach(&mut plan, &time, &file)?;
         Some(plan)
     } else if config.gait.is_some() {
         return Err(semantic(
@@ -647,22 +647,37 @@ fn resolve_description(
 /// Every target of `plan` over the run's first steps is within reach: up to
 /// the start-up, the ramp and two periods (after the ramp the plan repeats
 /// itself in the body's frame every period) or the run's end, every step.
-/// The first foot out of reach is an error naming it and the time.
+/// The first foot out of reach is an error naming it and the time. The
+/// targets at the poses the start-up stability check samples over those
+/// steps ([`fbd_sim::robot::gait_pose_stride`]) are kept with `plan`
+/// ([`fbd_robot::gait::GaitPlan::record_samples`]): they are the run's
+/// own, and the check needs no inverse kinematics of its own.
 fn check_reach(
-    plan: &fbd_robot::gait::GaitPlan,
+    plan: &mut fbd_robot::gait::GaitPlan,
     time: &RobotTime,
     file: &str,
 ) -> Result<(), ConfigError> {
     let p = plan.params();
     let horizon = time.duration.min(p.startup + p.ramp + 2.0 * p.period);
     let steps = (horizon / time.dt).round() as usize + 1;
-    let mut plan = plan.clone();
-    let n = plan.standing().len();
+    let stride = fbd_sim::robot::gait_pose_stride(steps);
+    let mut stepped = plan.clone();
+    let n = stepped.standing().len();
     let (mut q, mut qd) = (vec![0.0; n], vec![0.0; n]);
+    let mut targets = Vec::with_capacity(steps / stride + 1);
     for k in 0..steps {
-        plan.targets(k as f64 * time.dt, &mut q, &mut qd)
+        stepped
+            .targets(k as f64 * time.dt, &mut q, &mut qd)
             .map_err(|e| semantic(file, format!("gait: {e}")))?;
+        if k % stride == 0 {
+            targets.push(q.clone());
+        }
     }
+    plan.record_samples(fbd_robot::gait::SampledTargets {
+        dt: time.dt,
+        stride,
+        targets,
+    });
     Ok(())
 }
 

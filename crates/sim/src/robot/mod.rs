@@ -29,6 +29,6 @@ mod step;
 pub use crate::engine::tree_record::{PLANE_ROOT, RobotContactRow, RobotRecord, plane_q_index};
 pub use control::{GaitWork, JointTrajectory, RobotControl, joint_rates};
 pub use data::RobotData;
-pub use model::{RobotSim, mass_matrix};
+pub use model::{RobotSim, gait_pose_stride, mass_matrix};
 pub use params::RobotParams;
 pub use step::step;

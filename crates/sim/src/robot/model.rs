@@ -281,6 +281,15 @@ fn pd_stability(robot: &RobotModel, p: &RobotParams) -> Result<(), SimError> {
     )
 }
 
+/// Steps between two of the poses a gait's start-up stability check
+/// samples from a run of `steps` steps (at most
+/// [`crate::joint_inertia::GAIT_POSES`] of them, evenly spread): the
+/// stride of the targets a caller records for it
+/// ([`fbd_robot::gait::GaitPlan::record_samples`]).
+pub fn gait_pose_stride(steps: usize) -> usize {
+    steps / crate::joint_inertia::GAIT_POSES + 1
+}
+
 /// Calls `visit(q, standing)` on every pose of [`pd_stability`] in order
 /// (the coordinates; the contact points standing, indices into
 /// `robot.contacts`) until it returns `false`. Every pose keeps the root
@@ -316,11 +325,34 @@ fn for_each_pose(
             }
         }
         RobotControl::Gait { plan, .. } => {
+            if let Some(samples) = plan.samples().filter(|s| s.dt == p.dt) {
+                // The targets the run will command, recorded by the
+                // configuration's reach check over the start-up, the ramp
+                // and two periods (after the ramp the plan repeats itself
+                // in the body's frame every period): no IK here.
+                let mut standing = Vec::with_capacity(plan.leg_count());
+                for (i, target) in samples.targets.iter().enumerate() {
+                    let t = (i * samples.stride) as f64 * p.dt;
+                    standing.clear();
+                    if ground {
+                        standing.extend(
+                            (0..plan.leg_count())
+                                .filter(|&l| plan.stance(l, t))
+                                .map(|l| plan.foot_contact(l)),
+                        );
+                    }
+                    q[BASE_DOF..].copy_from_slice(target);
+                    if !visit(&q, &standing) {
+                        return;
+                    }
+                }
+                return;
+            }
             let mut plan = (**plan).clone();
             let n = robot.joints.len();
             let (mut target, mut rate) = (vec![0.0; n], vec![0.0; n]);
             let steps = (p.duration / p.dt).round() as usize + 1;
-            let stride = steps / crate::joint_inertia::GAIT_POSES + 1;
+            let stride = gait_pose_stride(steps);
             let mut standing = Vec::with_capacity(plan.leg_count());
             for k in (0..steps).step_by(stride) {
                 let t = k as f64 * p.dt;

@@ -93,6 +93,20 @@ fn to_table(d: &Bound<'_, PyDict>, prefix: &str) -> PyResult<toml::Table> {
     Ok(t)
 }
 
+/// A dict configuration as TOML text (its conversion needs the GIL, its
+/// parsing not), with whether it is an imported robot's (`model =
+/// "robot"`); None when `config` is no dict.
+pub fn dict_text(config: Option<&Bound<'_, PyAny>>) -> PyResult<Option<(String, bool)>> {
+    let Some(d) = config.and_then(|c| c.cast::<PyDict>().ok()) else {
+        return Ok(None);
+    };
+    let table = to_table(d, "")?;
+    let robot = table.get("model").and_then(|m| m.as_str()) == Some(fbd_scenario::robot::MODEL);
+    let text = toml::to_string(&table)
+        .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))?;
+    Ok(Some((text, robot)))
+}
+
 /// Loads `config` (None, path, TOML text or dict) and validates it.
 pub fn load(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Loaded> {
     let Some(obj) = config.filter(|c| !c.is_none()) else {

@@ -43,6 +43,7 @@ fn _fbd(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulator::step_many, m)?)?;
     m.add_function(wrap_pyfunction!(simulator::observe_many, m)?)?;
     m.add_function(wrap_pyfunction!(simulator::set_pd_targets_many, m)?)?;
+    m.add_function(wrap_pyfunction!(simulator::simulators_many, m)?)?;
     m.add_function(wrap_pyfunction!(simulator::_state_from_log, m)?)?;
     m.add_function(wrap_pyfunction!(simulator::_simulator_from_state, m)?)?;
     m.add(

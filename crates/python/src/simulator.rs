@@ -568,54 +568,8 @@ impl Simulator {
     #[pyo3(signature = (config=None))]
     fn new(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
         guard(|| {
-            if let Some(robot) = crate::config::load_robot(py, config)? {
-                let (source, from_text) = crate::config::robot_source(config);
-                let model = robot.sim().map_err(|e| {
-                    config_error(
-                        py,
-                        &fbd_output::ConfigError::Semantic {
-                            file: source.clone(),
-                            message: e.to_string(),
-                        },
-                        from_text,
-                    )
-                })?;
-                let text = robot.config.to_toml();
-                let plant = Plant::Robot(Box::new(model), Box::new(robot));
-                return Ok(Self::build(plant, source, text));
-            }
-            let loaded = crate::config::load(py, config)?;
-            let text = loaded.config.to_toml();
-            let plant = match &loaded.config {
-                fbd_scenario::Config::Planar(c) => Plant::Planar(Box::new(
-                    c.model(&loaded.source)
-                        .map_err(|e| config_error(py, &e, loaded.from_text))?,
-                )),
-                fbd_scenario::Config::Hexapod(h) => {
-                    if !h.is_dynamic() {
-                        return Err(crate::errors::cli_error(
-                            py,
-                            &fbd_output::OutputError::Usage(format!(
-                                "{}: model = \"hexapod\" with a kinematic gait (dynamics = \"kinematic\"): Simulator steps the 3D dynamics; fbd.run(config) runs the kinematic gait",
-                                loaded.source
-                            )),
-                            true,
-                        ));
-                    }
-                    let params = h
-                        .spatial_params(&loaded.source)
-                        .map_err(|e| config_error(py, &e, loaded.from_text))?;
-                    let model = SpatialModel::new(&params).map_err(|e| {
-                        crate::errors::cli_error(
-                            py,
-                            &fbd_output::OutputError::Usage(format!("{}: {e}", loaded.source)),
-                            true,
-                        )
-                    })?;
-                    Plant::Hexapod(Box::new(model))
-                }
-            };
-            Ok(Self::build(plant, loaded.source, text))
+            let prepared = prepare(py, config)?;
+            assemble(prepared).map_err(|f| f.into_err(py))
         })
     }
 
@@ -1194,6 +1148,145 @@ pub fn _simulator_from_state(
         sim.pd = Some(p);
     }
     Ok(sim)
+}
+
+/// A configuration read with the GIL (a dict or a string is Python's),
+/// not yet built into a model.
+enum Prepared {
+    /// Loaded and validated.
+    Ready(Ready),
+    /// A dict as TOML text, parsed by [`assemble`]; `true` for a robot's.
+    Dict(String, bool),
+}
+
+/// A loaded and validated configuration.
+enum Ready {
+    Robot(Box<fbd_output::config::robot::LoadedRobot>, String, bool),
+    Loaded(Box<crate::config::Loaded>),
+}
+
+/// Why a prepared configuration could not be built, turned into the
+/// Python exception with the GIL ([`Failure::into_err`]).
+enum Failure {
+    Config(fbd_output::ConfigError, bool),
+    Usage(String),
+}
+
+impl Failure {
+    fn into_err(self, py: Python<'_>) -> PyErr {
+        match self {
+            Failure::Config(e, from_text) => config_error(py, &e, from_text),
+            Failure::Usage(m) => {
+                crate::errors::cli_error(py, &fbd_output::OutputError::Usage(m), true)
+            }
+        }
+    }
+}
+
+/// Loads `config` (None, a path, TOML text or a dict) for a simulator.
+fn prepare(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Prepared> {
+    if let Some((text, robot)) = crate::config::dict_text(config)? {
+        return Ok(Prepared::Dict(text, robot));
+    }
+    if let Some(robot) = crate::config::load_robot(py, config)? {
+        let (source, from_text) = crate::config::robot_source(config);
+        return Ok(Prepared::Ready(Ready::Robot(
+            Box::new(robot),
+            source,
+            from_text,
+        )));
+    }
+    Ok(Prepared::Ready(Ready::Loaded(Box::new(
+        crate::config::load(py, config)?,
+    ))))
+}
+
+/// Parses a prepared dict's text (as `load` and `load_robot` would).
+fn parse(prepared: Prepared) -> Result<Ready, Failure> {
+    let source = crate::config::DICT_SOURCE;
+    Ok(match prepared {
+        Prepared::Ready(ready) => ready,
+        Prepared::Dict(text, true) => {
+            let robot = fbd_output::config::robot::load_str(&text, std::path::Path::new(source))
+                .map_err(|e| Failure::Config(e, false))?;
+            Ready::Robot(Box::new(robot), source.to_owned(), false)
+        }
+        Prepared::Dict(text, false) => {
+            let config = fbd_scenario::parse_str(&text, source, &[])
+                .map_err(|e| Failure::Config(e, false))?;
+            Ready::Loaded(Box::new(crate::config::Loaded {
+                config,
+                source: source.to_owned(),
+                from_text: false,
+            }))
+        }
+    })
+}
+
+/// Builds the model and simulator of a prepared configuration (no GIL
+/// needed: [`simulators_many`] builds many on Rust threads).
+fn assemble(prepared: Prepared) -> Result<Simulator, Failure> {
+    let loaded = match parse(prepared)? {
+        Ready::Robot(robot, source, from_text) => {
+            let model = robot.sim().map_err(|e| {
+                Failure::Config(
+                    fbd_output::ConfigError::Semantic {
+                        file: source.clone(),
+                        message: e.to_string(),
+                    },
+                    from_text,
+                )
+            })?;
+            let text = robot.config.to_toml();
+            let plant = Plant::Robot(Box::new(model), robot);
+            return Ok(Simulator::build(plant, source, text));
+        }
+        Ready::Loaded(loaded) => loaded,
+    };
+    let text = loaded.config.to_toml();
+    let plant = match &loaded.config {
+        fbd_scenario::Config::Planar(c) => Plant::Planar(Box::new(
+            c.model(&loaded.source)
+                .map_err(|e| Failure::Config(e, loaded.from_text))?,
+        )),
+        fbd_scenario::Config::Hexapod(h) => {
+            if !h.is_dynamic() {
+                return Err(Failure::Usage(format!(
+                    "{}: model = \"hexapod\" with a kinematic gait (dynamics = \"kinematic\"): Simulator steps the 3D dynamics; fbd.run(config) runs the kinematic gait",
+                    loaded.source
+                )));
+            }
+            let params = h
+                .spatial_params(&loaded.source)
+                .map_err(|e| Failure::Config(e, loaded.from_text))?;
+            let model = SpatialModel::new(&params)
+                .map_err(|e| Failure::Usage(format!("{}: {e}", loaded.source)))?;
+            Plant::Hexapod(Box::new(model))
+        }
+    };
+    Ok(Simulator::build(plant, loaded.source, text))
+}
+
+/// `simulators_many(configs)`: a `Simulator` per configuration of the
+/// list (each as `Simulator(config)` builds it, bit for bit), the
+/// configurations read one after the other and the models built on Rust
+/// threads (rayon; the GIL released). The first configuration that fails
+/// raises its error, as `Simulator(config)` would. The vector
+/// environments reset their sub-environments through it.
+#[pyfunction]
+pub fn simulators_many(py: Python<'_>, configs: &Bound<'_, PyList>) -> PyResult<Vec<Simulator>> {
+    guard(|| {
+        let prepared: Vec<Prepared> = configs
+            .iter()
+            .map(|c| prepare(py, Some(&c)))
+            .collect::<PyResult<_>>()?;
+        let built: Vec<Result<Simulator, Failure>> =
+            py.detach(|| prepared.into_par_iter().map(assemble).collect());
+        built
+            .into_iter()
+            .map(|r| r.map_err(|f| f.into_err(py)))
+            .collect()
+    })
 }
 
 /// The simulators of a Python list, borrowed.

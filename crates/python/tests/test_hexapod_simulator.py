@@ -177,3 +177,30 @@ def test_step_many_equals_serial():
             s.step(t, steps=10)
     for a, b in zip(sims, serial):
         np.testing.assert_array_equal(a.q, b.q)
+
+
+def test_simulators_many_equals_one_by_one(examples):
+    """`_fbd.simulators_many` (the vector environments' resets) builds each
+    simulator as `Simulator(config)` does, from dicts, text and paths, a
+    robot's too; the first bad configuration raises its own error."""
+    from fbd import _fbd
+
+    configs = [
+        {"model": "hexapod", "time": {"dt": 0.001, "duration": 0.05}, "terrain": {"mu_static": 0.7 + 0.1 * i}}
+        for i in range(3)
+    ] + [STAND, {"time": {"dt": 0.002}}, str(examples / "robots" / "lab_hexapod_pd.toml")]
+    many = _fbd.simulators_many(configs)
+    for config, sim in zip(configs, many):
+        one = fbd.Simulator(config)
+        assert sim.model == one.model and sim.contact_points == one.contact_points
+        for _ in range(3):
+            sim.step(steps=5)
+            one.step(steps=5)
+        np.testing.assert_array_equal(sim.q, one.q)
+        a, b = sim.observe(), one.observe()
+        for key in a:
+            np.testing.assert_array_equal(a[key], b[key], err_msg=key)
+    with pytest.raises(fbd.ConfigError, match="mu_static"):
+        _fbd.simulators_many([configs[0], {"model": "hexapod", "terrain": {"mu_static": -1.0}}])
+    with pytest.raises(fbd.ConfigError, match="kinematic"):
+        _fbd.simulators_many([examples / "hexapod_tripod.toml"])

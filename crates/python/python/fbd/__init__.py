@@ -27,7 +27,7 @@ import numpy as _np
 
 from . import _fbd
 from ._errors import ConfigError, SimulationError
-from ._fbd import Simulator, SimulatorState, observe_many, set_pd_targets_many, step_many
+from ._fbd import Simulator, SimulatorState, observe_many, set_pd_targets_many, simulators_many, step_many
 
 __all__ = [
     "ConfigError",
@@ -45,6 +45,7 @@ __all__ = [
     "planar_fk",
     "run",
     "set_pd_targets_many",
+    "simulators_many",
     "step_many",
     "sweep",
 ]

@@ -185,10 +185,14 @@ class _FbdEnv(gymnasium.Env):
         return self._observe(_fbd.observe_many([self.sim], list(self.OBSERVED)))[0]
 
     def _start(self) -> Tuple[np.ndarray, Dict[str, Any]]:
-        self.sim = _fbd.Simulator(self._config())
+        self._adopt(_fbd.Simulator(self._config()))
+        return self._observation(), {}
+
+    def _adopt(self, sim: "_fbd.Simulator") -> None:
+        """Takes ``sim``, built from ``_config()``, as the episode's simulator."""
+        self.sim = sim
         self._error = None
         self._new_simulator()
-        return self._observation(), {}
 
     def _new_simulator(self) -> None:
         """After a new simulator is built (indices of its points)."""
@@ -615,7 +619,9 @@ class RobotEnv(_FbdEnv):
 class _FbdVectorEnv(VectorEnv):
     """N environments of one class stepped together: the physics of every
     sub-environment on Rust threads (``fbd._fbd.step_many``, the GIL
-    released), the rest exactly as N serial environments would, with the
+    released), the task's rules once for the whole batch
+    (``_step_batch``), new simulators built together (``_reset_envs``),
+    each result as N serial environments would give it, with the
     ``NEXT_STEP`` autoreset of Gymnasium ≥ 1.1: the step after a
     sub-environment terminated or truncated resets it (its action is
     ignored; reward 0, not terminated, not truncated)."""
@@ -642,13 +648,36 @@ class _FbdVectorEnv(VectorEnv):
             seeds = list(seed)
             if len(seeds) != self.num_envs:
                 raise ValueError(f"seed: expected {self.num_envs} seeds, got {len(seeds)}")
-        obs, infos = [], {}
-        for i, (env, s) in enumerate(zip(self.envs, seeds)):
-            o, info = env.reset(seed=s, options=options)
-            obs.append(o)
-            infos = self._add_info(infos, info, i)
+        obs = np.zeros((self.num_envs,) + self.single_observation_space.shape, dtype=np.float64)
+        infos: Dict[str, Any] = {}
+        infos = self._reset_envs(np.arange(self.num_envs), seeds, options, obs, infos)
         self._autoreset[:] = False
-        return np.stack(obs), infos
+        return obs, infos
+
+    def _reset_envs(self, ids, seeds, options, obs: np.ndarray, infos: Dict[str, Any]) -> Dict[str, Any]:
+        """Resets the sub-environments ``ids`` (with ``seeds``), their first
+        observations into ``obs``: environments that build a new simulator
+        per episode draw their configurations one after the other and
+        build the simulators together on Rust threads
+        (``_fbd.simulators_many``), each as its own ``reset`` would."""
+        envs = [self.envs[i] for i in ids]
+        if not envs:
+            return infos
+        if type(envs[0])._start is not _FbdEnv._start:
+            for i, env, s in zip(ids, envs, seeds):
+                obs[i], info = env.reset(seed=s, options=options)
+                infos = self._add_info(infos, info, i)
+            return infos
+        configs = []
+        for env, s in zip(envs, seeds):
+            gymnasium.Env.reset(env, seed=s)
+            configs.append(env._config())
+        sims = _fbd.simulators_many(configs)
+        for env, sim in zip(envs, sims):
+            env._adopt(sim)
+        task = envs[0]
+        obs[ids] = task._observe(_fbd.observe_many(sims, list(task.OBSERVED)))
+        return infos
 
     def step(self, actions: Any):
         actions = np.asarray(actions, dtype=np.float64)
@@ -662,9 +691,8 @@ class _FbdVectorEnv(VectorEnv):
             truncated = np.zeros(n, dtype=np.bool_)
             obs = np.zeros((n,) + self.single_observation_space.shape, dtype=np.float64)
             infos: Dict[str, Any] = {}
-            for i in np.flatnonzero(self._autoreset):
-                obs[i], info = self.envs[i].reset()
-                infos = self._add_info(infos, info, i)
+            resetting = np.flatnonzero(self._autoreset)
+            infos = self._reset_envs(resetting, [None] * len(resetting), None, obs, infos)
             stepping = np.flatnonzero(~self._autoreset)
             if stepping.size:
                 o, r, te, tr, batch_infos = self._step_batch(stepping, actions[stepping])

@@ -290,6 +290,19 @@ pub fn gait_pose_stride(steps: usize) -> usize {
     steps / crate::joint_inertia::GAIT_POSES + 1
 }
 
+/// The contact points of `plan`'s stance feet at `t` into `standing`
+/// (none without ground).
+fn stance_feet(plan: &fbd_robot::gait::GaitPlan, ground: bool, t: f64, standing: &mut Vec<usize>) {
+    standing.clear();
+    if ground {
+        standing.extend(
+            (0..plan.leg_count())
+                .filter(|&l| plan.stance(l, t))
+                .map(|l| plan.foot_contact(l)),
+        );
+    }
+}
+
 /// Calls `visit(q, standing)` on every pose of [`pd_stability`] in order
 /// (the coordinates; the contact points standing, indices into
 /// `robot.contacts`) until it returns `false`. Every pose keeps the root
@@ -333,14 +346,7 @@ fn for_each_pose(
                 let mut standing = Vec::with_capacity(plan.leg_count());
                 for (i, target) in samples.targets.iter().enumerate() {
                     let t = (i * samples.stride) as f64 * p.dt;
-                    standing.clear();
-                    if ground {
-                        standing.extend(
-                            (0..plan.leg_count())
-                                .filter(|&l| plan.stance(l, t))
-                                .map(|l| plan.foot_contact(l)),
-                        );
-                    }
+                    stance_feet(plan, ground, t, &mut standing);
                     q[BASE_DOF..].copy_from_slice(target);
                     if !visit(&q, &standing) {
                         return;
@@ -361,14 +367,7 @@ fn for_each_pose(
                 if plan.targets(t, &mut target, &mut rate).is_err() {
                     return;
                 }
-                standing.clear();
-                if ground {
-                    standing.extend(
-                        (0..plan.leg_count())
-                            .filter(|&l| plan.stance(l, t))
-                            .map(|l| plan.foot_contact(l)),
-                    );
-                }
+                stance_feet(&plan, ground, t, &mut standing);
                 q[BASE_DOF..].copy_from_slice(&target);
                 if !visit(&q, &standing) {
                     return;

@@ -160,3 +160,45 @@ def test_vector_env_pickles():
         x = venv.step(a)[0]
         y = twin.step(a)[0]
         np.testing.assert_array_equal(x, y)
+
+
+def test_vector_env_reports_a_failed_step_as_a_serial_env_would(monkeypatch):
+    """A sub-environment whose physics fails (here: an error injected for
+    sub-environment 1 after its period was stepped) ends its episode as a
+    single environment's `_finish` does — reward 0, terminated, not
+    truncated, `info["error"]` — while the others step on; the next step
+    resets it."""
+    import fbd.gym as fgym
+    from fbd import SimulationError
+
+    n = 3
+    venv = gymnasium.make_vec("fbd/HexapodWalk-v0", num_envs=n, vectorization_mode="vector_entry_point")
+    venv.reset(seed=5)
+    actions = np.zeros((n, 18))
+    venv.step(actions)
+    real = fgym._fbd.step_many
+    twin = pickle.loads(pickle.dumps(venv.unwrapped.envs[1]))
+    twin_before = twin._apply(actions[1])
+    twin.sim.step(steps=twin.frame_skip)
+    error = SimulationError("injected failure")
+
+    def failing(sims, torques, steps):
+        out = real(sims, torques, steps)
+        out[1] = error
+        return out
+
+    monkeypatch.setattr(fgym._fbd, "step_many", failing)
+    obs, rewards, terminated, truncated, info = venv.step(actions)
+    monkeypatch.setattr(fgym._fbd, "step_many", real)
+    want = twin._finish(twin_before, error)
+    np.testing.assert_array_equal(obs[1], want[0])
+    assert (rewards[1], bool(terminated[1]), bool(truncated[1])) == want[1:4] == (0.0, True, False)
+    assert info["error"][1] == want[4]["error"] == "injected failure"
+    assert list(info["_error"]) == [False, True, False]
+    assert list(info["_forward_speed"]) == [True, False, True]
+    assert not terminated[0] and not terminated[2]
+    # The next step resets sub-environment 1 (reward 0, its first observation).
+    obs, rewards, terminated, truncated, info = venv.step(actions)
+    assert rewards[1] == 0.0 and not terminated[1] and not truncated[1]
+    assert "error" not in info
+    venv.close()

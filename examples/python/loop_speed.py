@@ -18,8 +18,11 @@ that give the same trajectory bit for bit (the script checks it):
 
 Then ``fbd/HexapodWalk-v0``'s vector entry point with N = 1, 2, 8
 (``--vector``) sub-environments (zero actions, 50 steps of 20 physics steps each), and N
-serial environments for comparison: environment steps per second and
-physics steps per second. Prints the best of ``--repeat`` runs of each.
+serial environments for comparison: environment steps per second,
+physics steps per second, and the vector environment's Python work per
+control period (its time less the physics inside ``step_many``) and of
+a reset of all N (the fastest). Prints the best of ``--repeat`` runs of
+each.
 """
 
 from __future__ import annotations
@@ -83,7 +86,12 @@ def cli(binary: str):
 
 
 def vector(n: int, serial: bool, steps: int = 50):
+    """Environment steps per second of N sub-environments, and the Python
+    work of a control period (µs: its time less the physics in
+    `step_many`; the vector environment only)."""
     import gymnasium
+
+    import fbd.gym
 
     if serial:
         envs = [gymnasium.make("fbd/HexapodWalk-v0").unwrapped for _ in range(n)]
@@ -94,15 +102,31 @@ def vector(n: int, serial: bool, steps: int = 50):
         for _ in range(steps):
             for e in envs:
                 e.step(a)
-    else:
-        v = gymnasium.make_vec("fbd/HexapodWalk-v0", num_envs=n, vectorization_mode="vector_entry_point")
-        v.reset(seed=0)
-        a = np.zeros((n, 18))
+        return n * steps / (time.perf_counter() - t), float("nan"), float("nan")
+    v = gymnasium.make_vec("fbd/HexapodWalk-v0", num_envs=n, vectorization_mode="vector_entry_point")
+    v.reset(seed=0)
+    a = np.zeros((n, 18))
+    step_many = fbd.gym._fbd.step_many
+    physics = [0.0]
+
+    def timed(*args):
+        t0 = time.perf_counter()
+        out = step_many(*args)
+        physics[0] += time.perf_counter() - t0
+        return out
+
+    fbd.gym._fbd.step_many = timed
+    try:
         t = time.perf_counter()
         for _ in range(steps):
             v.step(a)
-    dt = time.perf_counter() - t
-    return n * steps / dt
+        dt = time.perf_counter() - t
+    finally:
+        fbd.gym._fbd.step_many = step_many
+    t = time.perf_counter()
+    v.reset(seed=1)
+    reset = time.perf_counter() - t
+    return n * steps / dt, (dt - physics[0]) / steps * 1e6, reset * 1e3
 
 
 def main() -> None:
@@ -120,12 +144,17 @@ def main() -> None:
     if args.skip_vector:
         return
     print()
-    print("| HexapodWalk-v0, N sub-environments | vector env: env steps/s (physics steps/s) | N serial envs: env steps/s |")
-    print("|---|---|---|")
+    print(
+        "| HexapodWalk-v0, N sub-environments | vector env: env steps/s (physics steps/s) "
+        "| its Python work a period (µs) | a reset of all N (ms) | N serial envs: env steps/s |"
+    )
+    print("|---|---|---|---|---|")
     for n in (int(x) for x in args.vector.split(",")):
-        v = max(vector(n, False) for _ in range(args.repeat))
-        s = max(vector(n, True) for _ in range(args.repeat))
-        print(f"| N = {n} | {v:,.0f} ({20 * v:,.0f}) | {s:,.0f} ({20 * s:,.0f}) |")
+        runs = [vector(n, False) for _ in range(args.repeat)]
+        v, py, _ = max(runs)
+        reset = min(r[2] for r in runs)
+        s, _, _ = max(vector(n, True) for _ in range(args.repeat))
+        print(f"| N = {n} | {v:,.0f} ({20 * v:,.0f}) | {py:,.0f} | {reset:.2f} | {s:,.0f} ({20 * s:,.0f}) |")
 
 
 def loop(args, best) -> None:

@@ -202,3 +202,22 @@ def test_vector_env_reports_a_failed_step_as_a_serial_env_would(monkeypatch):
     assert rewards[1] == 0.0 and not terminated[1] and not truncated[1]
     assert "error" not in info
     venv.close()
+
+
+def test_batched_rules_compute_each_row_on_its_own():
+    """The helpers the batched task rules use give each row of a batch
+    bit for bit what the row alone gives (so a vector environment of any
+    N equals its single environments)."""
+    from fbd import gym as fgym
+
+    rng = np.random.default_rng(3)
+    for n in (2, 5, 16, 33):
+        rot = np.linalg.qr(rng.normal(size=(n, 3, 3)))[0]
+        v = rng.normal(size=(n, 3))
+        x = rng.normal(size=(n, 18))
+        batch = fgym._rotate_back(rot, v), fgym._sum_squares(x), fgym._quaternions(rot)
+        for i in range(n):
+            one = fgym._rotate_back(rot[i : i + 1], v[i : i + 1]), fgym._sum_squares(x[i : i + 1]), fgym._quaternions(rot[i : i + 1])
+            for b, o in zip(batch, one):
+                np.testing.assert_array_equal(b[i], o[0])
+        np.testing.assert_allclose(batch[0], np.einsum("nji,nj->ni", rot, v), rtol=0, atol=1e-14)

@@ -233,9 +233,11 @@ class _FbdEnv(gymnasium.Env):
 
 
 def _rotate_back(rot: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``rotᵀ·v`` of N rotations (N, 3, 3) and vectors (N, 3), each row
-    summed in the same order whatever N."""
-    return rot[:, 0, :] * v[:, 0:1] + rot[:, 1, :] * v[:, 1:2] + rot[:, 2, :] * v[:, 2:3]
+    """``rotᵀ·v`` of N rotations (N, 3, 3) and vectors (N, 3): ``vᵀ·rot``
+    as a stack of N (1 × 3)·(3 × 3) products, each computed on its own
+    whatever N (the vector environments' rows equal a single
+    environment's, tested)."""
+    return np.matmul(v[:, None, :], rot)[:, 0, :]
 
 
 def _sum_squares(x: np.ndarray) -> np.ndarray:

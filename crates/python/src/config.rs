@@ -102,9 +102,13 @@ pub fn dict_text(config: Option<&Bound<'_, PyAny>>) -> PyResult<Option<(String, 
     };
     let table = to_table(d, "")?;
     let robot = table.get("model").and_then(|m| m.as_str()) == Some(fbd_scenario::robot::MODEL);
-    let text = toml::to_string(&table)
-        .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))?;
-    Ok(Some((text, robot)))
+    Ok(Some((table_text(&table)?, robot)))
+}
+
+/// A dict's table as TOML text.
+fn table_text(table: &toml::Table) -> PyResult<String> {
+    toml::to_string(table)
+        .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))
 }
 
 /// Loads `config` (None, path, TOML text or dict) and validates it.
@@ -119,8 +123,7 @@ pub fn load(py: Python<'_>, config: Option<&Bound<'_, PyAny>>) -> PyResult<Loade
     let err =
         |e: fbd_scenario::ConfigError, from_text| crate::errors::config_error(py, &e, from_text);
     if let Ok(d) = obj.cast::<PyDict>() {
-        let text = toml::to_string(&to_table(d, "")?)
-            .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))?;
+        let text = table_text(&to_table(d, "")?)?;
         let config = fbd_scenario::parse_str(&text, DICT_SOURCE, &[]).map_err(|e| err(e, false))?;
         return Ok(Loaded {
             config,
@@ -177,9 +180,7 @@ pub fn load_robot(
         if model.as_deref() != Some(fbd_scenario::robot::MODEL) {
             return Ok(None);
         }
-        let table = to_table(d, "")?;
-        let text = toml::to_string(&table)
-            .map_err(|e| PyTypeError::new_err(format!("<dict>: cannot be written as TOML: {e}")))?;
+        let text = table_text(&to_table(d, "")?)?;
         return load_str(&text, std::path::Path::new(DICT_SOURCE))
             .map(Some)
             .map_err(|e| err(e, false));

@@ -88,6 +88,12 @@ pub struct RunArgs {
     /// Output directory, created if needed.
     #[arg(short, long, value_name = "DIR", default_value = "out")]
     pub out: PathBuf,
+    /// Set a key of the configuration (repeatable, applied in order):
+    /// `--set time.dt=0.0005 --set time.duration=5`. VALUE is a TOML
+    /// value (`0.5`, `[0.0, 0.6]`, `true`, `"flat"`), or a string when it
+    /// is not one. The written config.toml holds the result.
+    #[arg(long = "set", value_name = "KEY=VALUE", value_parser = crate::Override::parse)]
+    pub set: Vec<crate::Override>,
 }
 
 /// Arguments of `fbd kinematics`.
@@ -118,7 +124,9 @@ pub struct InverseArgs {
 pub fn dispatch(cli: Cli, out: &mut dyn Write) -> Result<(), CliError> {
     match cli.command {
         None => crate::run::run_command(None, &cli.out, out),
-        Some(Command::Run(a)) => crate::run::run_command(a.config.as_deref(), &a.out, out),
+        Some(Command::Run(a)) => {
+            crate::run::run_command_with(a.config.as_deref(), &a.set, &a.out, out)
+        }
         Some(Command::Kinematics(a)) => crate::kinematics::kinematics_command(&a.config, out),
         Some(Command::Inverse(a)) => crate::kinematics::inverse_command(
             &a.config,

@@ -445,18 +445,20 @@ pub fn files(robot: &LoadedRobot) -> Vec<&'static str> {
     output::selected(output::files_as(&FILES, output.format), output)
 }
 
-/// `fbd run` of a `model = "robot"` configuration `text` read from `path`:
+/// `fbd run` of a `model = "robot"` configuration `text` read from `path`,
+/// with `overrides` (`fbd run --set`) applied:
 /// simulates, writes the files, prints the step count, and ends like every
 /// run ([`output::conclude`]: exit 3 after a simulation error, 130 when
 /// interrupted).
 pub fn run_command(
     text: &str,
     path: &Path,
+    overrides: &[crate::config::Override],
     out_dir: &Path,
     out: &mut dyn Write,
 ) -> Result<(), OutputError> {
     let source = path.display().to_string();
-    let robot = crate::config::robot::load_str(text, path)?;
+    let robot = crate::config::robot::load_with_overrides(text, path, overrides)?;
     let RobotRunOutput {
         run,
         summary: _,

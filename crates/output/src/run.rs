@@ -17,6 +17,9 @@ use crate::plot::{self, PlotData, PlotRecorder, Stance};
 use crate::steptime::StepTimes;
 use crate::viewer::{self, planar::PlanarScene};
 
+/// How messages name the configuration of a run without a file.
+const DEFAULT_SOURCE: &str = "the built-in default";
+
 /// Snapshot intervals of `stance.svg` (one more snapshot than this).
 const STANCE_INTERVALS: usize = 10;
 
@@ -399,16 +402,38 @@ pub fn run_command(
     out_dir: &Path,
     out: &mut dyn Write,
 ) -> Result<(), OutputError> {
+    run_command_with(config_path, &[], out_dir, out)
+}
+
+/// [`run_command`] with `overrides` (dotted keys, `fbd run --set
+/// KEY=VALUE`) applied to the configuration, or to the built-in default
+/// without one, in order, before it is validated: an unknown key or a
+/// value of the wrong type is a configuration error naming the key, and
+/// the `config.toml` written holds the result (so that `fbd run
+/// DIR/config.toml` repeats the run).
+pub fn run_command_with(
+    config_path: Option<&Path>,
+    overrides: &[config::Override],
+    out_dir: &Path,
+    out: &mut dyn Write,
+) -> Result<(), OutputError> {
     if let Some(p) = config_path {
         let text = config::read_text(p)?;
         if config::robot::is_robot(&text) {
             // An imported robot: every file in `robot_run`.
-            return crate::robot_run::run_command(&text, p, out_dir, out);
+            return crate::robot_run::run_command(&text, p, overrides, out_dir, out);
         }
     }
     let (config, source) = match config_path {
-        Some(p) => (config::load(p)?, p.display().to_string()),
-        None => (Config::default(), "the built-in default".to_owned()),
+        Some(p) => (
+            config::load_with_overrides(p, overrides)?,
+            p.display().to_string(),
+        ),
+        None if overrides.is_empty() => (Config::default(), DEFAULT_SOURCE.to_owned()),
+        None => (
+            config::parse_str(&Config::default().to_toml(), DEFAULT_SOURCE, overrides)?,
+            DEFAULT_SOURCE.to_owned(),
+        ),
     };
     let dynamic = match &config {
         Config::Planar(p) => p.dt_warning(),

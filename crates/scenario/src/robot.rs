@@ -973,7 +973,34 @@ pub fn load_with_overrides(
         })?;
     }
     let text = toml::to_string(&table).map_err(|e| semantic(&file, e.to_string()))?;
-    load_str(&text, path)
+    load_str(&text, path).map_err(|e| match e {
+        // A line of the text the overrides made is no line of the file:
+        // the error names the override instead.
+        ConfigError::Syntax { message, .. } => ConfigError::Override {
+            key: override_of(&message, overrides),
+            file,
+            message,
+        },
+        other => other,
+    })
+}
+
+/// The key of the override a message (`table.key: what`) is about: the
+/// last override in the table it names, or every override's key.
+fn override_of(message: &str, overrides: &[crate::Override]) -> String {
+    let table = message.split([':', ' ']).next().unwrap_or_default();
+    let named = overrides
+        .iter()
+        .rev()
+        .find(|o| o.key == table || o.key.starts_with(&format!("{table}.")));
+    match named {
+        Some(o) => o.key.clone(),
+        None => overrides
+            .iter()
+            .map(|o| o.key.as_str())
+            .collect::<Vec<_>>()
+            .join("`, `"),
+    }
 }
 
 /// Reads `path` and loads its robot ([`load_str`]).

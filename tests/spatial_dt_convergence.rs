@@ -20,8 +20,8 @@
 //! constant number per halving (logarithmically; which rocks a step
 //! resolves moves with the round-off), where a chatter at the step rate
 //! would double them with every halving: from 4 to 0.25 ms they must grow
-//! less than 8-fold (3.7-fold here; a chatter would be 16-fold). They are
-//! printed, and checked against the README's "about 120 at 4 ms, 440 at
+//! less than 8-fold (3.6-fold here; a chatter would be 16-fold). They are
+//! printed, and checked against the README's "about 130 at 4 ms, 450 at
 //! 0.25 ms", rounded to tens.
 
 mod common;
@@ -181,7 +181,7 @@ fn the_landing_converges_as_dt_shrinks() {
         finest.events,
         finest.dt
     );
-    // The README's "about 120 at 4 ms, 440 at 0.25 ms": the events rounded
+    // The README's "about 130 at 4 ms, 450 at 0.25 ms": the events rounded
     // to tens.
     let readme = common::readme::doc("README.md");
     let tens = |n: usize| (n as f64 / 10.0).round() * 10.0;

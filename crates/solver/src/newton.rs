@@ -127,6 +127,32 @@ pub struct NewtonParams {
     /// bound keeps a long tumbling run's memory finite. `0`: unbounded.
     /// Default: `256`.
     pub max_patterns: usize,
+    /// **The watchdog of a crawl**: how many full Newton steps may be
+    /// taken whole, without the line search, once the iteration crawls
+    /// ([`Self::crawl_steps`] full steps in a row cut to
+    /// [`Self::crawl_step`] or less) and a whole step does not decrease the
+    /// residual. The iterate before them is kept; the first of them whose
+    /// residual is below its residual ends the watch (the iteration goes
+    /// on from there, chord steps again allowed); when none is after this
+    /// many, the iteration returns to the kept iterate and takes its damped
+    /// step, and the watch may start again at the next step of the crawl.
+    /// A solve that ends without converging returns the kept iterate when
+    /// it ends watching (the better of the two). Semismooth Newton on the
+    /// contact rows' kinks (a point on the edge of its friction disc, the
+    /// normal's `min`) crawls so: the whole step crosses a kink and
+    /// raises the max-norm, and the line search cuts it to 1/128 and less
+    /// for tens of iterations, each 0.2 % lower; the whole steps cross
+    /// the kink and converge beyond it (see `docs/reference.md`, *Speed*).
+    /// `0` disables it. Default: `0` (the 3D models take 5).
+    pub watchdog: usize,
+    /// Full steps in a row cut to [`Self::crawl_step`] or less that make
+    /// a crawl (see [`Self::watchdog`]). Default: `2`.
+    pub crawl_steps: usize,
+    /// The step length (fraction of the Newton step) at or below which a
+    /// damped full step is a step of a crawl (see [`Self::watchdog`]).
+    /// Default: `1/16`: the 3D walk's damped steps, where its feet land,
+    /// are longer, and its path is the same with the watchdog as without.
+    pub crawl_step: f64,
 }
 
 impl Default for NewtonParams {
@@ -142,6 +168,9 @@ impl Default for NewtonParams {
             refactor_cost: 0.0,
             compiled_lu: true,
             max_patterns: 256,
+            watchdog: 0,
+            crawl_steps: 2,
+            crawl_step: 1.0 / 16.0,
         }
     }
 }
@@ -174,6 +203,10 @@ struct Workspace {
     dx: Vec<f64>,
     x_trial: Vec<f64>,
     r_trial: Vec<f64>,
+    /// The iterate and residual kept by the watchdog
+    /// ([`NewtonParams::watchdog`]).
+    x_kept: Vec<f64>,
+    r_kept: Vec<f64>,
     mem: MemBuffer,
     mem_req: StackReq,
     /// Scratch of the compiled LU's compilations (grown to the largest
@@ -201,6 +234,8 @@ impl Clone for Workspace {
             dx: self.dx.clone(),
             x_trial: self.x_trial.clone(),
             r_trial: self.r_trial.clone(),
+            x_kept: self.x_kept.clone(),
+            r_kept: self.r_kept.clone(),
             mem: MemBuffer::new(self.mem_req),
             mem_req: self.mem_req,
             compile: CompileScratch::default(),
@@ -283,6 +318,8 @@ impl NewtonSolver {
                 dx: Vec::new(),
                 x_trial: Vec::new(),
                 r_trial: Vec::new(),
+                x_kept: Vec::new(),
+                r_kept: Vec::new(),
                 mem: MemBuffer::new(StackReq::EMPTY),
                 mem_req: StackReq::EMPTY,
                 compile: CompileScratch::default(),
@@ -617,6 +654,8 @@ impl Workspace {
             &mut self.dx,
             &mut self.x_trial,
             &mut self.r_trial,
+            &mut self.x_kept,
+            &mut self.r_kept,
         ] {
             v.reserve(n.saturating_sub(v.len()));
         }
@@ -683,6 +722,15 @@ impl Workspace {
         set_len(&mut self.dx, n);
         set_len(&mut self.x_trial, n);
         set_len(&mut self.r_trial, n);
+        set_len(&mut self.x_kept, n);
+        set_len(&mut self.r_kept, n);
+        // The watchdog (`NewtonParams::watchdog`): full steps in a row cut
+        // to `crawl_step` or less, and, while watching, the kept iterate's
+        // residual norm and the whole steps left.
+        let mut crawl = 0usize;
+        let mut watch: Option<(f64, usize)> = None;
+        // The step right after a return to the kept iterate is damped.
+        let mut damp = false;
 
         let chords = params.chord_steps > 0;
         // Full Newton steps and chord steps applied to `x`, factorisations.
@@ -711,6 +759,21 @@ impl Workspace {
                     residual: rnorm,
                     factorizations,
                 });
+            }
+            if let Some((kept, left)) = watch {
+                if rnorm < kept {
+                    watch = None;
+                } else if left == 0 {
+                    // No whole step got below the kept iterate: back to it,
+                    // for its damped step.
+                    watch = None;
+                    damp = true;
+                    x.copy_from_slice(&self.x_kept);
+                    self.r.copy_from_slice(&self.r_kept);
+                    rnorm = kept;
+                    have_jacobian = false;
+                    usable = false;
+                }
             }
 
             if usable && *run < params.chord_steps {
@@ -750,6 +813,11 @@ impl Workspace {
 
             // Full Newton step: factor J at x and solve J Δx = −r.
             if full == params.max_iterations {
+                if let Some((kept, _)) = watch {
+                    // The better iterate.
+                    x.copy_from_slice(&self.x_kept);
+                    rnorm = kept;
+                }
                 return Err(SolverError::Diverged {
                     iter: full,
                     residual: rnorm,
@@ -831,6 +899,23 @@ impl Workspace {
                 }
                 if let Some(trial_norm) = scaled_norm(sys, &self.r_trial) {
                     any_finite = true;
+                    // The watchdog's whole step (see `NewtonParams::watchdog`).
+                    let crawling = params.watchdog > 0
+                        && crawl >= params.crawl_steps.max(1)
+                        && trial_norm >= rnorm;
+                    if k == 0 && !damp && (watch.is_some() || crawling) {
+                        watch = Some(match watch {
+                            Some((kept, left)) => (kept, left - 1),
+                            None => {
+                                self.x_kept.copy_from_slice(x);
+                                self.r_kept.copy_from_slice(&self.r);
+                                (rnorm, params.watchdog - 1)
+                            }
+                        });
+                        have_jacobian = false;
+                        accepted = Some(trial_norm);
+                        break;
+                    }
                     if trial_norm < rnorm {
                         have_jacobian = k == 0 && !chords;
                         accepted = Some(trial_norm);
@@ -864,9 +949,15 @@ impl Workspace {
             std::mem::swap(&mut self.r, &mut self.r_trial);
             rnorm = trial_norm;
             full += 1;
+            damp = false;
+            crawl = if alpha <= params.crawl_step {
+                crawl + 1
+            } else {
+                0
+            };
             // A damped step: far from the root, where the Jacobian changes
-            // fast; the next step refactors too.
-            usable = chords && alpha == 1.0;
+            // fast; the next step refactors too, as does a watched one.
+            usable = chords && alpha == 1.0 && watch.is_none();
             *run = 0;
         }
     }

@@ -476,3 +476,83 @@ fn the_pattern_cache_is_bounded_and_evicts_the_least_recently_used() {
     assert_eq!(bounded.evicted_patterns(), 4);
     assert_eq!(bounded.symbolic_factorizations(), 6);
 }
+
+/// The linear complementarity problem `min(x, A·x + b) = 0` (two
+/// unknowns), semismooth like the contact rows: row `i` is `x_i` where
+/// `x_i ≤ y_i` and `y_i = (A·x + b)_i` beyond.
+struct Lcp {
+    a: [[f64; 2]; 2],
+    b: [f64; 2],
+}
+
+impl Lcp {
+    fn y(&self, x: &[f64]) -> [f64; 2] {
+        std::array::from_fn(|i| self.a[i][0] * x[0] + self.a[i][1] * x[1] + self.b[i])
+    }
+}
+
+impl NewtonSystem for Lcp {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn pattern_key(&self) -> u64 {
+        0
+    }
+    fn pattern(&self, e: &mut Vec<(usize, usize)>) {
+        e.extend([(0, 0), (0, 1), (1, 0), (1, 1)]);
+    }
+    fn eval(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut fbd_solver::JacobianSink<'_>>) {
+        let y = self.y(x);
+        let mut jac = jac;
+        for i in 0..2 {
+            let identity = x[i] <= y[i];
+            r[i] = if identity { x[i] } else { y[i] };
+            if let Some(j) = jac.as_deref_mut() {
+                for k in 0..2 {
+                    let v = if identity {
+                        f64::from(u8::from(i == k))
+                    } else {
+                        self.a[i][k]
+                    };
+                    j.add(i, k, v);
+                }
+            }
+        }
+    }
+}
+
+/// A semismooth system whose damped Newton iteration stalls at a kink (the
+/// line search finds no decrease below a step of 1/256 after two steps cut
+/// to 1/16 or less) converges with the watchdog's whole steps, to the
+/// complementarity solution.
+#[test]
+fn the_watchdog_takes_a_crawl_across_its_kink() {
+    let lcp = || Lcp {
+        a: [
+            [0.13787289283264367, -0.4426848543133972],
+            [1.017486474381074, -1.3066112595978296],
+        ],
+        b: [-0.4116867936057472, 1.827518567008105],
+    };
+    let x0 = [-0.1430663804640684, 1.337560930857414];
+    let mut x = x0.to_vec();
+    let plain = NewtonSolver::default().solve(&mut lcp(), &mut x);
+    assert!(
+        matches!(plain, Err(SolverError::Diverged { .. })),
+        "{plain:?}"
+    );
+    let mut x = x0.to_vec();
+    let params = NewtonParams {
+        watchdog: 5,
+        ..NewtonParams::default()
+    };
+    let rep = NewtonSolver::new(params)
+        .solve(&mut lcp(), &mut x)
+        .expect("the watchdog crosses the kink");
+    assert!(rep.iterations <= 10, "{rep:?}");
+    let y = lcp().y(&x);
+    for i in 0..2 {
+        assert!(x[i] >= -1e-9 && y[i] >= -1e-9, "x {x:?}, y {y:?}");
+        assert!(x[i].min(y[i]).abs() <= 1e-9, "x {x:?}, y {y:?}");
+    }
+}

@@ -15,20 +15,23 @@ fn summary(dir: &std::path::Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
 }
 
+/// `fbd run [CONFIG] --set S…  --out DIR`, which must succeed.
+fn run_ok(config: Option<&str>, sets: &[&str], out: &std::path::Path) {
+    let mut args = vec!["run"];
+    args.extend(config);
+    for set in sets {
+        args.extend(["--set", set]);
+    }
+    args.extend(["--out", s(out)]);
+    let o = fbd(&args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+}
+
 #[test]
 fn set_changes_the_default_and_its_written_configuration_repeats_the_run() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("a");
-    let o = fbd(&[
-        "run",
-        "--set",
-        "time.duration=0.3",
-        "--set",
-        "time.dt = 0.005",
-        "--out",
-        s(&out),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    run_ok(None, &["time.duration=0.3", "time.dt = 0.005"], &out);
     let c = config(&out);
     assert_eq!(c["time"]["dt"].as_float(), Some(0.005));
     assert_eq!(c["time"]["duration"].as_float(), Some(0.3));
@@ -36,21 +39,11 @@ fn set_changes_the_default_and_its_written_configuration_repeats_the_run() {
     assert_eq!(summary(&out)["steps"], 61);
     // The later of two settings of one key wins.
     let twice = tmp.path().join("twice");
-    let o = fbd(&[
-        "run",
-        "--set",
-        "time.duration=1",
-        "--set",
-        "time.duration=0.2",
-        "--out",
-        s(&twice),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    run_ok(None, &["time.duration=1", "time.duration=0.2"], &twice);
     assert_eq!(config(&twice)["time"]["duration"].as_float(), Some(0.2));
     // The written configuration repeats the run, byte for byte.
     let again = tmp.path().join("b");
-    let o = fbd(&["run", s(&out.join("config.toml")), "--out", s(&again)]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    run_ok(Some(s(&out.join("config.toml"))), &[], &again);
     let read = |d: &std::path::Path| std::fs::read(d.join("trajectory.csv")).unwrap();
     assert_eq!(read(&out), read(&again));
 }
@@ -59,30 +52,14 @@ fn set_changes_the_default_and_its_written_configuration_repeats_the_run() {
 fn set_changes_a_hexapod_and_a_robot_configuration() {
     let tmp = tempfile::tempdir().unwrap();
     let out = tmp.path().join("walk");
-    let o = fbd(&[
-        "run",
-        &example("hexapod_walk.toml"),
-        "--set",
-        "time.dt=0.0005",
-        "--set",
-        "time.duration=0.05",
-        "--out",
-        s(&out),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let walk = example("hexapod_walk.toml");
+    run_ok(Some(&walk), &["time.dt=0.0005", "time.duration=0.05"], &out);
     let sm = summary(&out);
     assert_eq!(sm["dt"], 0.0005);
     assert_eq!(sm["steps"], 101);
     let out = tmp.path().join("robot");
-    let o = fbd(&[
-        "run",
-        &example("robots/lab_hexapod_stand.toml"),
-        "--set",
-        "time.duration=0.02",
-        "--out",
-        s(&out),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let robot = example("robots/lab_hexapod_stand.toml");
+    run_ok(Some(&robot), &["time.duration=0.02"], &out);
     assert_eq!(config(&out)["time"]["duration"].as_float(), Some(0.02));
     assert_eq!(summary(&out)["steps"], 21);
 }

@@ -136,8 +136,8 @@ pub struct NewtonParams {
     /// on from there, chord steps again allowed); when none is after this
     /// many, the iteration returns to the kept iterate and takes its damped
     /// step, and the watch may start again at the next step of the crawl.
-    /// A solve that ends without converging returns the kept iterate when
-    /// it ends watching (the better of the two). Semismooth Newton on the
+    /// A solve that reaches [`Self::max_iterations`] while watching returns
+    /// the kept iterate (the better one). Semismooth Newton on the
     /// contact rows' kinks (a point on the edge of its friction disc, the
     /// normal's `min`) crawls so: the whole step crosses a kink and
     /// raises the max-norm, and the line search cuts it to 1/128 and less

@@ -180,7 +180,20 @@ pub fn joint_rates(
     theta: [f64; 3],
     tip_velocity: &Vector3<f64>,
 ) -> Result<[f64; 3], SingularLeg> {
-    Ok(solve(geom, &LegTrig::new(theta), tip_velocity)?.into())
+    joint_rates_trig(geom, &LegTrig::new(theta), tip_velocity)
+}
+
+/// [`joint_rates`] from precomputed sines and cosines of the joint angles.
+///
+/// # Errors
+/// [`SingularLeg`] as [`joint_rates`].
+#[inline]
+pub fn joint_rates_trig(
+    geom: &LegGeometry,
+    trig: &LegTrig,
+    tip_velocity: &Vector3<f64>,
+) -> Result<[f64; 3], SingularLeg> {
+    Ok(solve(geom, trig, tip_velocity)?.into())
 }
 
 /// Joint rates and accelerations: `θ̇ = J⁻¹·ṗ`,

@@ -24,7 +24,7 @@ use std::f64::consts::TAU;
 use fbd_kinematics::KinematicsError;
 use fbd_kinematics::hexapod::HexapodModel;
 use fbd_kinematics::ik::{KneeBranch, leg_ik_trig};
-use fbd_kinematics::leg_jacobian::{LegTrig, joint_accelerations_trig};
+use fbd_kinematics::leg_jacobian::{LegTrig, joint_accelerations_trig, joint_rates_trig};
 use fbd_kinematics::limits::{Joint, JointLimits};
 use fbd_kinematics::nalgebra::Vector3;
 
@@ -51,14 +51,16 @@ fn nearest(a: f64, near: f64) -> f64 {
 /// Solves leg `leg` (array index) for a foot at `p, v, acc` (inertial) with
 /// the body in state `body` at time `t`; `previous` are the angles of the
 /// previous step (the branch to stay near), `branch` the knee branch.
-/// Returns the joints and the sines and cosines of their angles.
+/// Returns the joints and the sines and cosines of their angles. With
+/// `ACCEL = false` the joint accelerations are not computed (a joint
+/// controller needs angles and rates): `accel` is NaN.
 ///
 /// # Errors
 /// [`GaitError::Unreachable`], [`GaitError::Singular`],
 /// [`GaitError::JointLimit`], naming the leg (1–6) and `t`.
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn solve_leg(
+pub fn solve_leg<const ACCEL: bool>(
     model: &HexapodModel,
     limits: &JointLimits,
     leg: usize,
@@ -76,12 +78,11 @@ pub fn solve_leg(
     let ddd = acc - body.acceleration;
     let d_b = rt * d;
     let v_b = rt * (dd - w.cross(&d));
-    let a_b = rt * (ddd - wd.cross(&d) - 2.0 * w.cross(&dd) + w.cross(&w.cross(&d)));
     let mount = model.mount(leg);
     let p0 = mount.body_to_base(&d_b);
     // Velocities transform by the rotation alone.
     let r0 = mount.rotation().transpose();
-    let (v0, a0) = (r0 * v_b, r0 * a_b);
+    let v0 = r0 * v_b;
     let number = leg + 1;
     let geom = model.leg();
     let (mut theta, trig) = leg_ik_trig(geom, &p0, branch).map_err(|e| match e {
@@ -110,15 +111,20 @@ pub fn solve_leg(
     for k in 0..3 {
         theta[k] = nearest(theta[k], previous[k]);
     }
-    let (rate, accel) =
-        joint_accelerations_trig(geom, &trig, &v0, &a0).map_err(|s| GaitError::Singular {
-            leg: number,
-            t,
-            what: format!(
-                "the leg Jacobian is singular (det {:.3e} m³: leg stretched or folded)",
-                s.det
-            ),
-        })?;
+    let rates = if ACCEL {
+        let a_b = rt * (ddd - wd.cross(&d) - 2.0 * w.cross(&dd) + w.cross(&w.cross(&d)));
+        joint_accelerations_trig(geom, &trig, &v0, &(r0 * a_b))
+    } else {
+        joint_rates_trig(geom, &trig, &v0).map(|rate| (rate, [f64::NAN; 3]))
+    };
+    let (rate, accel) = rates.map_err(|s| GaitError::Singular {
+        leg: number,
+        t,
+        what: format!(
+            "the leg Jacobian is singular (det {:.3e} m³: leg stretched or folded)",
+            s.det
+        ),
+    })?;
     for j in Joint::ALL {
         let x = theta[j.index()];
         let [lo, hi] = limits.range(j);

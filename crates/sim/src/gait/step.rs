@@ -32,7 +32,7 @@ pub fn anchor(model: &GaitModel, leg: usize, k: Option<usize>) -> Vector3<f64> {
 /// A [`GaitError`] naming the leg and the time when a foot target is out of
 /// reach, a leg is singular or a joint passes its limit.
 pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), GaitError> {
-    let (support, n_support, trig) = targets(model, data, k)?;
+    let (support, n_support, trig) = targets::<true>(model, data, k)?;
     let pose = BodyPose {
         position: data.body.position,
         phi: data.body.phi,
@@ -45,22 +45,23 @@ pub fn step(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), Gait
 }
 
 /// The part of [`step`] a joint controller needs: step `k`'s phases,
-/// feet, body state and the legs' joint angles, rates and accelerations
-/// (`data.legs`), without the forward kinematics, centre of mass and
-/// stability margin (`data.fk`, `data.com` and `data.margin` keep their
-/// previous values). The same numbers as [`step`]'s.
+/// feet, body state and the legs' joint angles and rates (`data.legs`),
+/// without their accelerations (`accel` is NaN), the forward kinematics,
+/// centre of mass and stability margin (`data.fk`, `data.com` and
+/// `data.margin` keep their previous values). The same numbers as
+/// [`step`]'s.
 ///
 /// # Errors
 /// As [`step`].
 pub fn step_targets(model: &GaitModel, data: &mut GaitData, k: usize) -> Result<(), GaitError> {
-    targets(model, data, k).map(|_| ())
+    targets::<false>(model, data, k).map(|_| ())
 }
 
-/// [`step_targets`], returning the stance feet's horizontal positions
-/// (their number) and each leg's sines and cosines for the forward
-/// kinematics.
+/// [`step_targets`] (with the joint accelerations when `ACCEL`),
+/// returning the stance feet's horizontal positions (their number) and
+/// each leg's sines and cosines for the forward kinematics.
 #[allow(clippy::type_complexity)]
-fn targets(
+fn targets<const ACCEL: bool>(
     model: &GaitModel,
     data: &mut GaitData,
     k: usize,
@@ -94,7 +95,7 @@ fn targets(
             support[n_support] = [foot.x, foot.z];
             n_support += 1;
         }
-        (data.legs[leg], *trig) = solve_leg(
+        (data.legs[leg], *trig) = solve_leg::<ACCEL>(
             &model.kin,
             &p.limits,
             leg,

@@ -597,9 +597,17 @@ fn loads<M: FbdModel>(model: &M, dims: &Dims, data: &mut M::Data, z: &[f64]) {
             apply(&mut model.wrenches(data)[b], sgn, &r, &f, &m);
         }
     }
+    // A free contact point's force and a free stop's moment are exact
+    // zeros (singleton rows, `fbd_solver`): their contributions (±0)
+    // would leave every sum as it is — an accumulator that starts at +0
+    // never becomes −0, and adding ±0 to any other value returns it — so
+    // they are skipped, with the same bits.
     for c in 0..dims.contacts {
-        let view = model.contact(data, c);
         let col = dims.contact_force(c, 0);
+        if z[col..col + M::S::LIN].iter().all(|&v| v == 0.0) {
+            continue;
+        }
+        let view = model.contact(data, c);
         let f = frame_force::<M::S>(&view.frame, &z[col..col + M::S::LIN]);
         let body = view.body;
         let r = arm::<M::S>(
@@ -612,8 +620,11 @@ fn loads<M: FbdModel>(model: &M, dims: &Dims, data: &mut M::Data, z: &[f64]) {
         apply(&mut model.wrenches(data)[body], 1.0, &r, &f, &none);
     }
     for l in 0..dims.limits {
-        let stop = model.stop(data, l);
         let lambda = z[dims.limit_moment(l)];
+        if lambda == 0.0 {
+            continue;
+        }
+        let stop = model.stop(data, l);
         let (child, parent, axis) = (stop.child, stop.parent, stop.axis);
         let w = model.wrenches(data);
         for i in 0..M::S::ANG {

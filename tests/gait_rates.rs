@@ -1,7 +1,8 @@
 //! Joint rates (from the analytic leg Jacobian, not from differences) equal
 //! the central differences of the joint angles to O(Δt²): halving Δt
 //! divides the largest difference by about 4. Accelerations likewise match
-//! the central differences of the rates.
+//! the central differences of the rates. The joint controller's targets
+//! are the gait's angles and rates, bit for bit, without accelerations.
 
 mod common;
 
@@ -64,4 +65,33 @@ fn rates_and_accelerations_are_second_order_consistent() {
         (3.0..5.0).contains(&ra),
         "acceleration error ratio {ra} ({a1:e} → {a2:e}), expected ≈ 4"
     );
+}
+
+/// The joint controller's targets (`step_targets`, without the joint
+/// accelerations) are the kinematic gait's (`step`) angles and rates bit
+/// for bit, on a turning, swaying, pitching walk; their accelerations are
+/// NaN (not computed), the gait's finite.
+#[test]
+fn controller_targets_are_the_gaits_angles_and_rates() {
+    let params = GaitParams {
+        forward: Command::Constant(0.07),
+        yaw_rate: Command::Constant(6f64.to_radians()),
+        sway: 0.01,
+        pitch: 2f64.to_radians(),
+        walk_time: 1.5,
+        ..GaitParams::preset(GaitKind::Tripod)
+    };
+    let m = model(params, 0.002, 2.0);
+    let (rows, _) = run_ok(&m);
+    let mut targets = fbd_sim::gait::GaitData::new(&m);
+    for (k, row) in rows.iter().enumerate() {
+        fbd_sim::gait::step_targets(&m, &mut targets, k).unwrap();
+        for (leg, (a, b)) in targets.legs.iter().zip(&row.legs).enumerate() {
+            let bits = |v: [f64; 3]| v.map(f64::to_bits);
+            assert_eq!(bits(a.theta), bits(b.theta), "step {k}, leg {leg}");
+            assert_eq!(bits(a.rate), bits(b.rate), "step {k}, leg {leg}");
+            assert!(a.accel.iter().all(|x| x.is_nan()), "step {k}, leg {leg}");
+            assert!(b.accel.iter().all(|x| x.is_finite()), "step {k}, leg {leg}");
+        }
+    }
 }

@@ -493,7 +493,9 @@ impl Pattern {
 /// are consecutive (`row, row + 1, …`) is a *segment*, whose update
 /// `w[row..row + len] −= v[..]·w[j]` works on contiguous memory with no
 /// row index read per entry (the compiler vectorises it); the entries
-/// between segments are updated one by one through their rows. The fill of
+/// between segments are updated one by one through their rows, and
+/// consecutive short such pieces — of one column or of several — are one
+/// piece whose entries also read their own columns ([`MIXED`]). The fill of
 /// the FBD systems' factors is largely made of such blocks: on the hexapod
 /// walk of `bench/peer`, `U`'s 832 entries are 99 runs of consecutive
 /// rows, `L`'s 611 are 320. Every entry gets the same update, in the same
@@ -507,6 +509,8 @@ pub(crate) struct Stream<T> {
     pub(crate) runs: Vec<(u32, u32)>,
     /// The entries' rows.
     pub(crate) rows: Vec<u32>,
+    /// The entries' columns (read by the [`MIXED`] pieces).
+    pub(crate) cols: Vec<u32>,
     /// The entries' values.
     pub(crate) vals: Vec<T>,
 }
@@ -520,9 +524,14 @@ pub(crate) const SEGMENT_MIN: u32 = 6;
 /// Marks a [`Piece`] of entries updated one by one through their rows.
 const BY_ROW: u32 = u32::MAX;
 
+/// Marks a [`Piece`] of entries of several columns, updated one by one
+/// through their rows and columns (`w[j]` read per entry).
+const MIXED: u32 = u32::MAX - 1;
+
 /// One piece of a [`Stream`]: column `col`'s entries `start..end`; a
 /// segment of rows `row..row + (end − start)`, or, with `row ==
-/// BY_ROW`, entries with their own rows.
+/// BY_ROW`, entries with their own rows; with `row == MIXED`, the entries
+/// `start..end` of one or more columns, each with its own row and column.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Piece {
     pub(crate) col: u32,
@@ -539,6 +548,7 @@ impl<T> Stream<T> {
             pieces: Vec::with_capacity(entries),
             runs: Vec::with_capacity(entries),
             rows: Vec::with_capacity(entries),
+            cols: Vec::with_capacity(entries),
             vals: Vec::with_capacity(entries),
         }
     }
@@ -548,6 +558,7 @@ impl<T> Stream<T> {
         self.pieces.reserve(entries);
         self.runs.reserve(entries);
         self.rows.reserve(entries);
+        self.cols.reserve(entries);
         self.vals.reserve(entries);
     }
 
@@ -557,6 +568,7 @@ impl<T> Stream<T> {
             .capacity()
             .min(self.runs.capacity())
             .min(self.rows.capacity())
+            .min(self.cols.capacity())
             .min(self.vals.capacity())
     }
 
@@ -564,6 +576,7 @@ impl<T> Stream<T> {
         self.pieces.clear();
         self.runs.clear();
         self.rows.clear();
+        self.cols.clear();
         self.vals.clear();
     }
 
@@ -573,6 +586,7 @@ impl<T> Stream<T> {
     /// them.
     pub(crate) fn end_run(&mut self, j: u32) {
         let end = self.rows.len() as u32;
+        self.cols.resize(self.rows.len(), j);
         if self.runs.last().map_or(0, |&(_, e)| e) < end {
             self.runs.push((j, end));
         }
@@ -582,6 +596,7 @@ impl<T> Stream<T> {
     /// pushed together); [`Self::seal`] after the last one.
     pub(crate) fn push(&mut self, i: u32, j: u32, v: T) {
         self.rows.push(i);
+        self.cols.push(j);
         self.vals.push(v);
         let end = self.rows.len() as u32;
         match self.runs.last_mut() {
@@ -633,6 +648,43 @@ impl<T> Stream<T> {
             }
             start = end;
         }
+        self.merge_by_row();
+    }
+
+    /// Joins each run of two or more consecutive by-row pieces into one
+    /// [`MIXED`] piece (the same entries in the same order): a piece's own
+    /// cost (its column's `w[j]`, its range and kind, a loop set up) is
+    /// more than that of reading each entry's `w[j]`, where columns are
+    /// short (most of `L`'s runs are one or two entries long: [`SEGMENT_MIN`]).
+    /// Measured with `valgrind --tool=cachegrind`: the planar moving
+    /// flight of `bench/peer` 1.6 % fewer instructions, the hexapod walk
+    /// 0.6 % (joining only pieces of at most 2 or 4 entries saves less;
+    /// segments from 4 or 10 rows instead of [`SEGMENT_MIN`] cost more).
+    fn merge_by_row(&mut self) {
+        let by_row = |p: &Piece| p.row == BY_ROW;
+        let mut out = 0;
+        let mut i = 0;
+        while i < self.pieces.len() {
+            let mut e = i;
+            while e < self.pieces.len() && by_row(&self.pieces[e]) {
+                e += 1;
+            }
+            if e - i >= 2 {
+                self.pieces[out] = Piece {
+                    col: self.pieces[i].col,
+                    row: MIXED,
+                    start: self.pieces[i].start,
+                    end: self.pieces[e - 1].end,
+                };
+                out += 1;
+                i = e;
+            } else {
+                self.pieces[out] = self.pieces[i];
+                out += 1;
+                i += 1;
+            }
+        }
+        self.pieces.truncate(out);
     }
 
     /// Each column's number and the range of its entries, in order.
@@ -656,6 +708,7 @@ impl<T> Stream<T> {
         self.pieces.extend_from_slice(&other.pieces);
         self.runs.extend_from_slice(&other.runs);
         self.rows.extend_from_slice(&other.rows);
+        self.cols.extend_from_slice(&other.cols);
         let mut start = 0;
         for &(col, end) in &other.runs {
             self.vals.extend(
@@ -673,10 +726,20 @@ impl Stream<f64> {
     #[inline]
     fn sweep(&self, w: &mut [f64]) {
         for p in &self.pieces {
-            // Final when column `j`'s updates start (see `Factors::sweep`).
-            let wj = w[p.col as usize];
             let (start, end) = (p.start as usize, p.end as usize);
             let vals = &self.vals[start..end];
+            if p.row == MIXED {
+                for ((&i, &j), &v) in self.rows[start..end]
+                    .iter()
+                    .zip(&self.cols[start..end])
+                    .zip(vals)
+                {
+                    w[i as usize] -= v * w[j as usize];
+                }
+                continue;
+            }
+            // Final when column `j`'s updates start (see `Factors::sweep`).
+            let wj = w[p.col as usize];
             if p.row == BY_ROW {
                 for (&i, &v) in self.rows[start..end].iter().zip(vals) {
                     w[i as usize] -= v * wj;
@@ -1384,7 +1447,8 @@ mod tests {
     }
 
     /// A stream's pieces hold every entry once, in order, segments only
-    /// of consecutive rows and at least `SEGMENT_MIN` long, and its sweep
+    /// of consecutive rows and at least `SEGMENT_MIN` long, no two by-row
+    /// pieces in a row (they are one mixed piece), and its sweep
     /// is the entry-by-entry sweep bit for bit (columns of every mix of
     /// runs: long, short, by themselves and between segments).
     #[test]
@@ -1418,17 +1482,27 @@ mod tests {
             last = p.end;
             for e in p.start..p.end {
                 let (i, j, _) = entries[e as usize];
-                assert_eq!(j, p.col);
+                assert_eq!(j, stream.cols[e as usize]);
+                if p.row != MIXED {
+                    assert_eq!(j, p.col);
+                }
                 covered[e as usize] = true;
-                if p.row != BY_ROW {
+                if p.row != BY_ROW && p.row != MIXED {
                     assert!(p.end - p.start >= SEGMENT_MIN);
                     assert_eq!(i, p.row + (e - p.start), "a segment's rows follow");
                 }
             }
         }
         assert!(covered.iter().all(|&c| c));
-        assert!(stream.pieces.iter().any(|p| p.row != BY_ROW));
-        assert!(stream.pieces.iter().any(|p| p.row == BY_ROW));
+        // Consecutive by-row pieces are joined into mixed ones.
+        assert!(stream.pieces.iter().any(|p| p.row == MIXED));
+        assert!(stream.pieces.iter().any(|p| p.row < MIXED));
+        assert!(
+            !stream
+                .pieces
+                .windows(2)
+                .any(|w| w[0].row == BY_ROW && w[1].row == BY_ROW)
+        );
         let w0: Vec<f64> = (0..n).map(|i| 1.0 + (i as f64).sin()).collect();
         let mut by_entry = w0.clone();
         for &(i, j, v) in &entries {

@@ -1457,6 +1457,18 @@ mod tests {
         factors
     }
 
+    /// A linear congruential generator from `seed` (the high bits of each
+    /// state): the sweeps' tests' entries.
+    fn lcg(seed: u64) -> impl FnMut() -> u64 {
+        let mut s = seed;
+        move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            s >> 33
+        }
+    }
+
     /// A stream's pieces hold every entry once, in order, segments only
     /// of consecutive rows and at least `SEGMENT_MIN` long, no two by-row
     /// pieces in a row (they are one mixed piece), and its sweep
@@ -1465,24 +1477,18 @@ mod tests {
     #[test]
     fn pieces_sweep_as_entries_do() {
         let n = 40u32;
-        let mut s = 7u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            s >> 33
-        };
+        let mut next = lcg(7);
         let mut stream = Stream::with_capacity((n * n) as usize);
         let mut entries = Vec::new();
         for j in 0..n - 1 {
             let mut i = j + 1;
             while i < n {
-                if next() % 3 != 0 {
+                if !next().is_multiple_of(3) {
                     let v = (next() % 1000) as f64 / 997.0 - 0.5;
                     stream.push(i, j, v);
                     entries.push((i, j, v));
                 }
-                i += 1 + (next() % 4 == 0) as u32 * (1 + (next() % 3) as u32);
+                i += 1 + next().is_multiple_of(4) as u32 * (1 + (next() % 3) as u32);
             }
         }
         stream.seal();
@@ -1533,18 +1539,12 @@ mod tests {
     #[test]
     fn sweeps_of_many_right_hand_sides_are_each_ones_sweep() {
         let n = 30u32;
-        let mut s = 11u64;
-        let mut next = || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            s >> 33
-        };
+        let mut next = lcg(11);
         let mut lower = Stream::with_capacity((n * n) as usize);
         let mut upper = Stream::with_capacity((n * n) as usize);
         for j in 0..n - 1 {
             for i in j + 1..n {
-                if next() % 3 == 0 {
+                if next().is_multiple_of(3) {
                     lower.push(i, j, (next() % 1000) as f64 / 997.0 - 0.5);
                 }
             }
@@ -1552,7 +1552,7 @@ mod tests {
         // `U`, last column first, its entries above the diagonal.
         for j in (1..n).rev() {
             for i in 0..j {
-                if next() % 3 == 0 {
+                if next().is_multiple_of(3) {
                     upper.push(i, j, (next() % 1000) as f64 / 991.0 - 0.5);
                 }
             }

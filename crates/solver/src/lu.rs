@@ -494,8 +494,8 @@ impl Pattern {
 /// `w[row..row + len] −= v[..]·w[j]` works on contiguous memory with no
 /// row index read per entry (the compiler vectorises it); the entries
 /// between segments are updated one by one through their rows, and
-/// consecutive short such pieces — of one column or of several — are one
-/// piece whose entries also read their own columns ([`MIXED`]). The fill of
+/// consecutive such pieces — of one column or of several — are one piece
+/// whose entries also read their own columns ([`MIXED`]). The fill of
 /// the FBD systems' factors is largely made of such blocks: on the hexapod
 /// walk of `bench/peer`, `U`'s 832 entries are 99 runs of consecutive
 /// rows, `L`'s 611 are 320. Every entry gets the same update, in the same

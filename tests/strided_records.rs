@@ -4,6 +4,12 @@
 //! of the run with stride 1. The spatial step carries each body's
 //! momentum `L[k+½]` from the record's making to the next step, so this
 //! checks that a skipped record still carries it (`skip_record`).
+//!
+//! A run that writes every `STRIDE`-th record and observes the others
+//! (`fbd run`'s plots and peaks, `fbd_sim::engine::run::run_in_written`)
+//! makes those without what only a written row reads: their observed
+//! fields, and every written record whole, must be those of the run that
+//! makes every record whole, to the bit.
 
 use fbd_sim::spatial::{SpatialModel, SpatialParams};
 use fbd_sim::{Control, Model, PlanarParams};
@@ -53,4 +59,54 @@ fn strided_spatial_records_are_those_of_every_step() {
     for (i, r) in strided.iter().enumerate() {
         assert_eq!(*r, every[i * STRIDE], "step {}", i * STRIDE);
     }
+}
+
+#[test]
+fn observed_spatial_records_are_those_of_every_step() {
+    // The same tumbling PD stance, every record handed out, every
+    // `STRIDE`-th whole.
+    let mut p: SpatialParams = common::spatial::stance();
+    p.duration = 0.4;
+    p.dt = 0.001;
+    p.q0[1] += 0.02;
+    p.qdot0[3..6].copy_from_slice(&[0.5, -0.8, 0.3]);
+    let model = SpatialModel::new(&p).unwrap();
+    let every = fbd_sim::spatial::run_collect(&model).0;
+    let mut observed = Vec::new();
+    let stop = std::sync::atomic::AtomicBool::new(false);
+    let summary =
+        fbd_sim::spatial::run_until_written(&model, &stop, STRIDE, |r| observed.push(r.clone()));
+    assert!(summary.error.is_none(), "{:?}", summary.error);
+    assert_eq!(observed.len(), every.len());
+    let mut partial = 0;
+    for (k, (o, e)) in observed.iter().zip(&every).enumerate() {
+        if k % STRIDE == 0 {
+            assert_eq!(o, e, "written step {k}");
+            continue;
+        }
+        // What the plots and the peaks read.
+        assert_eq!((o.step, o.t.to_bits()), (e.step, e.t.to_bits()), "step {k}");
+        assert_eq!(o.q, e.q, "q, step {k}");
+        assert_eq!(o.contacts, e.contacts, "contacts, step {k}");
+        assert_eq!(o.torque, e.torque, "torques, step {k}");
+        assert_eq!(o.rate, e.rate, "rates, step {k}");
+        assert_eq!(
+            o.reaction_force, e.reaction_force,
+            "reaction forces, step {k}"
+        );
+        assert_eq!(
+            o.kinetic.to_bits(),
+            e.kinetic.to_bits(),
+            "kinetic, step {k}"
+        );
+        assert_eq!(
+            o.potential.to_bits(),
+            e.potential.to_bits(),
+            "potential, step {k}"
+        );
+        assert_eq!(o.newton_iterations, e.newton_iterations, "step {k}");
+        // What they do not: left as the last whole record's.
+        partial += (o.reaction_moment != e.reaction_moment || o.momentum != e.momentum) as usize;
+    }
+    assert!(partial > 0, "the observed records left something out");
 }

@@ -20,27 +20,47 @@ use crate::output::{self, FirstError};
 pub trait Stepper<R> {
     /// What the run returns (steps, events, the error that stopped it).
     type Run;
-    /// Runs the model.
-    fn step(&self, stop: &AtomicBool, each: impl FnMut(&R)) -> Self::Run;
+    /// Runs the model. Of the records handed to `each`, only every
+    /// `written`-th step's is written (the others are observed: plots,
+    /// peaks); a model may leave out of those what only a written row
+    /// reads ([`fbd_sim::engine::run::run_in_written`]).
+    fn step(&self, stop: &AtomicBool, written: usize, each: impl FnMut(&R)) -> Self::Run;
 }
 
 impl Stepper<fbd_sim::RobotRecord> for fbd_sim::Model {
     type Run = fbd_sim::RunSummary;
-    fn step(&self, stop: &AtomicBool, each: impl FnMut(&fbd_sim::RobotRecord)) -> Self::Run {
+    /// Every record whole (the planar record has nothing to leave out).
+    fn step(
+        &self,
+        stop: &AtomicBool,
+        _written: usize,
+        each: impl FnMut(&fbd_sim::RobotRecord),
+    ) -> Self::Run {
         fbd_sim::run_until(self, stop, each)
     }
 }
 
 impl Stepper<fbd_sim::robot::RobotRecord> for fbd_sim::spatial::SpatialModel {
     type Run = fbd_sim::RunSummary;
-    fn step(&self, stop: &AtomicBool, each: impl FnMut(&fbd_sim::robot::RobotRecord)) -> Self::Run {
-        fbd_sim::spatial::run_until(self, stop, each)
+    fn step(
+        &self,
+        stop: &AtomicBool,
+        written: usize,
+        each: impl FnMut(&fbd_sim::robot::RobotRecord),
+    ) -> Self::Run {
+        fbd_sim::spatial::run_until_written(self, stop, written, each)
     }
 }
 
 impl Stepper<fbd_sim::gait::GaitData> for fbd_sim::gait::GaitModel {
     type Run = fbd_sim::gait::GaitSummary;
-    fn step(&self, stop: &AtomicBool, each: impl FnMut(&fbd_sim::gait::GaitData)) -> Self::Run {
+    /// Every record whole (a kinematic gait's is its state).
+    fn step(
+        &self,
+        stop: &AtomicBool,
+        _written: usize,
+        each: impl FnMut(&fbd_sim::gait::GaitData),
+    ) -> Self::Run {
         fbd_sim::gait::run_gait(self, stop, each)
     }
 }
@@ -239,7 +259,8 @@ pub fn drive<F: RunFiles, S: Stepper<F::Record, Run = F::Run>>(
     config_toml: &str,
     on_row: &mut dyn FnMut(&F::Record),
 ) -> RunOutput<F::Run, F::Summary> {
-    let run = stepper.step(stop, |r| rec.push(r, on_row));
+    let written = rec.stride;
+    let run = stepper.step(stop, written, |r| rec.push(r, on_row));
     rec.finish(run, config_toml)
 }
 

@@ -270,8 +270,14 @@ struct RobotStepper<'a> {
 
 impl Stepper<RobotRecord> for RobotStepper<'_> {
     type Run = RobotRun;
-    fn step(&self, stop: &AtomicBool, mut each: impl FnMut(&RobotRecord)) -> RobotRun {
-        self.robot.run_sim(self.sim, stop, &mut each)
+    fn step(
+        &self,
+        stop: &AtomicBool,
+        written: usize,
+        mut each: impl FnMut(&RobotRecord),
+    ) -> RobotRun {
+        self.robot
+            .run_sim_written(self.sim, stop, written, &mut each)
     }
 }
 

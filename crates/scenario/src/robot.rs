@@ -1532,8 +1532,22 @@ impl LoadedRobot {
         stop: &std::sync::atomic::AtomicBool,
         on_record: &mut dyn FnMut(&fbd_sim::robot::RobotRecord),
     ) -> RobotRun {
+        self.run_sim_written(sim, stop, 1, on_record)
+    }
+
+    /// [`Self::run_sim`] for a caller that writes every `written`-th record
+    /// and only observes the others, which are then made without what
+    /// only a written row reads ([`fbd_sim::engine::run::run_in_written`]).
+    pub fn run_sim_written(
+        &self,
+        sim: &fbd_sim::robot::RobotSim,
+        stop: &std::sync::atomic::AtomicBool,
+        written: usize,
+        on_record: &mut dyn FnMut(&fbd_sim::robot::RobotRecord),
+    ) -> RobotRun {
         let mut data = fbd_sim::robot::RobotData::new(sim);
-        let summary = fbd_sim::engine::run::run_in(sim, &mut data, stop, on_record);
+        let summary =
+            fbd_sim::engine::run::run_in_written(sim, &mut data, stop, written, on_record);
         RobotRun {
             summary,
             steps_planned: sim.steps,

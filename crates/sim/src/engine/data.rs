@@ -146,6 +146,10 @@ pub struct RunData<M: Engine> {
     /// Whether the next step's record is made (`true` unless a run skips
     /// the rows it does not hand out, [`super::run::run_until`]).
     pub(crate) want_record: bool,
+    /// Whether that record is whole (`true` unless a run hands out records
+    /// that are observed but not written, [`super::run::run_in_written`]:
+    /// those leave out what no observer of them reads).
+    pub(crate) whole_record: bool,
 }
 
 /// What a model gives [`RunData::build`].
@@ -237,6 +241,7 @@ impl<M: Engine> RunData<M> {
             best_limits: free,
             last_resort: false,
             want_record: true,
+            whole_record: true,
             q: q0,
         }
     }
@@ -316,6 +321,7 @@ where
             checked_limits: self.checked_limits.clone(),
             last_resort: self.last_resort,
             want_record: self.want_record,
+            whole_record: self.whole_record,
         }
     }
 }

@@ -30,8 +30,25 @@ pub fn run_in<M: Engine>(
     model: &M,
     data: &mut RunData<M>,
     stop: &AtomicBool,
+    on_row: impl FnMut(&M::Record),
+) -> RunSummary {
+    run_in_written(model, data, stop, 1, on_row)
+}
+
+/// [`run_in`] for a caller that writes only every `written`-th of the
+/// records it is handed (step `k` with `k % written == 0`) and observes
+/// the others (`fbd run`'s plots and peaks, which want every step): those
+/// are made without what only a written row reads (a tree model's
+/// reaction moments, joint stops, momenta and centre of mass:
+/// [`super::tree_record::RobotRecord`]). `written = 1` is [`run_in`].
+pub fn run_in_written<M: Engine>(
+    model: &M,
+    data: &mut RunData<M>,
+    stop: &AtomicBool,
+    written: usize,
     mut on_row: impl FnMut(&M::Record),
 ) -> RunSummary {
+    let written = written.max(1);
     let settings = model.settings();
     let stride = settings.stride.max(1);
     let mut error: Option<SimError> = None;
@@ -45,6 +62,7 @@ pub fn run_in<M: Engine>(
         }
         let wanted = k % stride == 0;
         data.want_record = wanted;
+        data.whole_record = k % written == 0;
         match super::step::step(model, data) {
             Ok(()) if wanted => {
                 let t = std::time::Instant::now();
@@ -60,6 +78,7 @@ pub fn run_in<M: Engine>(
     }
     let wall = start.elapsed().saturating_sub(observer).as_secs_f64();
     data.want_record = true;
+    data.whole_record = true;
     summary(data, wall, error, interrupted)
 }
 

@@ -53,6 +53,12 @@ pub struct RobotContactRow {
 /// `rate`, `momentum`, `angular_momentum` and `com` stay zero (its files
 /// read none of them, and they would cost every step; a planar model's
 /// rates are its simulator's readout, `Readout::qdot`).
+///
+/// A tree model's record handed out to be observed but not written
+/// ([`crate::engine::run::run_in_written`]: `fbd run`'s plots and peaks
+/// between its written rows) is filled except for `reaction_moment`,
+/// `limit`, `stop`, `momentum`, `angular_momentum` and `com`, which keep
+/// the values of the last whole record.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RobotRecord {
     /// Step index k.
@@ -238,6 +244,23 @@ pub fn make_record<M>(
         row.state = data.trial[c].code();
     }
     rec.torque.copy_from_slice(&fbd.torque);
+    let whole = data.whole_record;
+    if !whole {
+        // Observed, not written: the reaction forces only.
+        for i in 0..mech.reactions.len() {
+            let f = mech.reaction_force(i, 0);
+            rec.reaction_force[i] = [z[f], z[f + 1], z[f + 2]];
+        }
+        for j in 0..rec.rate.len() {
+            let r = coordinate_rate(model, data, ROOT_DOF + j);
+            data.record.rate[j] = r;
+        }
+        let (kinetic, potential) = energies(mech, &mut data.fbd, h);
+        let rec = &mut data.record;
+        rec.kinetic = kinetic;
+        rec.potential = potential;
+        return;
+    }
     for i in 0..mech.reactions.len() {
         let (f, m) = reaction_wrench(mech, fbd, z, i);
         rec.reaction_force[i] = f.into();
@@ -357,6 +380,27 @@ pub fn momenta(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> Momenta {
         angular_momentum: hm.into(),
         com: (c / mech.total_mass()).into(),
     }
+}
+
+/// The kinetic and potential energies of [`momenta`] (the same sums in
+/// the same order, so the same values), keeping every body's `L[k+½]` as
+/// it does, without the momenta and centre of mass: the record of a step
+/// that is observed but not written ([`crate::engine::run::run_in_written`]).
+fn energies(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> (f64, f64) {
+    let g = mech.gravity;
+    let (mut kinetic, mut potential) = (0.0, 0.0);
+    for (b, body) in mech.bodies.iter().enumerate() {
+        let mb = body.model_body;
+        let (c0, c1) = (fbd.kin.com[mb], fbd.kin_next.com[mb]);
+        let v = (c1 - c0) / h;
+        let (l, psi) = momentum_over_step(mech, fbd, b, h);
+        fbd.l_carry[b] = l;
+        kinetic +=
+            0.5 * body.mass * v.norm_squared() + 0.5 * psi.dot(&(body.inertia * psi)) / (h * h);
+        potential += body.mass * g * 0.5 * (c0.y + c1.y);
+    }
+    fbd.l_carry_dt = h;
+    (kinetic, potential)
 }
 
 /// Every body's `L[k+½]` over the step, kept for the next step's `L[k−½]`

@@ -30,5 +30,5 @@ pub use data::SpatialData;
 pub use model::{LegLimit, SpatialModel, closed_form, fastest_mode_over_poses, modes_slower_than};
 pub use params::{LegTrajectory3, SpatialControl, SpatialParams, default_q0, hexagon_inertia};
 pub use record::{LegIndex, LegRow, RecordIndex};
-pub use run::{run_collect, run_until};
+pub use run::{run_collect, run_until, run_until_written};
 pub use step::step;

@@ -17,6 +17,18 @@ pub fn run_until(
     crate::engine::run::run_until(model, SpatialData::new(model), stop, on_row)
 }
 
+/// [`run_until`] for a caller that writes every `written`-th record and
+/// only observes the others ([`crate::engine::run::run_in_written`]).
+pub fn run_until_written(
+    model: &SpatialModel,
+    stop: &AtomicBool,
+    written: usize,
+    on_row: impl FnMut(&RobotRecord),
+) -> RunSummary {
+    let mut data = SpatialData::new(model);
+    crate::engine::run::run_in_written(model, &mut data, stop, written, on_row)
+}
+
 /// [`run_until`] keeping every written record in memory.
 pub fn run_collect(model: &SpatialModel) -> (Vec<RobotRecord>, RunSummary) {
     let mut rows = Vec::with_capacity(model.steps / model.params.stride.max(1) + 1);

@@ -513,16 +513,7 @@ pub(crate) struct Stream<T> {
     pub(crate) cols: Vec<u32>,
     /// The entries' values.
     pub(crate) vals: Vec<T>,
-    /// Each entry's row and column as bytes, made by [`Self::seal`] when
-    /// every row and column is below [`SMALL`] (else empty): the sweeps of
-    /// such a stream index a `[f64; SMALL]` with them, with no bounds
-    /// check ([`Stream::sweep`]).
-    pub(crate) small: Vec<[u8; 2]>,
 }
-
-/// The dimension below which a stream's rows and columns are bytes
-/// ([`Stream::small`]).
-pub(crate) const SMALL: usize = 256;
 
 /// The shortest run of consecutive rows that [`Stream::seal`] makes a
 /// segment: shorter runs cost more as segments (a loop set up per run)
@@ -559,7 +550,6 @@ impl<T> Stream<T> {
             rows: Vec::with_capacity(entries),
             cols: Vec::with_capacity(entries),
             vals: Vec::with_capacity(entries),
-            small: Vec::with_capacity(entries),
         }
     }
 
@@ -570,7 +560,6 @@ impl<T> Stream<T> {
         self.rows.reserve(entries);
         self.cols.reserve(entries);
         self.vals.reserve(entries);
-        self.small.reserve(entries);
     }
 
     /// The entries this can hold without allocating.
@@ -581,7 +570,6 @@ impl<T> Stream<T> {
             .min(self.rows.capacity())
             .min(self.cols.capacity())
             .min(self.vals.capacity())
-            .min(self.small.capacity())
     }
 
     pub(crate) fn clear(&mut self) {
@@ -590,7 +578,6 @@ impl<T> Stream<T> {
         self.rows.clear();
         self.cols.clear();
         self.vals.clear();
-        self.small.clear();
     }
 
     /// Closes column `j`'s run: the entries pushed since the last run
@@ -662,26 +649,6 @@ impl<T> Stream<T> {
             start = end;
         }
         self.merge_by_row();
-        self.small.clear();
-        if self
-            .rows
-            .iter()
-            .chain(&self.cols)
-            .all(|&i| (i as usize) < SMALL)
-        {
-            self.small.extend(
-                self.rows
-                    .iter()
-                    .zip(&self.cols)
-                    .map(|(&i, &j)| [i as u8, j as u8]),
-            );
-        }
-    }
-
-    /// Whether every row and column is a byte ([`Self::small`]).
-    #[inline]
-    fn is_small(&self) -> bool {
-        self.small.len() == self.rows.len()
     }
 
     /// Joins each run of two or more consecutive by-row pieces into one
@@ -742,7 +709,6 @@ impl<T> Stream<T> {
         self.runs.extend_from_slice(&other.runs);
         self.rows.extend_from_slice(&other.rows);
         self.cols.extend_from_slice(&other.cols);
-        self.small.extend_from_slice(&other.small);
         let mut start = 0;
         for &(col, end) in &other.runs {
             self.vals.extend(
@@ -756,51 +722,9 @@ impl<T> Stream<T> {
 }
 
 impl Stream<f64> {
-    /// The sweep `w[i] −= v·w[j]` over every entry, in order: through
-    /// [`Self::sweep_small`] when the rows and columns are bytes and `w`
-    /// has room for [`SMALL`] values (its entries from the stream's
-    /// dimension on are neither read nor written).
+    /// The sweep `w[i] −= v·w[j]` over every entry, in order.
     #[inline]
     fn sweep(&self, w: &mut [f64]) {
-        if self.is_small()
-            && let Some(w) = w.first_chunk_mut::<SMALL>()
-        {
-            self.sweep_small(w);
-        } else {
-            self.sweep_wide(w);
-        }
-    }
-
-    /// [`Self::sweep`] with byte rows and columns into a `[f64; SMALL]`:
-    /// the same updates in the same order, without a bounds check per
-    /// entry (14 instructions an entry of a [`MIXED`] piece become 10).
-    fn sweep_small(&self, w: &mut [f64; SMALL]) {
-        for p in &self.pieces {
-            let (start, end) = (p.start as usize, p.end as usize);
-            let vals = &self.vals[start..end];
-            let entries = &self.small[start..end];
-            if p.row == MIXED {
-                for (&[i, j], &v) in entries.iter().zip(vals) {
-                    w[i as usize] -= v * w[j as usize];
-                }
-                continue;
-            }
-            let wj = w[p.col as u8 as usize];
-            if p.row == BY_ROW {
-                for (&[i, _], &v) in entries.iter().zip(vals) {
-                    w[i as usize] -= v * wj;
-                }
-            } else {
-                let row = p.row as usize;
-                for (x, &v) in w[row..row + vals.len()].iter_mut().zip(vals) {
-                    *x -= v * wj;
-                }
-            }
-        }
-    }
-
-    /// [`Self::sweep`] with the rows and columns as stored.
-    fn sweep_wide(&self, w: &mut [f64]) {
         for p in &self.pieces {
             let (start, end) = (p.start as usize, p.end as usize);
             let vals = &self.vals[start..end];
@@ -900,7 +824,7 @@ impl Factors {
             pivot_inv: vec![0.0; n],
             lower: Stream::with_capacity(n * n.saturating_sub(1) / 2),
             upper: Stream::with_capacity(n * n.saturating_sub(1) / 2),
-            work: vec![0.0; n.max(SMALL)],
+            work: vec![0.0; n],
             perturbed: Vec::with_capacity(MAX_PERTURBED),
             wood_w: Vec::with_capacity((MAX_PERTURBED + 1) * n),
             wood_stride: 1,
@@ -1237,9 +1161,7 @@ impl Factors {
             rhs[k] -= c * pattern.single_x[t];
         }
         if n > 0 {
-            // The sweeps get all of the scratch (at least `SMALL` long:
-            // `Stream::sweep`), the rest the first `n`.
-            let w = &mut self.work[..];
+            let w = &mut self.work[..n];
             for (wi, &p) in w.iter_mut().zip(&self.row_src) {
                 *wi = rhs[p];
             }
@@ -1257,7 +1179,7 @@ impl Factors {
                     &self.wood_w,
                     self.wood_stride,
                     &self.wood_c,
-                    &mut w[..n],
+                    w,
                 );
                 for (&c, &wj) in pattern.col_dst.iter().zip(w.iter()) {
                     rhs[c] = wj;
@@ -1603,29 +1525,11 @@ mod tests {
         for &(i, j, v) in &entries {
             by_entry[i as usize] -= v * by_entry[j as usize];
         }
-        // A scratch of `n` values: the sweep with the stored rows and
-        // columns; of `SMALL` values: with their bytes, the values past
-        // `n` (NaN) neither read nor written.
-        assert!(stream.is_small(), "a dimension below SMALL has byte rows");
-        let mut by_piece = w0.clone();
+        let mut by_piece = w0;
         stream.sweep(&mut by_piece);
-        let mut small = w0;
-        small.resize(SMALL, f64::NAN);
-        stream.sweep(&mut small);
-        for ((a, b), c) in by_entry.iter().zip(&by_piece).zip(&small) {
+        for (a, b) in by_entry.iter().zip(&by_piece) {
             assert_eq!(a.to_bits(), b.to_bits());
-            assert_eq!(a.to_bits(), c.to_bits());
         }
-        assert!(small[n as usize..].iter().all(|v| v.is_nan()));
-        // A row of `SMALL` or more: no bytes, the sweep as stored.
-        let mut wide = Stream::with_capacity(1);
-        wide.push(SMALL as u32, 0, 1.0);
-        wide.seal();
-        assert!(!wide.is_small());
-        let mut w = vec![0.0; SMALL + 1];
-        w[0] = 2.0;
-        wide.sweep(&mut w);
-        assert_eq!(w[SMALL], -2.0);
     }
 
     /// The sweeps of several right-hand sides at once (the Woodbury

@@ -54,15 +54,24 @@ pub fn run_in_written<M: Engine>(
     let mut error: Option<SimError> = None;
     let mut interrupted = false;
     let mut observer = std::time::Duration::ZERO;
+    // Steps to the next handed-out record and to the next written one
+    // (counted down: no division a step).
+    let (mut to_wanted, mut to_written) = (0, 0);
     let start = std::time::Instant::now();
-    for k in 0..settings.steps {
+    for _ in 0..settings.steps {
         if stop.load(Ordering::Relaxed) {
             interrupted = true;
             break;
         }
-        let wanted = k % stride == 0;
+        let wanted = to_wanted == 0;
+        to_wanted = if wanted { stride - 1 } else { to_wanted - 1 };
         data.want_record = wanted;
-        data.whole_record = k % written == 0;
+        data.whole_record = to_written == 0;
+        to_written = if to_written == 0 {
+            written - 1
+        } else {
+            to_written - 1
+        };
         match super::step::step(model, data) {
             Ok(()) if wanted => {
                 let t = std::time::Instant::now();

@@ -11,6 +11,7 @@
 //! fields, and every written record whole, must be those of the run that
 //! makes every record whole, to the bit.
 
+use fbd_sim::robot::RobotRecord;
 use fbd_sim::spatial::{SpatialModel, SpatialParams};
 use fbd_sim::{Control, Model, PlanarParams};
 
@@ -43,14 +44,19 @@ fn strided_planar_records_are_those_of_every_step() {
     }
 }
 
-#[test]
-fn strided_spatial_records_are_those_of_every_step() {
-    // The PD stance dropped onto its feet, tumbling a little.
+/// The PD stance dropped onto its feet, tumbling a little, for 0.4 s.
+fn tumbling_stance() -> SpatialParams {
     let mut p: SpatialParams = common::spatial::stance();
     p.duration = 0.4;
     p.dt = 0.001;
     p.q0[1] += 0.02;
     p.qdot0[3..6].copy_from_slice(&[0.5, -0.8, 0.3]);
+    p
+}
+
+#[test]
+fn strided_spatial_records_are_those_of_every_step() {
+    let mut p = tumbling_stance();
     let every = fbd_sim::spatial::run_collect(&SpatialModel::new(&p).unwrap()).0;
     p.stride = STRIDE;
     let (strided, summary) = fbd_sim::spatial::run_collect(&SpatialModel::new(&p).unwrap());
@@ -63,14 +69,8 @@ fn strided_spatial_records_are_those_of_every_step() {
 
 #[test]
 fn observed_spatial_records_are_those_of_every_step() {
-    // The same tumbling PD stance, every record handed out, every
-    // `STRIDE`-th whole.
-    let mut p: SpatialParams = common::spatial::stance();
-    p.duration = 0.4;
-    p.dt = 0.001;
-    p.q0[1] += 0.02;
-    p.qdot0[3..6].copy_from_slice(&[0.5, -0.8, 0.3]);
-    let model = SpatialModel::new(&p).unwrap();
+    // Every record handed out, every `STRIDE`-th whole.
+    let model = SpatialModel::new(&tumbling_stance()).unwrap();
     let every = fbd_sim::spatial::run_collect(&model).0;
     let mut observed = Vec::new();
     let stop = std::sync::atomic::AtomicBool::new(false);
@@ -84,27 +84,16 @@ fn observed_spatial_records_are_those_of_every_step() {
             assert_eq!(o, e, "written step {k}");
             continue;
         }
-        // What the plots and the peaks read.
-        assert_eq!((o.step, o.t.to_bits()), (e.step, e.t.to_bits()), "step {k}");
-        assert_eq!(o.q, e.q, "q, step {k}");
-        assert_eq!(o.contacts, e.contacts, "contacts, step {k}");
-        assert_eq!(o.torque, e.torque, "torques, step {k}");
-        assert_eq!(o.rate, e.rate, "rates, step {k}");
-        assert_eq!(
-            o.reaction_force, e.reaction_force,
-            "reaction forces, step {k}"
-        );
-        assert_eq!(
-            o.kinetic.to_bits(),
-            e.kinetic.to_bits(),
-            "kinetic, step {k}"
-        );
-        assert_eq!(
-            o.potential.to_bits(),
-            e.potential.to_bits(),
-            "potential, step {k}"
-        );
-        assert_eq!(o.newton_iterations, e.newton_iterations, "step {k}");
+        // What the plots and the peaks read, to the bit.
+        let seen = |r: &RobotRecord| {
+            (
+                (r.step, r.t.to_bits(), r.newton_iterations),
+                (r.q.clone(), r.contacts.clone(), r.reaction_force.clone()),
+                (r.torque.clone(), r.rate.clone()),
+                (r.kinetic.to_bits(), r.potential.to_bits()),
+            )
+        };
+        assert_eq!(seen(o), seen(e), "observed fields, step {k}");
         // What they do not: left as the last whole record's.
         partial += (o.reaction_moment != e.reaction_moment || o.momentum != e.momentum) as usize;
     }

@@ -356,6 +356,22 @@ pub struct Momenta {
 /// `fbd.l_carry`, the next step's `L[k−½]` when this step is accepted
 /// whole.
 pub fn momenta(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> Momenta {
+    momenta_of::<true>(mech, fbd, h)
+}
+
+/// The kinetic and potential energies of [`momenta`] (the same sums in
+/// the same order, so the same values), keeping every body's `L[k+½]` as
+/// it does, without the momenta and centre of mass: the record of a step
+/// that is observed but not written ([`crate::engine::run::run_in_written`]).
+fn energies(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> (f64, f64) {
+    let m = momenta_of::<false>(mech, fbd, h);
+    (m.kinetic, m.potential)
+}
+
+/// [`momenta`], its linear and angular momenta and centre of mass left
+/// zero unless `WHOLE`.
+#[inline]
+fn momenta_of<const WHOLE: bool>(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> Momenta {
     let g = mech.gravity;
     let (mut kinetic, mut potential) = (0.0, 0.0);
     let (mut p, mut hm, mut c) = (Vector3::zeros(), Vector3::zeros(), Vector3::zeros());
@@ -368,39 +384,25 @@ pub fn momenta(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> Momenta {
         kinetic +=
             0.5 * body.mass * v.norm_squared() + 0.5 * psi.dot(&(body.inertia * psi)) / (h * h);
         potential += body.mass * g * 0.5 * (c0.y + c1.y);
-        p += body.mass * v;
-        hm += body.mass * c0.cross(&v) + l;
-        c += body.mass * c0;
+        if WHOLE {
+            p += body.mass * v;
+            hm += body.mass * c0.cross(&v) + l;
+            c += body.mass * c0;
+        }
     }
     fbd.l_carry_dt = h;
+    let com = if WHOLE {
+        (c / mech.total_mass()).into()
+    } else {
+        [0.0; 3]
+    };
     Momenta {
         kinetic,
         potential,
         momentum: p.into(),
         angular_momentum: hm.into(),
-        com: (c / mech.total_mass()).into(),
+        com,
     }
-}
-
-/// The kinetic and potential energies of [`momenta`] (the same sums in
-/// the same order, so the same values), keeping every body's `L[k+½]` as
-/// it does, without the momenta and centre of mass: the record of a step
-/// that is observed but not written ([`crate::engine::run::run_in_written`]).
-fn energies(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> (f64, f64) {
-    let g = mech.gravity;
-    let (mut kinetic, mut potential) = (0.0, 0.0);
-    for (b, body) in mech.bodies.iter().enumerate() {
-        let mb = body.model_body;
-        let (c0, c1) = (fbd.kin.com[mb], fbd.kin_next.com[mb]);
-        let v = (c1 - c0) / h;
-        let (l, psi) = momentum_over_step(mech, fbd, b, h);
-        fbd.l_carry[b] = l;
-        kinetic +=
-            0.5 * body.mass * v.norm_squared() + 0.5 * psi.dot(&(body.inertia * psi)) / (h * h);
-        potential += body.mass * g * 0.5 * (c0.y + c1.y);
-    }
-    fbd.l_carry_dt = h;
-    (kinetic, potential)
 }
 
 /// Every body's `L[k+½]` over the step, kept for the next step's `L[k−½]`

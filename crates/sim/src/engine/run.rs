@@ -63,15 +63,9 @@ pub fn run_in_written<M: Engine>(
             interrupted = true;
             break;
         }
-        let wanted = to_wanted == 0;
-        to_wanted = if wanted { stride - 1 } else { to_wanted - 1 };
+        let wanted = countdown(&mut to_wanted, stride);
         data.want_record = wanted;
-        data.whole_record = to_written == 0;
-        to_written = if to_written == 0 {
-            written - 1
-        } else {
-            to_written - 1
-        };
+        data.whole_record = countdown(&mut to_written, written);
         match super::step::step(model, data) {
             Ok(()) if wanted => {
                 let t = std::time::Instant::now();
@@ -89,6 +83,15 @@ pub fn run_in_written<M: Engine>(
     data.want_record = true;
     data.whole_record = true;
     summary(data, wall, error, interrupted)
+}
+
+/// Whether this is a step of a period of `period` steps (`left` counts
+/// the steps to the next one down, from 0 at the first).
+#[inline]
+fn countdown(left: &mut usize, period: usize) -> bool {
+    let now = *left == 0;
+    *left = if now { period - 1 } else { *left - 1 };
+    now
 }
 
 /// The summary of a run that ended with `data` (its event lists move

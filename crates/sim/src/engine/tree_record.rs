@@ -244,48 +244,47 @@ pub fn make_record<M>(
         row.state = data.trial[c].code();
     }
     rec.torque.copy_from_slice(&fbd.torque);
+    // A record observed but not written leaves out the reaction moments,
+    // the stops, the momenta and the centre of mass (see the type's docs).
     let whole = data.whole_record;
-    if !whole {
-        // Observed, not written: the reaction forces only.
-        for i in 0..mech.reactions.len() {
-            let f = mech.reaction_force(i, 0);
-            rec.reaction_force[i] = [z[f], z[f + 1], z[f + 2]];
-        }
-        for j in 0..rec.rate.len() {
-            let r = coordinate_rate(model, data, ROOT_DOF + j);
-            data.record.rate[j] = r;
-        }
-        let (kinetic, potential) = energies(mech, &mut data.fbd, h);
-        let rec = &mut data.record;
-        rec.kinetic = kinetic;
-        rec.potential = potential;
-        return;
-    }
     for i in 0..mech.reactions.len() {
-        let (f, m) = reaction_wrench(mech, fbd, z, i);
-        rec.reaction_force[i] = f.into();
-        rec.reaction_moment[i] = m.into();
+        if whole {
+            let (f, m) = reaction_wrench(mech, fbd, z, i);
+            rec.reaction_force[i] = f.into();
+            rec.reaction_moment[i] = m.into();
+        } else {
+            rec.reaction_force[i] = reaction_force(mech, z, i).into();
+        }
     }
-    rec.limit.fill(LimitCode::Free);
-    rec.stop.fill(0.0);
-    for (l, lim) in mech.limits.iter().enumerate() {
-        let stop = z[dims.limit_moment(l)];
-        let m = Vector3::from(rec.reaction_moment[lim.reaction]) + stop * fbd.kin.axis[lim.joint];
-        rec.reaction_moment[lim.reaction] = m.into();
-        rec.limit[lim.joint] = LimitCode::of(&data.limit_trial[l]);
-        rec.stop[lim.joint] = stop;
+    if whole {
+        rec.limit.fill(LimitCode::Free);
+        rec.stop.fill(0.0);
+        for (l, lim) in mech.limits.iter().enumerate() {
+            let stop = z[dims.limit_moment(l)];
+            let m =
+                Vector3::from(rec.reaction_moment[lim.reaction]) + stop * fbd.kin.axis[lim.joint];
+            rec.reaction_moment[lim.reaction] = m.into();
+            rec.limit[lim.joint] = LimitCode::of(&data.limit_trial[l]);
+            rec.stop[lim.joint] = stop;
+        }
     }
     for j in 0..rec.rate.len() {
         let r = coordinate_rate(model, data, ROOT_DOF + j);
         data.record.rate[j] = r;
     }
-    let m = momenta(mech, &mut data.fbd, h);
+    let m = if whole {
+        momenta(mech, &mut data.fbd, h)
+    } else {
+        momenta_of::<false>(mech, &mut data.fbd, h)
+    };
     let rec = &mut data.record;
     rec.kinetic = m.kinetic;
     rec.potential = m.potential;
-    rec.momentum = m.momentum;
-    rec.angular_momentum = m.angular_momentum;
-    rec.com = m.com;
+    if whole {
+        rec.momentum = m.momentum;
+        rec.angular_momentum = m.angular_momentum;
+        rec.com = m.com;
+    }
 }
 
 /// Contact point `c` at `q[k]` (where it touches the ground), and the
@@ -333,8 +332,14 @@ pub fn reaction_wrench(
     for &j in re.joint_list() {
         m += fbd.torque[j] * fbd.kin.axis[j];
     }
+    (reaction_force(mech, z, i), m)
+}
+
+/// Reaction `i`'s force on its child body (as [`reaction_wrench`]'s).
+#[inline]
+pub fn reaction_force(mech: &TreeMechanism, z: &[f64], i: usize) -> Vector3<f64> {
     let f = mech.reaction_force(i, 0);
-    (Vector3::new(z[f], z[f + 1], z[f + 2]), m)
+    Vector3::new(z[f], z[f + 1], z[f + 2])
 }
 
 /// The energies and momenta of a (sub)step of length `h`.
@@ -359,17 +364,11 @@ pub fn momenta(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> Momenta {
     momenta_of::<true>(mech, fbd, h)
 }
 
-/// The kinetic and potential energies of [`momenta`] (the same sums in
-/// the same order, so the same values), keeping every body's `L[k+½]` as
-/// it does, without the momenta and centre of mass: the record of a step
-/// that is observed but not written ([`crate::engine::run::run_in_written`]).
-fn energies(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> (f64, f64) {
-    let m = momenta_of::<false>(mech, fbd, h);
-    (m.kinetic, m.potential)
-}
-
 /// [`momenta`], its linear and angular momenta and centre of mass left
-/// zero unless `WHOLE`.
+/// zero unless `WHOLE`: without them, the same kinetic and potential
+/// energies (the same sums in the same order) and the same `L[k+½]` kept,
+/// for a record observed but not written
+/// ([`crate::engine::run::run_in_written`]).
 #[inline]
 fn momenta_of<const WHOLE: bool>(mech: &TreeMechanism, fbd: &mut TreeFbdData, h: f64) -> Momenta {
     let g = mech.gravity;

@@ -1083,6 +1083,9 @@ pub struct RunAudit {
     /// Failed Newton solves the state search recovered from by sticking
     /// its slowest slide.
     pub newton_fallbacks: usize,
+    /// Crawling Newton solves given up at a certain touchdown (3D models;
+    /// the search touched the point down and solved again).
+    pub abandoned_crawls: usize,
     /// Substeps solved in retries, failed attempts included.
     pub substeps: usize,
     /// Of `retried_steps`, those solved with faer's reference LU after
@@ -1113,6 +1116,7 @@ impl RunAudit {
             enumerated_cycles: run.enumerated_cycles,
             rejected_solutions: run.rejected_solutions,
             newton_fallbacks: run.newton_fallbacks,
+            abandoned_crawls: run.abandoned_crawls,
             substeps: run.substeps,
             reference_lu_retries: run.retries.iter().filter(|r| r.reference_lu).count(),
             direction_refinements: run.direction_refinements,

@@ -50,6 +50,10 @@ pub struct RunSummary {
     /// Failed Newton solves the state search recovered from by changing
     /// the trial states.
     pub newton_fallbacks: usize,
+    /// Crawling Newton solves given up because a free point was already
+    /// below the ground at their kept iterate: the search touched it down
+    /// and solved again (3D models).
+    pub abandoned_crawls: usize,
     /// Substeps solved in retries, failed attempts included.
     pub substeps: usize,
     /// Re-solves that moved a fixed friction direction to the step's own

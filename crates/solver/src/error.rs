@@ -43,4 +43,17 @@ pub enum SolverError {
         /// appeared.
         iter: usize,
     },
+
+    /// The system gave up a crawling solve ([`crate::NewtonSystem::abandon_crawl`]):
+    /// at the kept iterate of a crawl, a change of the system's equations
+    /// is already certain. The unknowns hold that iterate.
+    #[error(
+        "Newton gave up a crawl at iteration {iter} (scaled residual max-norm {residual:e}): the equations change"
+    )]
+    Abandoned {
+        /// Number of Newton steps accepted before giving up.
+        iter: usize,
+        /// Scaled residual max-norm at the returned iterate.
+        residual: f64,
+    },
 }

@@ -153,6 +153,11 @@ pub struct NewtonParams {
     /// Default: `1/16`: the 3D walk's damped steps, where its feet land,
     /// are longer, and its path is the same with the watchdog as without.
     pub crawl_step: f64,
+    /// Whether the watchdog, returning to its kept iterate, asks the
+    /// system whether to give the solve up there
+    /// ([`crate::NewtonSystem::abandon_crawl`]; a system that never does
+    /// answers `false`). Default: `true`.
+    pub give_up_crawls: bool,
 }
 
 impl Default for NewtonParams {
@@ -171,6 +176,7 @@ impl Default for NewtonParams {
             watchdog: 0,
             crawl_steps: 2,
             crawl_step: 1.0 / 16.0,
+            give_up_crawls: true,
         }
     }
 }
@@ -773,6 +779,12 @@ impl Workspace {
                     rnorm = kept;
                     have_jacobian = false;
                     usable = false;
+                    if params.give_up_crawls && sys.abandon_crawl(x, rnorm) {
+                        return Err(SolverError::Abandoned {
+                            iter: full,
+                            residual: rnorm,
+                        });
+                    }
                 }
             }
 

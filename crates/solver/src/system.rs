@@ -35,6 +35,16 @@ pub trait NewtonSystem {
     fn residual_weight(&self, row: usize) -> f64 {
         1.0 / self.residual_scale(row)
     }
+
+    /// Called when a crawl's watchdog returns to its kept iterate `x`, of
+    /// scaled residual max-norm `residual` ([`crate::NewtonParams::watchdog`]):
+    /// `true` gives the solve up there ([`crate::SolverError::Abandoned`]),
+    /// for a system whose equations are certain to change at `x` (a caller
+    /// that solves again with other equations). Default: `false`.
+    fn abandon_crawl(&mut self, x: &[f64], residual: f64) -> bool {
+        let _ = (x, residual);
+        false
+    }
 }
 
 /// Write access to the Jacobian values of the current pattern.

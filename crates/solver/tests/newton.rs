@@ -556,3 +556,77 @@ fn the_watchdog_takes_a_crawl_across_its_kink() {
         assert!(x[i].min(y[i]).abs() <= 1e-9, "x {x:?}, y {y:?}");
     }
 }
+
+/// [`Lcp`] that gives up every crawl its watchdog returns from, keeping
+/// the iterate and residual it was handed.
+struct GivingUp {
+    lcp: Lcp,
+    handed: Option<(Vec<f64>, f64)>,
+}
+
+impl NewtonSystem for GivingUp {
+    fn dim(&self) -> usize {
+        self.lcp.dim()
+    }
+    fn pattern_key(&self) -> u64 {
+        self.lcp.pattern_key()
+    }
+    fn pattern(&self, e: &mut Vec<(usize, usize)>) {
+        self.lcp.pattern(e)
+    }
+    fn eval(&mut self, x: &[f64], r: &mut [f64], jac: Option<&mut fbd_solver::JacobianSink<'_>>) {
+        self.lcp.eval(x, r, jac)
+    }
+    fn abandon_crawl(&mut self, x: &[f64], residual: f64) -> bool {
+        self.handed = Some((x.to_vec(), residual));
+        true
+    }
+}
+
+/// A crawl whose watchdog returns to its kept iterate is given up when the
+/// system asks (`NewtonSystem::abandon_crawl`): the solve returns
+/// `Abandoned` with the unknowns at that kept iterate, whose residual is
+/// the one handed to the system; a system that does not ask goes on with
+/// the damped step (here to the line search's failure, one whole step a
+/// watch being too few for this kink).
+#[test]
+fn a_crawl_is_given_up_at_its_kept_iterate_when_the_system_asks() {
+    let lcp = || Lcp {
+        a: [
+            [0.13787289283264367, -0.4426848543133972],
+            [1.017486474381074, -1.3066112595978296],
+        ],
+        b: [-0.4116867936057472, 1.827518567008105],
+    };
+    let x0 = [-0.1430663804640684, 1.337560930857414];
+    // One whole step a watch: too few to cross this kink.
+    let params = NewtonParams {
+        watchdog: 1,
+        max_iterations: 100,
+        ..NewtonParams::default()
+    };
+    let mut sys = GivingUp {
+        lcp: lcp(),
+        handed: None,
+    };
+    let mut x = x0.to_vec();
+    let out = NewtonSolver::new(params).solve(&mut sys, &mut x);
+    let Err(SolverError::Abandoned { residual, .. }) = out else {
+        panic!("not given up: {out:?}");
+    };
+    let (kept, handed) = sys.handed.expect("the system was asked");
+    assert_eq!(x, kept, "the unknowns hold the kept iterate");
+    assert_eq!(residual, handed);
+    let mut r = [0.0; 2];
+    lcp().eval(&x, &mut r, None);
+    assert_eq!(residual, r[0].abs().max(r[1].abs()));
+    assert!(residual > NewtonParams::default().residual_tol);
+    // Not asked to give up, the same iteration goes on past that point.
+    let mut x = x0.to_vec();
+    let out = NewtonSolver::new(params).solve(&mut lcp(), &mut x);
+    assert!(
+        matches!(out, Err(SolverError::Diverged { iter, .. }) if iter > 0),
+        "{out:?}"
+    );
+    assert_ne!(x, kept);
+}

@@ -61,6 +61,9 @@ pub struct RunData<M: Engine> {
     /// Failed Newton solves after which the search changed the trial
     /// states and went on ([`Engine::newton_fallback`]).
     pub newton_fallbacks: usize,
+    /// Crawling solves given up at a certain touchdown, after which the
+    /// search touched the points down and went on ([`super::search`]).
+    pub abandoned_crawls: usize,
     /// Re-solves that moved a fixed friction direction to the step's slip
     /// ([`Engine::refine_directions`]).
     pub direction_refinements: usize,
@@ -205,6 +208,7 @@ impl<M: Engine> RunData<M> {
             enumerated_cycles: 0,
             rejected_solutions: 0,
             newton_fallbacks: 0,
+            abandoned_crawls: 0,
             substeps: 0,
             direction_refinements: 0,
             backward_slides: 0,
@@ -284,6 +288,7 @@ where
             enumerated_cycles: self.enumerated_cycles,
             rejected_solutions: self.rejected_solutions,
             newton_fallbacks: self.newton_fallbacks,
+            abandoned_crawls: self.abandoned_crawls,
             direction_refinements: self.direction_refinements,
             backward_slides: self.backward_slides,
             substeps: self.substeps,

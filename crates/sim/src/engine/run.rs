@@ -119,6 +119,7 @@ fn summary<M: Engine>(
         enumerated_cycles: data.enumerated_cycles,
         rejected_solutions: data.rejected_solutions,
         newton_fallbacks: data.newton_fallbacks,
+        abandoned_crawls: data.abandoned_crawls,
         substeps: data.substeps,
         direction_refinements: data.direction_refinements,
         backward_slides: data.backward_slides,

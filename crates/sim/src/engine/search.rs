@@ -17,6 +17,22 @@
 //! them together stick inside their cones (the complementarity rows then
 //! return any that must slide to ST3 at once).
 //!
+//! **Touchdowns during a crawl** (3D models). A solve whose Newton
+//! iteration crawls (its watchdog returns to the kept iterate,
+//! `fbd_solver::NewtonParams::watchdog`) is given up when a free point is
+//! already below the ground beyond the penetration tolerance at that kept
+//! iterate (`fbd_solver::SolverError::Abandoned`): converging those
+//! states would only confirm a touchdown the rules above apply anyway, and
+//! at an impact — a body whose hips and knees strike while its feet slide
+//! — the states before it are the hard ones (their semismooth solve
+//! crawled for all its 50 iterations, then its fallbacks ran). The search
+//! touches the points down there, anchored where the kept iterate's path
+//! crosses the ground (a crawl's iterate is off its solution by the
+//! residual it kept, about 1e-8 m at the crawls met), and solves again
+//! ([`RunData::abandoned_crawls`]). A step that does not crawl, or whose
+//! crawl has no such point, is solved as before; the solution accepted
+//! is checked by the law audit below like every other.
+//!
 //! **A slide that could not stop** (exact models). A sliding point whose slip stops is
 //! tried sticking; when sticking needs more than μS·N it slides on at
 //! μD·N, and the search does not try it again in that step. It keeps that
@@ -101,6 +117,26 @@ pub(crate) fn solve<M: Engine>(
         trials += 1;
         let report = match model.solve(data) {
             Ok(report) => report,
+            Err(e @ fbd_solver::SolverError::Abandoned { .. }) if trials < MAX_STATE_TRIALS => {
+                // A crawl whose kept iterate has a free point below the
+                // ground: its touchdowns are certain (module docs). Its
+                // iterations, as a failed solve's, are not counted.
+                model.evaluate_next(data);
+                if check_states(model, data) {
+                    let key = states_key(data);
+                    if !data.visited.contains(&key) {
+                        data.visited.push(key);
+                        data.abandoned_crawls += 1;
+                        continue;
+                    }
+                }
+                if model.newton_fallback(data) {
+                    data.newton_fallbacks += 1;
+                    data.z.copy_from_slice(&data.start_z);
+                    continue;
+                }
+                return Err(Failure::Newton(e));
+            }
             Err(e) => {
                 if trials < MAX_STATE_TRIALS && model.newton_fallback(data) {
                     data.newton_fallbacks += 1;

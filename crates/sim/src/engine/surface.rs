@@ -316,6 +316,20 @@ macro_rules! surface_stages {
 }
 pub(crate) use surface_stages;
 
+/// The largest scaled residual at which a crawl's kept iterate counts as
+/// near a solution for [`NewtonSystem::abandon_crawl`]: its positions are
+/// then within about `1e-3 · W·Δt²/m` of the solution's (`W` the weight,
+/// `m` the lightest body's mass: under 1 µm on the default hexapod at
+/// Δt = 1 ms), well inside [`ABANDON_DEPTH`].
+pub const ABANDON_RESIDUAL: f64 = 1e-3;
+
+/// How far below the surface (m) a free point of a crawl's kept iterate
+/// must be for its touchdown to be certain ([`NewtonSystem::abandon_crawl`]):
+/// 10 µm, ten times the iterate's uncertainty at [`ABANDON_RESIDUAL`]
+/// (a point that strikes the ground at 1 m/s is 1 mm below it at the end
+/// of a 1 ms step solved without its contact).
+pub const ABANDON_DEPTH: f64 = 1e-5;
+
 /// One step's equations on a surface as a [`NewtonSystem`].
 pub struct SurfaceSystem<'a, A: FbdModel<S = Space3, Ground = Surface>> {
     mech: &'a A,
@@ -352,6 +366,24 @@ where
     }
     fn residual_scale(&self, row: usize) -> f64 {
         self.scales[row]
+    }
+    /// A crawl is given up when its kept iterate is near a solution (a
+    /// scaled residual of at most [`ABANDON_RESIDUAL`]) and has a free
+    /// point more than [`ABANDON_DEPTH`] below the surface: the state
+    /// search touches it down whatever the rest of the solution (see
+    /// [`crate::engine::search`], "Touchdowns during a crawl").
+    fn abandon_crawl(&mut self, x: &[f64], residual: f64) -> bool {
+        if residual > ABANDON_RESIDUAL {
+            return false;
+        }
+        let nq = self.mech.dims().nq;
+        self.mech.kinematics_next(self.fbd, &x[..nq], false);
+        let contacts = self.fbd.contact_equations();
+        (0..contacts.len()).any(|c| {
+            contacts[c].state == SpatialState::Free
+                && clearance(self.surface, self.mech.contact_point(self.fbd, c, At::Next))
+                    < -ABANDON_DEPTH
+        })
     }
 }
 

@@ -521,20 +521,28 @@ impl NewtonSystem for Lcp {
     }
 }
 
+/// An [`Lcp`] whose damped Newton iteration from [`KINKED_START`] stalls at
+/// a kink.
+fn kinked_lcp() -> Lcp {
+    Lcp {
+        a: [
+            [0.13787289283264367, -0.4426848543133972],
+            [1.017486474381074, -1.3066112595978296],
+        ],
+        b: [-0.4116867936057472, 1.827518567008105],
+    }
+}
+
+/// The start of [`kinked_lcp`]'s stalling iteration.
+const KINKED_START: [f64; 2] = [-0.1430663804640684, 1.337560930857414];
+
 /// A semismooth system whose damped Newton iteration stalls at a kink (the
 /// line search finds no decrease below a step of 1/256 after two steps cut
 /// to 1/16 or less) converges with the watchdog's whole steps, to the
 /// complementarity solution.
 #[test]
 fn the_watchdog_takes_a_crawl_across_its_kink() {
-    let lcp = || Lcp {
-        a: [
-            [0.13787289283264367, -0.4426848543133972],
-            [1.017486474381074, -1.3066112595978296],
-        ],
-        b: [-0.4116867936057472, 1.827518567008105],
-    };
-    let x0 = [-0.1430663804640684, 1.337560930857414];
+    let (lcp, x0) = (kinked_lcp, KINKED_START);
     let mut x = x0.to_vec();
     let plain = NewtonSolver::default().solve(&mut lcp(), &mut x);
     assert!(
@@ -591,14 +599,7 @@ impl NewtonSystem for GivingUp {
 /// watch being too few for this kink).
 #[test]
 fn a_crawl_is_given_up_at_its_kept_iterate_when_the_system_asks() {
-    let lcp = || Lcp {
-        a: [
-            [0.13787289283264367, -0.4426848543133972],
-            [1.017486474381074, -1.3066112595978296],
-        ],
-        b: [-0.4116867936057472, 1.827518567008105],
-    };
-    let x0 = [-0.1430663804640684, 1.337560930857414];
+    let (lcp, x0) = (kinked_lcp, KINKED_START);
     // One whole step a watch: too few to cross this kink.
     let params = NewtonParams {
         watchdog: 1,

@@ -19,19 +19,20 @@
 //!
 //! **Touchdowns during a crawl** (3D models). A solve whose Newton
 //! iteration crawls (its watchdog returns to the kept iterate,
-//! `fbd_solver::NewtonParams::watchdog`) is given up when a free point is
-//! already below the ground beyond the penetration tolerance at that kept
-//! iterate (`fbd_solver::SolverError::Abandoned`): converging those
-//! states would only confirm a touchdown the rules above apply anyway, and
-//! at an impact — a body whose hips and knees strike while its feet slide
-//! — the states before it are the hard ones (their semismooth solve
-//! crawled for all its 50 iterations, then its fallbacks ran). The search
-//! touches the points down there, anchored where the kept iterate's path
-//! crosses the ground (a crawl's iterate is off its solution by the
-//! residual it kept, about 1e-8 m at the crawls met), and solves again
-//! ([`RunData::abandoned_crawls`]). A step that does not crawl, or whose
-//! crawl has no such point, is solved as before; the solution accepted
-//! is checked by the law audit below like every other.
+//! `fbd_solver::NewtonParams::watchdog`) is given up
+//! (`fbd_solver::SolverError::Abandoned`) when that kept iterate is near
+//! a solution and a free point is clearly below the ground there
+//! ([`super::surface::ABANDON_RESIDUAL`], [`super::surface::ABANDON_DEPTH`]:
+//! a scaled residual of at most 1e-3, positions within a micrometre, and
+//! a point more than 10 µm deep): converging those states would only
+//! confirm a touchdown the rules above apply anyway, and at an impact — a
+//! body whose hips and knees strike while its feet slide — the states
+//! before it are the hard ones (their semismooth solve crawled for all its
+//! 50 iterations, then its fallbacks ran). The search touches the points
+//! down there, anchored where the kept iterate's path crosses the ground,
+//! and solves again ([`RunData::abandoned_crawls`]). A step that does not
+//! crawl, or whose crawl has no such point, is solved as before; the
+//! solution accepted is checked by the law audit below like every other.
 //!
 //! **A slide that could not stop** (exact models). A sliding point whose slip stops is
 //! tried sticking; when sticking needs more than μS·N it slides on at

@@ -10,7 +10,7 @@
 
 mod common;
 
-use common::spatial::check_contact_laws;
+use common::spatial::assert_rows_within_laws;
 use fbd_scenario::{Config, load};
 use fbd_sim::RunSummary;
 use fbd_sim::spatial::{SpatialModel, run_collect};
@@ -38,15 +38,8 @@ fn exact(model: &SpatialModel) -> RunSummary {
         panic!("{e}");
     }
     assert_eq!(rows.len(), model.steps);
+    assert_rows_within_laws(model, &rows, &summary, "the run");
     let weight = model.mech.total_mass() * model.params.gravity;
-    let retried: Vec<usize> = summary.retries.iter().map(|r| r.step).collect();
-    let laws = check_contact_laws(model, &rows, &retried);
-    assert!(
-        laws.worst <= 1e-6 * weight,
-        "{:.3e} N at {}",
-        laws.worst,
-        laws.worst_at
-    );
     assert!(summary.max_law_violation <= 1e-6 * weight);
     summary
 }

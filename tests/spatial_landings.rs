@@ -17,7 +17,7 @@
 
 mod common;
 
-use common::spatial::{LawReport, check_contact_laws};
+use common::spatial::{LawReport, assert_rows_within_laws};
 use fbd_sim::RunSummary;
 use fbd_sim::spatial::{SpatialModel, run_collect};
 use std::path::Path;
@@ -61,15 +61,7 @@ fn complete_exactly_with(run: usize, watchdog: bool) -> (SpatialModel, RunSummar
         panic!("run {run}: {e}");
     }
     assert_eq!(rows.len(), model.steps, "run {run}");
-    let weight = model.mech.total_mass() * model.params.gravity;
-    let retried: Vec<usize> = summary.retries.iter().map(|r| r.step).collect();
-    let laws = check_contact_laws(&model, &rows, &retried);
-    assert!(
-        laws.worst <= 1e-6 * weight,
-        "run {run}: {:.3e} N at {}",
-        laws.worst,
-        laws.worst_at
-    );
+    let laws = assert_rows_within_laws(&model, &rows, &summary, &format!("run {run}"));
     (model, summary, laws)
 }
 

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::spatial::{check_contact_laws, stance};
+use common::spatial::{assert_rows_within_laws, stance};
 use common::strategies::{SlideThrow, fixed_config, slide_throw};
 use fbd_contact::Friction;
 use fbd_sim::spatial::{SpatialModel, SpatialParams, run_collect};
@@ -45,15 +45,8 @@ fn check(t: SlideThrow, complete: bool) -> usize {
         }
         Some(e) => panic!("{t:?}: {e}"),
     }
-    let retried: Vec<usize> = summary.retries.iter().map(|r| r.step).collect();
-    let rep = check_contact_laws(&model, &rows, &retried);
+    let rep = assert_rows_within_laws(&model, &rows, &summary, &format!("{t:?}"));
     let weight = model.mech.total_mass() * model.params.gravity;
-    assert!(
-        rep.worst <= 1e-6 * weight,
-        "{t:?}: {:.3e} N at {}",
-        rep.worst,
-        rep.worst_at
-    );
     assert!(summary.max_law_violation <= 1e-7 * weight);
     rep.directions
 }

@@ -126,3 +126,25 @@ pub fn check_contact_laws(
     }
     rep
 }
+
+/// [`check_contact_laws`] on a finished run (its retried steps taken from
+/// `summary`), failing unless every row is within the laws to 1e-6 of the
+/// weight; `what` names the run in the message. The law report.
+#[allow(dead_code)]
+pub fn assert_rows_within_laws(
+    model: &SpatialModel,
+    rows: &[fbd_sim::robot::RobotRecord],
+    summary: &fbd_sim::RunSummary,
+    what: &str,
+) -> LawReport {
+    let retried: Vec<usize> = summary.retries.iter().map(|r| r.step).collect();
+    let rep = check_contact_laws(model, rows, &retried);
+    let weight = model.mech.total_mass() * model.params.gravity;
+    assert!(
+        rep.worst <= 1e-6 * weight,
+        "{what}: {:.3e} N at {}",
+        rep.worst,
+        rep.worst_at
+    );
+    rep
+}

@@ -1017,6 +1017,16 @@ fn hexapod_landing_sweep_of_1000_runs() {
         (per_step[499] + per_step[500]) / 2.0,
         "3D landings: iterations a step",
     );
+    let total: u64 = s
+        .iter()
+        .map(|j| j["newton_iterations"].as_u64().unwrap())
+        .sum();
+    r.count(
+        "retried in substeps included: ",
+        " in the sweep",
+        total as usize,
+        "3D landings: Newton iterations in all",
+    );
     r.figure(
         "Newton iterations a step and writes ",
         " events",

@@ -13,6 +13,7 @@ mod common;
 use common::spatial::assert_rows_within_laws;
 use fbd_scenario::{Config, load};
 use fbd_sim::RunSummary;
+use fbd_sim::simulator::{Action, Simulator};
 use fbd_sim::spatial::{SpatialModel, run_collect};
 use std::path::Path;
 
@@ -70,4 +71,36 @@ fn the_drop_gives_up_the_crawl_before_its_hips_and_knees_strike() {
 fn the_walk_never_gives_up_a_solve() {
     let s = exact(&model("hexapod_walk", true));
     assert_eq!(s.abandoned_crawls, 0);
+}
+
+/// Every Newton step the solver takes is counted (`docs/reference.md`,
+/// *Speed*): stepped to its end, the drop — whose given-up crawls are
+/// failed solves, their steps in no report — has counted exactly the
+/// steps its solver took, chord steps included, and its rows hold them
+/// step by step (the given-up crawl's steps in the step that gave it up).
+#[test]
+fn every_step_of_every_solve_counts_the_given_up_ones_too() {
+    let model = model("hexapod_drop", true);
+    let steps = model.steps;
+    let mut sim = Simulator::new(model.clone());
+    let mut rows_sum = 0;
+    for _ in 1..steps {
+        sim.step(&Action::Controller).expect("the drop steps");
+        rows_sum += sim.data().record.newton_iterations;
+    }
+    let data = sim.data();
+    assert!(data.abandoned_crawls >= 1, "a crawl was given up");
+    assert_eq!(data.newton_iterations as u64, data.solver.steps_taken());
+    assert_eq!(
+        data.chord_iterations as u64,
+        data.solver.chord_steps_taken()
+    );
+    assert_eq!(rows_sum, data.newton_iterations);
+    // The same as a run writes.
+    let (rows, summary) = run_collect(&model);
+    assert_eq!(summary.newton_iterations, data.newton_iterations);
+    assert_eq!(
+        rows.iter().map(|r| r.newton_iterations).sum::<usize>(),
+        rows_sum
+    );
 }

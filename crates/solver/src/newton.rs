@@ -219,6 +219,10 @@ struct Workspace {
     /// reduced dimension compiled, see `CompileScratch`).
     compile: CompileScratch,
     numeric_factorizations: u64,
+    /// Steps applied to the unknowns by every solve, chord steps included.
+    steps_taken: u64,
+    /// Of [`Self::steps_taken`], the chord steps.
+    chord_steps_taken: u64,
     /// Factorisations by the compiled LU.
     compiled_factorizations: u64,
     /// Compiled factorisations abandoned for faer's (a pivot failed).
@@ -246,6 +250,8 @@ impl Clone for Workspace {
             mem_req: self.mem_req,
             compile: CompileScratch::default(),
             numeric_factorizations: self.numeric_factorizations,
+            steps_taken: self.steps_taken,
+            chord_steps_taken: self.chord_steps_taken,
             compiled_factorizations: self.compiled_factorizations,
             lu_fallbacks: self.lu_fallbacks,
             lu_corrected: self.lu_corrected,
@@ -330,6 +336,8 @@ impl NewtonSolver {
                 mem_req: StackReq::EMPTY,
                 compile: CompileScratch::default(),
                 numeric_factorizations: 0,
+                steps_taken: 0,
+                chord_steps_taken: 0,
                 compiled_factorizations: 0,
                 lu_fallbacks: 0,
                 lu_corrected: 0,
@@ -358,6 +366,20 @@ impl NewtonSolver {
     /// one-off dense warm-up per new pattern).
     pub fn numeric_factorizations(&self) -> u64 {
         self.ws.numeric_factorizations
+    }
+
+    /// Steps applied to the unknowns by every solve so far (full Newton
+    /// steps and chord steps), those of failed solves (diverged,
+    /// singular, given up) included: what a caller counts as the iterations a computation
+    /// spent (a solve's [`NewtonReport::iterations`] covers only a solve
+    /// that converged).
+    pub fn steps_taken(&self) -> u64 {
+        self.ws.steps_taken
+    }
+
+    /// Of [`Self::steps_taken`], the chord steps.
+    pub fn chord_steps_taken(&self) -> u64 {
+        self.ws.chord_steps_taken
     }
 
     /// Of [`Self::numeric_factorizations`], those done by the compiled LU
@@ -805,6 +827,8 @@ impl Workspace {
                         std::mem::swap(&mut self.r, &mut self.r_trial);
                         have_jacobian = false;
                         chord += 1;
+                        self.steps_taken += 1;
+                        self.chord_steps_taken += 1;
                         *run += 1;
                         pattern.chords_since += 1;
                         let rate = t / rnorm;
@@ -961,6 +985,7 @@ impl Workspace {
             std::mem::swap(&mut self.r, &mut self.r_trial);
             rnorm = trial_norm;
             full += 1;
+            self.steps_taken += 1;
             damp = false;
             crawl = if alpha <= params.crawl_step {
                 crawl + 1

@@ -343,6 +343,10 @@ fn error_messages_are_one_line() {
             residual: 0.5,
         },
         SolverError::NonFinite { iter: 4 },
+        SolverError::Abandoned {
+            iter: 7,
+            residual: 1e-4,
+        },
     ] {
         let m = e.to_string();
         assert!(!m.is_empty() && !m.contains('\n'), "{m}");
@@ -630,4 +634,48 @@ fn a_crawl_is_given_up_at_its_kept_iterate_when_the_system_asks() {
         "{out:?}"
     );
     assert_ne!(x, kept);
+}
+
+/// `NewtonSolver::steps_taken` counts every step applied to the unknowns
+/// (`chord_steps_taken` its chord steps): a converged solve's
+/// `NewtonReport::iterations`, and the steps of a solve that failed — here
+/// one cut off by the iteration limit after its chord steps — which no
+/// report carries.
+#[test]
+fn steps_taken_counts_the_steps_of_failed_solves_too() {
+    let root = root10();
+    let mut sys = TrigChain::with_root(&root, 1);
+    let params = NewtonParams {
+        chord_steps: 6,
+        ..NewtonParams::default()
+    };
+    let mut solver = NewtonSolver::new(params);
+    let mut x = vec![0.0; 10];
+    let first = solver.solve(&mut sys, &mut x).expect("converges");
+    assert_eq!(solver.steps_taken(), first.iterations as u64);
+    assert_eq!(solver.chord_steps_taken(), first.chord_iterations as u64);
+    // A far target, one full step allowed: the kept factorisation's chord
+    // steps, then the full step, then the limit.
+    let far: Vec<f64> = root.iter().map(|r| r + 3.0).collect();
+    sys.retarget(&far);
+    solver.params_mut().max_iterations = 1;
+    let before = (solver.steps_taken(), solver.chord_steps_taken());
+    let err = solver.solve(&mut sys, &mut x).unwrap_err();
+    let SolverError::Diverged { iter, .. } = err else {
+        panic!("{err}");
+    };
+    assert_eq!(iter, 1, "one full step");
+    let failed = solver.steps_taken() - before.0;
+    let chords = solver.chord_steps_taken() - before.1;
+    assert!(chords >= 1, "the kept factorisation was tried: {chords}");
+    assert_eq!(
+        failed,
+        iter as u64 + chords,
+        "every step of the failed solve"
+    );
+    // Converging from there adds its report's steps.
+    solver.params_mut().max_iterations = 20;
+    let before = solver.steps_taken();
+    let rep = solver.solve(&mut sys, &mut x).expect("converges");
+    assert_eq!(solver.steps_taken() - before, rep.iterations as u64);
 }

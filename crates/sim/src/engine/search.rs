@@ -104,15 +104,17 @@ pub(crate) fn start_search<M: Engine>(data: &mut RunData<M>) {
 }
 
 /// Stages 4–5: solves the current (sub)step until its contact and limit
-/// states are consistent. Returns the Newton iterations and the number of
-/// solves.
+/// states are consistent. Returns the Newton iterations — every step
+/// every solve of the search applied, those of failed and given-up
+/// solves included ([`fbd_solver::NewtonSolver::steps_taken`]) —
+/// and the number of solves.
 pub(crate) fn solve<M: Engine>(
     model: &M,
     data: &mut RunData<M>,
 ) -> Result<(usize, usize), Failure> {
     let mut fallback_used = false;
     let mut refinements = 0;
-    let mut newton_iterations = 0;
+    let steps_before = data.solver.steps_taken();
     let mut trials = 0;
     loop {
         trials += 1;
@@ -120,8 +122,7 @@ pub(crate) fn solve<M: Engine>(
             Ok(report) => report,
             Err(e @ fbd_solver::SolverError::Abandoned { .. }) if trials < MAX_STATE_TRIALS => {
                 // A crawl whose kept iterate has a free point below the
-                // ground: its touchdowns are certain (module docs). Its
-                // iterations, as a failed solve's, are not counted.
+                // ground: its touchdowns are certain (module docs).
                 model.evaluate_next(data);
                 if check_states(model, data) {
                     let key = states_key(data);
@@ -147,8 +148,6 @@ pub(crate) fn solve<M: Engine>(
                 return Err(Failure::Newton(e));
             }
         };
-        newton_iterations += report.iterations;
-        data.chord_iterations += report.chord_iterations;
         if !all_finite(&data.z) {
             return Err(Failure::NonFinite {
                 residual: report.residual,
@@ -191,7 +190,7 @@ pub(crate) fn solve<M: Engine>(
             }
         }
         if data.visited.contains(&key) || trials >= MAX_STATE_TRIALS {
-            if enumerate_states(model, data, &mut newton_iterations, &mut trials) {
+            if enumerate_states(model, data, &mut trials) {
                 data.enumerated_cycles += 1;
                 break;
             }
@@ -218,8 +217,7 @@ pub(crate) fn solve<M: Engine>(
         }
         data.visited.push(key);
     }
-    data.newton_iterations += newton_iterations;
-    Ok((newton_iterations, trials))
+    Ok(((data.solver.steps_taken() - steps_before) as usize, trials))
 }
 
 /// Counts the accepted slides whose slip runs against their reference
@@ -445,12 +443,7 @@ const MAX_ENUMERATED: usize = 64;
 /// kept in `data` (`true`). `false` when none is, or when there are too
 /// many to try ([`MAX_ENUMERATED`]); the least inconsistent trial is
 /// updated either way. No allocation.
-fn enumerate_states<M: Engine>(
-    model: &M,
-    data: &mut RunData<M>,
-    newton_iterations: &mut usize,
-    trials: &mut usize,
-) -> bool {
+fn enumerate_states<M: Engine>(model: &M, data: &mut RunData<M>, trials: &mut usize) -> bool {
     let mut points = [0usize; MAX_INVOLVED];
     let mut np = 0;
     for c in 0..data.trial.len() {
@@ -516,11 +509,9 @@ fn enumerate_states<M: Engine>(
         }
         data.z.copy_from_slice(&data.best_z);
         *trials += 1;
-        let Ok(report) = model.solve(data) else {
+        if model.solve(data).is_err() {
             continue;
-        };
-        *newton_iterations += report.iterations;
-        data.chord_iterations += report.chord_iterations;
+        }
         if !all_finite(&data.z) {
             continue;
         }

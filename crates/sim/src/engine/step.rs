@@ -38,9 +38,11 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
     let k = data.k;
     let t = k as f64 * model.dt();
     prepare(model, data)?;
+    let steps_before = data.solver.steps_taken();
+    let chords_before = data.solver.chord_steps_taken();
     let first = match solve(model, data) {
         Ok((iterations, trials)) => {
-            data.max_step_iterations = data.max_step_iterations.max(iterations);
+            count_iterations(data, steps_before, chords_before);
             record(model, data, iterations, trials, model.dt());
             let same = accept(model, data, t);
             model.accepted_whole(data);
@@ -82,7 +84,10 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
             match result {
                 Ok(iterations) => {
                     data.solver.params_mut().compiled_lu = compiled;
-                    data.max_step_iterations = data.max_step_iterations.max(iterations);
+                    // The record holds the substeps' searches; the
+                    // attempts that failed before them count too.
+                    let all = count_iterations(data, steps_before, chords_before);
+                    M::add_to_record(&mut data.record, all - iterations, 0);
                     data.retries.push(RetryEvent {
                         t,
                         step: k,
@@ -121,6 +126,22 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
             }
         },
     ))
+}
+
+/// Adds the Newton iterations the solver took since `steps_before`
+/// (chord steps since `chords_before`) — every solve of the step, failed
+/// attempts included — to the run's totals and its largest step; returns
+/// them.
+fn count_iterations<M: Engine>(
+    data: &mut RunData<M>,
+    steps_before: u64,
+    chords_before: u64,
+) -> usize {
+    let steps = (data.solver.steps_taken() - steps_before) as usize;
+    data.newton_iterations += steps;
+    data.chord_iterations += (data.solver.chord_steps_taken() - chords_before) as usize;
+    data.max_step_iterations = data.max_step_iterations.max(steps);
+    steps
 }
 
 /// Stages 1–3 of [`step`]: the constants of step `data.k`, the joint

@@ -370,9 +370,9 @@ impl NewtonSolver {
 
     /// Steps applied to the unknowns by every solve so far (full Newton
     /// steps and chord steps), those of failed solves (diverged,
-    /// singular, given up) included: what a caller counts as the iterations a computation
-    /// spent (a solve's [`NewtonReport::iterations`] covers only a solve
-    /// that converged).
+    /// singular, given up) included: what a caller counts as the
+    /// iterations a computation spent (a solve's
+    /// [`NewtonReport::iterations`] covers only a solve that converged).
     pub fn steps_taken(&self) -> u64 {
         self.ws.steps_taken
     }

@@ -107,6 +107,8 @@ pub fn step<M: Engine>(model: &M, data: &mut RunData<M>) -> Result<(), SimError>
         }
     }
     data.solver.params_mut().compiled_lu = compiled;
+    // The run's totals hold the failed step's iterations too.
+    count_iterations(data, steps_before, chords_before);
     // A step with no exact solution names the law its finest attempt
     // breaks; otherwise the whole step's failure is the error.
     let (failure, states, limits) = match last {

@@ -120,27 +120,15 @@ pub(crate) fn solve<M: Engine>(
         trials += 1;
         let report = match model.solve(data) {
             Ok(report) => report,
-            Err(e @ fbd_solver::SolverError::Abandoned { .. }) if trials < MAX_STATE_TRIALS => {
-                // A crawl whose kept iterate has a free point below the
-                // ground: its touchdowns are certain (module docs).
-                model.evaluate_next(data);
-                if check_states(model, data) {
-                    let key = states_key(data);
-                    if !data.visited.contains(&key) {
-                        data.visited.push(key);
-                        data.abandoned_crawls += 1;
-                        continue;
-                    }
-                }
-                if model.newton_fallback(data) {
-                    data.newton_fallbacks += 1;
-                    data.z.copy_from_slice(&data.start_z);
+            Err(e) => {
+                let retry = trials < MAX_STATE_TRIALS;
+                if retry
+                    && matches!(e, fbd_solver::SolverError::Abandoned { .. })
+                    && touch_down_after_crawl(model, data)
+                {
                     continue;
                 }
-                return Err(Failure::Newton(e));
-            }
-            Err(e) => {
-                if trials < MAX_STATE_TRIALS && model.newton_fallback(data) {
+                if retry && model.newton_fallback(data) {
                     data.newton_fallbacks += 1;
                     data.z.copy_from_slice(&data.start_z);
                     continue;
@@ -218,6 +206,23 @@ pub(crate) fn solve<M: Engine>(
         data.visited.push(key);
     }
     Ok(((data.solver.steps_taken() - steps_before) as usize, trials))
+}
+
+/// After a crawl given up at its kept iterate (module docs): the
+/// touchdowns certain there, made by the switching rules, when they lead
+/// to states not yet tried in this search (`true`: solve again).
+fn touch_down_after_crawl<M: Engine>(model: &M, data: &mut RunData<M>) -> bool {
+    model.evaluate_next(data);
+    if !check_states(model, data) {
+        return false;
+    }
+    let key = states_key(data);
+    if data.visited.contains(&key) {
+        return false;
+    }
+    data.visited.push(key);
+    data.abandoned_crawls += 1;
+    true
 }
 
 /// Counts the accepted slides whose slip runs against their reference

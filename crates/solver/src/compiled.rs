@@ -98,19 +98,32 @@
 
 use crate::lu::Stream;
 
-/// The threshold of the pivot check: a pivot at least a hundredth of the
-/// largest entry of its column, which bounds `L`'s entries by 100. Measured
-/// (fallbacks / factorisations, `bench/peer`): the moving planar flight
-/// 483 / 6353 at 0.1, 139 / 6384 at 0.01, 17 / 6350 at 0.001; the hexapod
-/// walk 54, 40 and 38 of 186 (its failed pivots are cancellations to
-/// round-off, `1e-5` against `3e6`, which no threshold accepts).
-pub const PIVOT_THRESHOLD: f64 = 0.01;
+/// The threshold of the pivot check: a pivot at least a thousandth of the
+/// largest entry of its column, which bounds `L`'s entries by 1000.
+/// Measured (fallbacks / factorisations, `bench/peer`): the moving planar
+/// flight 483 / 6353 at 0.1, 139 / 6384 at 0.01, 17 / 6350 at 0.001; the
+/// hexapod walk 54, 40 and 38 of 186 (its failed pivots are cancellations
+/// to round-off, `1e-5` against `3e6`, which no threshold accepts). From
+/// 0.01 to 0.001 (2026-11-28, `valgrind --tool=cachegrind`, `quick`
+/// build): the 3D drop of `bench/peer` 1,157 M → 1,106 M instructions
+/// (of its 969 factorisations 411 clean, 521 corrected and 37 by faer's
+/// LU, against 326, 588 and 55), 40 of
+/// the 1000 landings of `examples/sweep_hexapod_landing_1000.toml`
+/// (`--shard 0/25`) 31.09 G → 30.29 G, the walk and the moving flight
+/// −0.4 % and −0.7 %, standing and the passive fall the same; the 1000
+/// landings 56.7–59.3 s → 54.6–55.4 s of stepping (`--jobs 2`, two sweeps
+/// each, alternating), their Newton iterations within 0.1 %. The first 100
+/// of those landings (`samples = 100`, `--jobs 2`, two sweeps each): 5.09–
+/// 5.44 s at 0.001, 5.32–5.53 s at 0.003, 5.17–5.37 s at 0.0003,
+/// 5.47–5.63 s at 0.01.
+pub const PIVOT_THRESHOLD: f64 = 0.001;
 
 /// The threshold of the row choice at compilation
 /// ([`CompiledLu::choose_rows`]): a pivot at least a tenth of its column's
 /// largest entry (UMFPACK's default for threshold partial pivoting), a
-/// margin of ten over the check of later factorisations
-/// ([`PIVOT_THRESHOLD`]).
+/// margin of a hundred over the check of later factorisations
+/// ([`PIVOT_THRESHOLD`]). A hundredth or 0.3 instead: those 100 landings
+/// in 5.83 and 5.75 s, against 5.44 s (one sweep each, the same session).
 pub const ROW_CHOICE_THRESHOLD: f64 = 0.1;
 
 /// The most pivots of one factorisation that may be perturbed

@@ -1772,8 +1772,9 @@ mod tests {
     #[test]
     fn a_failed_pivot_is_perturbed_and_corrected() {
         // [[a, 1], [1, 1]]: compiled on a = 2 (row 0 pivots first), then
-        // a = 1e-3 fails the check (|a| < 0.01·1): the pivot is perturbed
-        // to 1 and the solve corrected (Sherman–Morrison), exactly.
+        // a = 1e-4 fails the check (|a| < 0.001·1, `PIVOT_THRESHOLD`): the
+        // pivot is perturbed to 1 and the solve corrected
+        // (Sherman–Morrison), exactly.
         let n = 2;
         let mut entries = vec![(0, 0), (0, 1), (1, 0), (1, 1)];
         let mut pattern = Pattern::build(0, n, &mut entries);
@@ -1795,12 +1796,24 @@ mod tests {
         assert_eq!(path, FactorPath::Compiled);
         // 2x + y = 1, x + y = 2: x = −1, y = 3.
         assert!((x[0] + 1.0).abs() < 1e-15 && (x[1] - 3.0).abs() < 1e-15);
-        let small = values_for(1e-3);
+        let small = values_for(1e-4);
         let (x, path) = solve_with(&mut factors, &mut pattern, &small, &b, &mut mem, true);
         assert_eq!(path, FactorPath::Corrected);
         // a·x + y = 1, x + y = 2: x = 1/(1 − a), y = 2 − x.
-        let exact = [1.0 / (1.0 - 1e-3), 2.0 - 1.0 / (1.0 - 1e-3)];
+        let exact = [1.0 / (1.0 - 1e-4), 2.0 - 1.0 / (1.0 - 1e-4)];
         assert!((x[0] - exact[0]).abs() < 1e-14 && (x[1] - exact[1]).abs() < 1e-14);
+        // a = 5e-3 passes it (a two-hundredth of its column): no correction.
+        let (x, path) = solve_with(
+            &mut factors,
+            &mut pattern,
+            &values_for(5e-3),
+            &b,
+            &mut mem,
+            true,
+        );
+        assert_eq!(path, FactorPath::Compiled);
+        let exact = [1.0 / (1.0 - 5e-3), 2.0 - 1.0 / (1.0 - 5e-3)];
+        assert!((x[0] - exact[0]).abs() < 1e-13 && (x[1] - exact[1]).abs() < 1e-13);
         // A zero pivot too.
         let (x, path) = solve_with(
             &mut factors,

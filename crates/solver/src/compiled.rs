@@ -84,8 +84,10 @@
 //! the values of its second fallback in a row (`RECOMPILE_AFTER`: its row
 //! order no longer fits the values). A pattern keeps one program per set
 //! of exact zeros among its values (a complementarity branch switched
-//! inside the pattern), compiled at that set's second fallback
-//! ([`crate::lu`]'s `zero_signature`); beyond `MAX_PROGRAMS` a new set
+//! inside the pattern): a set that the pattern's first program cannot
+//! factor gets its own program at once, compiled on those values, before
+//! any fallback ([`crate::lu`]'s `zero_signature`; at its second fallback
+//! until 2026-11-29); beyond `MAX_PROGRAMS` a new set
 //! takes the place of the least recently tried program but the first,
 //! compiled again in its storage.
 //! Results equal faer's to round-off (different order of the same sums),

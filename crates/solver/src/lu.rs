@@ -190,7 +190,8 @@ pub(crate) struct Pattern {
     /// [`Program::last_use`].
     factorizations: u64,
     /// The zero signatures that fell back to faer's LU once, without a
-    /// program of their own (compiled at their second fallback).
+    /// program of their own because the row choice found no pivot on
+    /// their values (compiled on faer's rows at their second fallback).
     failed: Vec<u64>,
 }
 
@@ -839,6 +840,56 @@ impl Factors {
         }
     }
 
+    /// Factors `reduced` with program `index` of `pattern`: its
+    /// factorisation, the sweeps' streams and, for perturbed pivots, the
+    /// Woodbury correction and its check. The path taken, or `None` when a
+    /// pivot could not be perturbed or the correction failed (the caller
+    /// then falls back).
+    fn run_program(
+        &mut self,
+        pattern: &mut Pattern,
+        index: usize,
+        reduced: &[f64],
+    ) -> Option<FactorPath> {
+        pattern.factorizations += 1;
+        pattern.programs[index].last_use = pattern.factorizations;
+        let program = &mut pattern.programs[index].lu;
+        program
+            .factor(reduced, &mut self.pivot_inv, &mut self.perturbed)
+            .ok()?;
+        for (s, &p) in self.row_src.iter_mut().zip(&program.row_perm) {
+            *s = pattern.kept_rows[p];
+        }
+        // The sweeps' streams: fixed entries, this factorisation's
+        // values (`U`'s divided by their column's pivot).
+        self.lower.map_from(&program.lower, |_, s| program.value(s));
+        let pivot_inv = &self.pivot_inv;
+        self.upper.map_from(&program.upper, |j, s| {
+            program.value(s) * pivot_inv[j as usize]
+        });
+        let fwd = pattern.col_perm.arrays().0;
+        let ok = self.perturbed.is_empty()
+            || self.woodbury(
+                pattern.structure.col_ptr(),
+                pattern.structure.row_idx(),
+                reduced,
+                &program.row_perm,
+                fwd,
+            );
+        if !ok {
+            return None;
+        }
+        self.owner = Some(pattern.id);
+        pattern.solves_since = 0;
+        pattern.chords_since = 0;
+        pattern.programs[index].fails = 0;
+        Some(if self.perturbed.is_empty() {
+            FactorPath::Compiled
+        } else {
+            FactorPath::Corrected
+        })
+    }
+
     /// Compiles a program of `pattern` on `reduced`, values whose exact
     /// zeros have the signature `zeros`, and keeps it. The row order is
     /// chosen by threshold Markowitz on these values (less fill than
@@ -959,10 +1010,10 @@ impl Factors {
     /// column ordering; the eliminated rows' pivots and columns are copied
     /// into `pattern`. `mem` must hold [`Self::scratch`]; `sc` is the
     /// scratch of a compilation (the pattern's first factorisation with
-    /// `compiled` or a set of exact zeros' second fallback, which allocate
-    /// the program, or a program's [`RECOMPILE_AFTER`]-th fallback in a
-    /// row, which allocates only when the program outgrows its storage).
-    /// Allocation-free otherwise.
+    /// `compiled`, or a new set of exact zeros that the first program
+    /// cannot factor, which allocate the program, or a program's
+    /// [`RECOMPILE_AFTER`]-th fallback in a row, which allocates only when
+    /// the program outgrows its storage). Allocation-free otherwise.
     ///
     /// # Errors
     /// [`SolverError::Singular`] when faer finds no structurally non-zero
@@ -999,45 +1050,23 @@ impl Factors {
             // the row choice finds no pivot, faer's LU below and its rows.
             self.add_program(sc, pattern, reduced, zeros, false, None);
         }
-        let known = pattern.programs.iter().position(|p| p.zeros == zeros);
+        let mut known = pattern.programs.iter().position(|p| p.zeros == zeros);
         if compiled && n > 0 && !pattern.programs.is_empty() {
-            let index = known.unwrap_or(0);
-            pattern.factorizations += 1;
-            pattern.programs[index].last_use = pattern.factorizations;
-            let program = &mut pattern.programs[index].lu;
-            if program
-                .factor(reduced, &mut self.pivot_inv, &mut self.perturbed)
-                .is_ok()
-            {
-                for (s, &p) in self.row_src.iter_mut().zip(&program.row_perm) {
-                    *s = pattern.kept_rows[p];
-                }
-                // The sweeps' streams: fixed entries, this factorisation's
-                // values (`U`'s divided by their column's pivot).
-                self.lower.map_from(&program.lower, |_, s| program.value(s));
-                let pivot_inv = &self.pivot_inv;
-                self.upper.map_from(&program.upper, |j, s| {
-                    program.value(s) * pivot_inv[j as usize]
-                });
-                let fwd = pattern.col_perm.arrays().0;
-                let ok = self.perturbed.is_empty()
-                    || self.woodbury(
-                        pattern.structure.col_ptr(),
-                        pattern.structure.row_idx(),
-                        reduced,
-                        &program.row_perm,
-                        fwd,
-                    );
-                if ok {
-                    self.owner = Some(pattern.id);
-                    pattern.solves_since = 0;
-                    pattern.chords_since = 0;
-                    pattern.programs[index].fails = 0;
-                    return Ok(if self.perturbed.is_empty() {
-                        FactorPath::Compiled
-                    } else {
-                        FactorPath::Corrected
-                    });
+            if let Some(path) = self.run_program(pattern, known.unwrap_or(0), reduced) {
+                return Ok(path);
+            }
+            if known.is_none() {
+                // A set of zeros without a program of its own, which the
+                // pattern's first program cannot factor: its own program,
+                // compiled on these values at once: a compilation and a
+                // factorisation with it cost less than faer's LU of the
+                // same values (on the 3D drop of `bench/peer`, about 0.7 M
+                // instructions for a compilation, 1.05 M for faer's LU;
+                // docs/reference.md, *Speed*).
+                self.add_program(sc, pattern, reduced, zeros, false, None);
+                known = pattern.programs.iter().position(|p| p.zeros == zeros);
+                if let Some(path) = known.and_then(|i| self.run_program(pattern, i, reduced)) {
+                    return Ok(path);
                 }
             }
             path = FactorPath::Fallback;
@@ -1095,8 +1124,9 @@ impl Factors {
             }
             self.lower.seal();
             self.upper.seal();
-            // A set of zeros gets its program at its second fallback: most
-            // pass once (a contact's branch for one iterate).
+            // A set of zeros still without a program here is one whose
+            // row choice found no pivot: it gets a program on faer's rows
+            // at its second fallback (most pass once).
             let recurring = if path == FactorPath::Fallback && known.is_none() {
                 match pattern.failed.iter().position(|&z| z == zeros) {
                     Some(i) => {
@@ -1910,10 +1940,11 @@ mod tests {
         // A complementarity row switching branch inside one pattern: rows
         // become `x_i = c` (their other entries exact zeros), a third of
         // them here. The program compiled without those zeros fails more
-        // pivots than it may perturb; the second fallback of that set of
-        // zeros compiles a program of its own, used from then on, and each
-        // solution equals faer's to round-off (a corrected one: within its
-        // check's backward error).
+        // pivots than it may perturb; that set of zeros then gets a
+        // program of its own at once, compiled on its values (no
+        // fallback to faer's LU), used from then on, and each solution
+        // equals faer's to round-off (a corrected one: within its check's
+        // backward error).
         let n = 150;
         let triplets = matrix(n, 5);
         let (n, mut pattern, mut mem, mut factors, b) = setup(&triplets);
@@ -1940,18 +1971,14 @@ mod tests {
         );
         assert_eq!(
             paths[1],
-            FactorPath::Fallback,
-            "other zeros fail the first program"
-        );
-        assert_eq!(
-            paths[3],
-            FactorPath::Fallback,
-            "compiled at the second fallback"
+            FactorPath::Compiled,
+            "other zeros get their own program at once"
         );
         assert_eq!(pattern.programs.len(), 2);
-        for (d, path) in paths.iter().enumerate().skip(4) {
+        for (d, path) in paths.iter().enumerate().skip(2) {
             assert_ne!(*path, FactorPath::Fallback, "draw {d}");
         }
+        assert_eq!(pattern.programs.len(), 2, "one program a set of zeros");
     }
 
     /// The pattern's first factorisation compiles its program and runs it.
@@ -2031,7 +2058,8 @@ mod tests {
         // MAX_PROGRAMS + 3 sets of exact zeros (rows `x_i = 1`: every row
         // with a diagonal entry outside the set's block of 8 rows, modulo
         // the number of sets), each met twice in a row (compiled at its
-        // second fallback), then all again: the first program (no zeros)
+        // first meeting, factored by its program at the second), then all
+        // again: the first program (no zeros)
         // stays, the pattern never keeps more than MAX_PROGRAMS, and the
         // sets compiled last factor by their programs; every solution
         // equals faer's to round-off.
@@ -2063,13 +2091,19 @@ mod tests {
         };
         let mut kept = None;
         for set in 0..sets {
+            let programs = pattern.programs.len();
             for _ in 0..2 {
-                assert_eq!(
+                assert_ne!(
                     next(Some(set), &mut pattern, &mut factors),
                     FactorPath::Fallback,
-                    "set {set} before its program"
+                    "set {set}"
                 );
             }
+            assert_eq!(
+                pattern.programs.len(),
+                (programs + 1).min(MAX_PROGRAMS),
+                "set {set}: one program, compiled at its first meeting"
+            );
             assert!(pattern.programs.len() <= MAX_PROGRAMS);
             if kept.is_none() && pattern.programs.len() == MAX_PROGRAMS {
                 kept = Some(storage(&pattern));

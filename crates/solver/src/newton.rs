@@ -104,12 +104,15 @@ pub struct NewtonParams {
     pub refactor_cost: f64,
     /// **The compiled LU** (`crate::compiled`): each pattern's numeric LU
     /// compiled, at its first factorisation, into a flat list of
-    /// operations on faer's column ordering and the row order of faer's
-    /// partial pivoting on those values; later factorisations run the list
-    /// and re-verify each pivot (threshold `0.01` of its column); a
-    /// failed pivot is perturbed and the solves corrected to the exact
-    /// system ([`NewtonSolver::lu_corrected`]), or, when that cannot be
-    /// done, the factorisation falls back to faer's pivoting LU
+    /// operations on faer's column ordering and a row order chosen on
+    /// those values (threshold Markowitz pivoting); later factorisations
+    /// run the list and re-verify each pivot (at least a thousandth of
+    /// its column, `compiled::PIVOT_THRESHOLD`); a failed pivot is
+    /// perturbed and the solves corrected to the exact system
+    /// ([`NewtonSolver::lu_corrected`]); a new set of exact zeros (a
+    /// complementarity branch switched) that cannot be factored so gets
+    /// a program of its own; when none of that can be done, the
+    /// factorisation falls back to faer's pivoting LU
     /// ([`NewtonSolver::lu_fallbacks`]). `false`: every factorisation by
     /// faer's pivoting LU, the reference path. Solutions agree to
     /// round-off. Default: `true`.

@@ -1055,14 +1055,16 @@ impl Factors {
             if let Some(path) = self.run_program(pattern, known.unwrap_or(0), reduced) {
                 return Ok(path);
             }
-            if known.is_none() {
+            if known.is_none() && !pattern.failed.contains(&zeros) {
                 // A set of zeros without a program of its own, which the
                 // pattern's first program cannot factor: its own program,
                 // compiled on these values at once: a compilation and a
                 // factorisation with it cost less than faer's LU of the
                 // same values (on the 3D drop of `bench/peer`, about 0.7 M
                 // instructions for a compilation, 1.05 M for faer's LU;
-                // docs/reference.md, *Speed*).
+                // docs/reference.md, *Speed*). Not for a set whose row
+                // choice already found no pivot (`Pattern::failed`): its
+                // second fallback compiles it on faer's rows.
                 self.add_program(sc, pattern, reduced, zeros, false, None);
                 known = pattern.programs.iter().position(|p| p.zeros == zeros);
                 if let Some(path) = known.and_then(|i| self.run_program(pattern, i, reduced)) {

@@ -111,8 +111,17 @@ pub fn under_along_normal(surface: &Surface, p: [f64; 3]) -> [f64; 3] {
     [p[0] - d * n[0], p[1] - d * n[1], p[2] - d * n[2]]
 }
 
-/// The contact frame `(t1, n, t2)` at `(x, z)` (see the module docs).
+/// The contact frame `(t1, n, t2)` at `(x, z)` (see the module docs); a
+/// plane's is made once, with the surface.
 pub fn frame(surface: &Surface, x: f64, z: f64) -> [[f64; 3]; 3] {
+    match surface.plane_frame() {
+        Some(frame) => frame,
+        None => frame_at(surface, x, z),
+    }
+}
+
+/// [`frame`] computed at `(x, z)`.
+pub(crate) fn frame_at(surface: &Surface, x: f64, z: f64) -> [[f64; 3]; 3] {
     let n = surface.normal(x, z);
     let [ux, uz] = surface.direction();
     let [gx, gz] = surface.gradient(x, z);
@@ -299,6 +308,39 @@ mod tests {
             &Friction::default(),
             &ContactParams::default(),
         )
+    }
+
+    #[test]
+    fn a_planes_frame_is_made_once_and_is_the_frame_everywhere() {
+        for (terrain, direction) in [
+            (Terrain::Flat { height: 0.2 }, 0.0),
+            (Terrain::None, 0.3),
+            (Terrain::slope_deg(3.5, 0.0), 0.0),
+            (Terrain::slope_deg(-12.0, 0.1), 1.1),
+        ] {
+            let s = Surface::new(terrain, direction);
+            assert!(s.plane_frame().is_some());
+            for (x, z) in [(0.0, 0.0), (0.4, -0.2), (-3.7, 12.5), (1e3, -1e3)] {
+                assert_eq!(frame(&s, x, z), frame_at(&s, x, z), "at ({x}, {z})");
+            }
+        }
+        // A terrain changed after the surface was made is not served from
+        // the frame made for the old one.
+        let mut s = Surface::new(Terrain::slope_deg(10.0, 0.0), 0.0);
+        s.terrain = Terrain::slope_deg(20.0, 0.0);
+        assert_eq!(frame(&s, 0.4, 0.0), frame_at(&s, 0.4, 0.0));
+        assert_ne!(
+            frame(&s, 0.4, 0.0)[1],
+            Surface::new(Terrain::slope_deg(10.0, 0.0), 0.0).normal(0.4, 0.0)
+        );
+        // No cached frame for the curved kinds.
+        let sine = Terrain::Sine {
+            amplitude: 0.1,
+            wavelength: 2.0,
+            phase: 0.0,
+            height: 0.0,
+        };
+        assert!(Surface::new(sine, 0.0).plane_frame().is_none());
     }
 
     #[test]

@@ -64,6 +64,10 @@ pub struct Surface {
     map: Option<Arc<Map>>,
     /// Friction patches, the last listed winning.
     patches: Arc<[FrictionPatch]>,
+    /// A plane's contact frame (flat or slope, no height map), the same
+    /// at every point, with the slope it was made for
+    /// ([`Self::plane_frame`]).
+    plane: Option<(f64, [[f64; 3]; 3])>,
 }
 
 impl Default for Surface {
@@ -79,12 +83,31 @@ impl Surface {
     /// model; π/2: along −Z, the forward direction of a robot at zero yaw).
     pub fn new(terrain: Terrain, direction: f64) -> Self {
         let (sin, cos) = direction.sin_cos();
-        Self {
+        let mut surface = Self {
             terrain,
             cos,
             sin,
             map: None,
             patches: Arc::from(Vec::new()),
+            plane: None,
+        };
+        if let Some(slope) = surface.terrain.plane_slope() {
+            surface.plane = Some((slope, crate::spatial::frame_at(&surface, 0.0, 0.0)));
+        }
+        surface
+    }
+
+    /// The contact frame of a plane, where the surface is one (flat or a
+    /// slope, no height map; the same frame at every point, made once),
+    /// for [`crate::spatial::frame`].
+    pub(crate) fn plane_frame(&self) -> Option<[[f64; 3]; 3]> {
+        match self.plane {
+            Some((slope, frame))
+                if self.map.is_none() && self.terrain.plane_slope() == Some(slope) =>
+            {
+                Some(frame)
+            }
+            _ => None,
         }
     }
 
@@ -93,6 +116,7 @@ impl Surface {
         let mean = grid.smoothed(MEAN_RADIUS);
         Self {
             map: Some(Arc::new(Map { grid, mean })),
+            plane: None,
             ..Self::new(Terrain::Flat { height: 0.0 }, 0.0)
         }
     }

@@ -223,6 +223,16 @@ impl Terrain {
         }
     }
 
+    /// The constant slope `dϱ/ds` of a plane (none, flat or slope), `None`
+    /// for the other kinds.
+    pub fn plane_slope(&self) -> Option<f64> {
+        match self {
+            Terrain::None | Terrain::Flat { .. } => Some(0.0),
+            Terrain::Slope { slope, .. } => Some(*slope),
+            _ => None,
+        }
+    }
+
     /// `ϱ′(x)` (0 without ground; at a profile vertex, the slope of the
     /// segment to its right).
     #[inline]

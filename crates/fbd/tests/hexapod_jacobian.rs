@@ -226,3 +226,59 @@ fn jacobian_of_complementarity_rows_on_a_rotated_slope_at_the_first_step() {
     );
     check_rows(&s, true, true, true);
 }
+
+/// At rest (`q[k−1] = q[k]`), the residual at the rest configuration is
+/// the same, bit for bit, whether the workspace evaluated it fresh or
+/// holds the frames and momenta of earlier evaluations (the kinematics
+/// at the same `q` and each body's `L[k+½]` at the same rotations are
+/// kept, not evaluated again), with other iterates in between and after
+/// a step accepted there.
+#[test]
+fn kept_frames_and_momenta_give_the_fresh_residual() {
+    use fbd_dynamics::tree::assemble::{advance, evaluate_next};
+    let mech = mechanism(&[1, 2, 3, 4, 5, 6]);
+    let n = mech.dims().dim();
+    let nq = mech.nq();
+    let rest = q_at(&mech, 0.0);
+    let at = |q: &[f64]| {
+        let mut z: Vec<f64> = (0..n).map(|i| 2.0 * ((i as f64) * 0.53).cos()).collect();
+        z[..nq].copy_from_slice(q);
+        z
+    };
+    let prepared = || {
+        let mut data = TreeFbdData::new(&mech);
+        set_previous(&mech, &mut data, &rest);
+        set_configuration(&mech, &mut data, &rest);
+        prepare_step(&mech, &mut data, History::Previous, 0.001);
+        data
+    };
+    let residual = |data: &mut TreeFbdData, z: &[f64]| {
+        let mut r = vec![0.0; n];
+        fbd_dynamics::eval(
+            &mech,
+            &Surface::default(),
+            data,
+            z,
+            &mut r,
+            &mut fbd_dynamics::NoJacobian,
+        );
+        r.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+    };
+    let fresh = residual(&mut prepared(), &at(&rest));
+    let mut data = prepared();
+    let moved = at(&q_at(&mech, 1e-4));
+    for z in [at(&rest), moved.clone(), at(&rest), at(&rest)] {
+        let r = residual(&mut data, &z);
+        if z[..nq] == rest[..] {
+            assert_eq!(r, fresh);
+        }
+    }
+    // The step accepted at rest: the next one is at rest again, its
+    // workspace handed the frames of q[k−1] = q[k].
+    evaluate_next(&mech, &mut data, &rest);
+    advance(&mut data);
+    prepare_step(&mech, &mut data, History::Previous, 0.001);
+    assert_eq!(residual(&mut data, &at(&rest)), fresh);
+    assert_ne!(residual(&mut data, &moved), fresh);
+    assert_eq!(residual(&mut data, &at(&rest)), fresh);
+}

@@ -414,3 +414,59 @@ proptest! {
         check_spatial(&[1, 3, 4], &q)?;
     }
 }
+
+/// Every field `eval` fills, for comparing two workspaces' evaluations.
+fn frames(kin: &TreeKin) -> Vec<f64> {
+    let mut v = Vec::new();
+    for list in [
+        &kin.origin,
+        &kin.com,
+        &kin.axis,
+        &kin.joint_origin,
+        &kin.contact,
+        &kin.contact_center,
+    ] {
+        v.extend(list.iter().flat_map(|x| x.iter().copied()));
+    }
+    v.extend(kin.rotation.iter().flat_map(|r| r.iter().copied()));
+    v.extend(kin.phi_axes.iter().flat_map(|x| x.iter().copied()));
+    v
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// `eval` at the `q` of its last evaluation finds its frames in place:
+    /// whatever the workspace evaluated before, it holds, bit for bit, a
+    /// fresh workspace's evaluation at the last `q` (a `q` that differs in
+    /// a single bit, a zero's sign included, is evaluated again).
+    #[test]
+    fn eval_again_at_the_same_q_is_a_fresh_evaluation(
+        q1 in q_strategy(LAB_JOINTS),
+        q2 in q_strategy(LAB_JOINTS),
+        j in 6..6 + LAB_JOINTS,
+    ) {
+        let model = lab();
+        let fresh = |q: &[f64]| {
+            let mut kin = TreeKin::new(&model);
+            kin.eval(&model, q);
+            frames(&kin)
+        };
+        let mut kin = TreeKin::new(&model);
+        prop_assert!(kin.evaluated_at().is_none());
+        for q in [&q1, &q2, &q2, &q1, &q1] {
+            kin.eval(&model, q);
+            prop_assert_eq!(kin.evaluated_at(), Some(&q[..]));
+            prop_assert_eq!(frames(&kin), fresh(q));
+        }
+        let mut signed = q1.clone();
+        signed[j] = 0.0;
+        kin.eval(&model, &signed);
+        signed[j] = -0.0;
+        kin.eval(&model, &signed);
+        prop_assert_eq!(
+            frames(&kin).iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+            fresh(&signed).iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        );
+    }
+}

@@ -55,6 +55,14 @@ pub struct TreeFbdData {
     /// Per FBD body, whether `l_next` and `psi_next` are those of the
     /// evaluated `kin_next` over this step's `dt` ([`step_momentum`]).
     l_next_fresh: Vec<bool>,
+    /// The coordinates of `kin` and of `kin_next` and the step length, bit
+    /// for bit, that the bodies marked in `l_kept` had their `l_next` and
+    /// `psi_next` computed at (valid when `l_key_valid`): at a rest, where
+    /// neither configuration changes from step to step, the momenta are
+    /// taken from there ([`keep_momenta`]).
+    l_key: Vec<f64>,
+    l_key_valid: bool,
+    l_kept: Vec<bool>,
     /// `L[k+½]` of every body at the accepted `q[k+1]` over a step of
     /// `l_carry_dt`, the next step's `L[k−½]` when `l_carry_valid`: a
     /// step accepted whole carries its momenta over, so that the next
@@ -129,6 +137,9 @@ impl TreeFbdData {
             l_next: vec![Vector3::zeros(); nb],
             psi_next: vec![Vector3::zeros(); nb],
             l_next_fresh: vec![false; nb],
+            l_key: vec![0.0; 2 * mech.nq() + 1],
+            l_key_valid: false,
+            l_kept: vec![false; nb],
             l_carry: vec![Vector3::zeros(); nb],
             l_carry_dt: 0.0,
             l_carry_valid: false,
@@ -302,6 +313,39 @@ pub fn advance(data: &mut TreeFbdData) {
     data.l_next_fresh.fill(false);
 }
 
+/// Keeps the bodies' `l_next` and `psi_next` (`l_kept`) while `kin`,
+/// `kin_next` and the step length are those they were computed for, bit
+/// for bit; forgets them otherwise. `L[k+½]` is a function of the two
+/// rotations and `Δt` alone: a robot at rest, predicted at its last
+/// configuration, evaluates the same pair every step.
+fn keep_momenta(data: &mut TreeFbdData) {
+    let same_bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let (Some(now), Some(next)) = (
+        data.terms.kin.evaluated_at(),
+        data.terms.kin_next.evaluated_at(),
+    ) else {
+        data.l_key_valid = false;
+        data.l_kept.fill(false);
+        return;
+    };
+    let nq = now.len();
+    let dt = data.terms.dt;
+    let (key_now, rest) = data.l_key.split_at_mut(nq);
+    let (key_next, key_dt) = rest.split_at_mut(nq);
+    if data.l_key_valid
+        && same_bits(key_now, now)
+        && same_bits(key_next, next)
+        && key_dt[0].to_bits() == dt.to_bits()
+    {
+        return;
+    }
+    key_now.copy_from_slice(now);
+    key_next.copy_from_slice(next);
+    key_dt[0] = dt;
+    data.l_key_valid = true;
+    data.l_kept.fill(false);
+}
+
 /// `L[k+½]` of FBD body `b` ([`crate::spatial::half_momentum_and_rotation`])
 /// and the rotation `ψ[k+½]` it is made of, over this step at the
 /// evaluated `q[k+1]` (after [`evaluate_next`]), when the last evaluation
@@ -357,6 +401,7 @@ impl FbdModel for TreeMechanism {
             data.l_next_fresh.fill(false);
         }
         data.terms.set_iterate(q);
+        keep_momenta(data);
     }
 
     #[inline]
@@ -374,15 +419,19 @@ impl FbdModel for TreeMechanism {
         let (dt, inertia) = (data.dt, &body.inertia);
         let (r_k, r_next) = (&data.kin.rotation[mb], &data.kin_next.rotation[mb]);
         let (l_next, psi) = if jacobian {
+            // The same values as `half_momentum_and_rotation`, bit for bit.
             let (l, d, psi) = half_momentum_derivative_and_rotation(r_k, r_next, inertia, dt);
             data.rot_d[b] = d * (bs.c_next / dt);
             (l, psi)
+        } else if data.l_kept[b] {
+            (data.l_next[b], data.psi_next[b])
         } else {
             half_momentum_and_rotation(r_k, r_next, inertia, dt)
         };
         data.l_next[b] = l_next;
         data.psi_next[b] = psi;
         data.l_next_fresh[b] = true;
+        data.l_kept[b] = true;
         ((bs.c_next * l_next - Vector3::from(bs.ang)) / dt).into()
     }
 

@@ -336,6 +336,7 @@ pub struct SurfaceSystem<'a, A: FbdModel<S = Space3, Ground = Surface>> {
     surface: &'a Surface,
     fbd: &'a mut A::Data,
     scales: &'a [f64],
+    weights: &'a [f64],
 }
 
 impl<A> NewtonSystem for SurfaceSystem<'_, A>
@@ -366,6 +367,9 @@ where
     }
     fn residual_scale(&self, row: usize) -> f64 {
         self.scales[row]
+    }
+    fn residual_weight(&self, row: usize) -> f64 {
+        self.weights[row]
     }
     /// A crawl is given up when its kept iterate is near a solution (a
     /// scaled residual of at most [`ABANDON_RESIDUAL`]) and has a free
@@ -424,6 +428,7 @@ pub fn system<'a, M: SurfaceEngine>(
         surface: model.ground(),
         fbd: &mut data.fbd,
         scales: &data.scales,
+        weights: &data.weights,
     };
     (sys, &mut data.solver, &mut data.z)
 }
@@ -517,25 +522,38 @@ fn row_scales<M: SurfaceEngine>(model: &M, data: &mut RunData<M>) {
     let extent = data.q[0].abs().max(data.q[1].abs()).max(data.q[2].abs());
     let force = model.total_mass() * model.gravity().abs().max(1.0) + 1e-6 * k * (1.0 + extent);
     let moment = force * model.length_scale(data);
+    let position = 1e-3 * k * (1.0 + extent);
     let ncp = complementarity(model, data);
+    // Each row's scale and its weight `1 / scale` (the scaled norm's, read
+    // at every iterate): three divisions a solve, not one per row and
+    // iterate.
+    let [f, m, p] = [force, moment, position].map(|s| (s, 1.0 / s));
+    let (scales, weights) = (&mut data.scales, &mut data.weights);
+    let mut set = |row: usize, (s, w): (f64, f64)| {
+        scales[row] = s;
+        weights[row] = w;
+    };
     for b in 0..lay.bodies {
         let row = lay.body_row(b);
-        data.scales[row..row + 3].fill(force);
-        data.scales[row + 3..row + 6].fill(moment);
+        for a in 0..3 {
+            set(row + a, f);
+            set(row + 3 + a, m);
+        }
     }
-    let position = 1e-3 * k * (1.0 + extent);
     for c in 0..lay.contacts {
         let row = lay.contact_row(c);
         let s = match data.trial[c] {
-            SpatialState::Free => [force; 3],
-            _ if ncp => [force; 3],
-            SpatialState::Stick { .. } => [position; 3],
-            SpatialState::Slide { .. } => [force, position, force],
+            SpatialState::Free => [f; 3],
+            _ if ncp => [f; 3],
+            SpatialState::Stick { .. } => [p; 3],
+            SpatialState::Slide { .. } => [f, p, f],
         };
-        data.scales[row..row + 3].copy_from_slice(&s);
+        for (a, v) in s.into_iter().enumerate() {
+            set(row + a, v);
+        }
     }
     for l in 0..lay.limits {
-        data.scales[lay.limit_row(l)] = moment;
+        set(lay.limit_row(l), m);
     }
 }
 

@@ -232,13 +232,19 @@ fn jacobian_of_complementarity_rows_on_a_rotated_slope_at_the_first_step() {
 /// holds the frames and momenta of earlier evaluations (the kinematics
 /// at the same `q` and each body's `L[k+½]` at the same rotations are
 /// kept, not evaluated again), with other iterates in between and after
-/// a step accepted there.
+/// a step accepted there; and after every evaluation the workspace's
+/// frames and momenta are those computed afresh, outside it (a fresh
+/// `TreeKin` at the iterate, `half_momentum_and_rotation` of its
+/// rotations).
 #[test]
 fn kept_frames_and_momenta_give_the_fresh_residual() {
-    use fbd_dynamics::tree::assemble::{advance, evaluate_next};
+    use fbd_dynamics::spatial::half_momentum_and_rotation;
+    use fbd_dynamics::tree::assemble::{advance, evaluate_next, step_momentum};
+    use fbd_dynamics::tree::kin::TreeKin;
     let mech = mechanism(&[1, 2, 3, 4, 5, 6]);
     let n = mech.dims().dim();
     let nq = mech.nq();
+    let dt = 0.001;
     let rest = q_at(&mech, 0.0);
     let at = |q: &[f64]| {
         let mut z: Vec<f64> = (0..n).map(|i| 2.0 * ((i as f64) * 0.53).cos()).collect();
@@ -249,9 +255,12 @@ fn kept_frames_and_momenta_give_the_fresh_residual() {
         let mut data = TreeFbdData::new(&mech);
         set_previous(&mech, &mut data, &rest);
         set_configuration(&mech, &mut data, &rest);
-        prepare_step(&mech, &mut data, History::Previous, 0.001);
+        prepare_step(&mech, &mut data, History::Previous, dt);
         data
     };
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    // The residual at `z`, with the workspace's kinematics at `z`'s `q`
+    // and every body's momentum checked against fresh computations.
     let residual = |data: &mut TreeFbdData, z: &[f64]| {
         let mut r = vec![0.0; n];
         fbd_dynamics::eval(
@@ -262,12 +271,44 @@ fn kept_frames_and_momenta_give_the_fresh_residual() {
             &mut r,
             &mut fbd_dynamics::NoJacobian,
         );
-        r.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+        let mut fresh = TreeKin::new(&mech.model);
+        fresh.eval(&mech.model, &z[..nq]);
+        assert_eq!(data.kin_next, fresh, "kinematics at the iterate");
+        for (b, body) in mech.bodies.iter().enumerate() {
+            let mb = body.model_body;
+            let (l, psi) = half_momentum_and_rotation(
+                &data.kin.rotation[mb],
+                &data.kin_next.rotation[mb],
+                &body.inertia,
+                dt,
+            );
+            let (kl, kpsi) = step_momentum(data, b).expect("computed at the iterate");
+            assert_eq!(
+                bits(kl.as_slice()),
+                bits(l.as_slice()),
+                "body {b}'s momentum"
+            );
+            assert_eq!(
+                bits(kpsi.as_slice()),
+                bits(psi.as_slice()),
+                "body {b}'s rotation"
+            );
+        }
+        bits(&r)
     };
     let fresh = residual(&mut prepared(), &at(&rest));
     let mut data = prepared();
     let moved = at(&q_at(&mech, 1e-4));
-    for z in [at(&rest), moved.clone(), at(&rest), at(&rest)] {
+    let mut joints_moved = at(&rest);
+    joints_moved[nq - 1] += 1e-3;
+    for z in [
+        at(&rest),
+        moved.clone(),
+        at(&rest),
+        joints_moved,
+        at(&rest),
+        at(&rest),
+    ] {
         let r = residual(&mut data, &z);
         if z[..nq] == rest[..] {
             assert_eq!(r, fresh);
@@ -277,7 +318,7 @@ fn kept_frames_and_momenta_give_the_fresh_residual() {
     // workspace handed the frames of q[k−1] = q[k].
     evaluate_next(&mech, &mut data, &rest);
     advance(&mut data);
-    prepare_step(&mech, &mut data, History::Previous, 0.001);
+    prepare_step(&mech, &mut data, History::Previous, dt);
     assert_eq!(residual(&mut data, &at(&rest)), fresh);
     assert_ne!(residual(&mut data, &moved), fresh);
     assert_eq!(residual(&mut data, &at(&rest)), fresh);

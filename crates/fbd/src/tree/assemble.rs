@@ -13,7 +13,7 @@
 //! residual and its pattern are every model's ([`crate::assembly::eval`],
 //! [`crate::assembly::pattern`]).
 
-use super::kin::{Columns, TreeKin};
+use super::kin::{Columns, TreeKin, same_bits};
 use super::mechanism::TreeMechanism;
 use crate::assemble::{History, JacobianSink};
 use crate::assembly::{
@@ -319,7 +319,6 @@ pub fn advance(data: &mut TreeFbdData) {
 /// rotations and `Δt` alone: a robot at rest, predicted at its last
 /// configuration, evaluates the same pair every step.
 fn keep_momenta(data: &mut TreeFbdData) {
-    let same_bits = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
     let (Some(now), Some(next)) = (
         data.terms.kin.evaluated_at(),
         data.terms.kin_next.evaluated_at(),
@@ -335,7 +334,7 @@ fn keep_momenta(data: &mut TreeFbdData) {
     if data.l_key_valid
         && same_bits(key_now, now)
         && same_bits(key_next, next)
-        && key_dt[0].to_bits() == dt.to_bits()
+        && same_bits(key_dt, &[dt])
     {
         return;
     }

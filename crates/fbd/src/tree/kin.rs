@@ -395,13 +395,7 @@ impl TreeKin {
         // bit, they are already here — a robot at rest, whose predicted
         // configuration is the last one, which the workspace handed over
         // at the step before holds.
-        if self.evaluated
-            && self
-                .at
-                .iter()
-                .zip(q)
-                .all(|(a, b)| a.to_bits() == b.to_bits())
-        {
+        if self.evaluated && same_bits(&self.at, q) {
             return;
         }
         self.at.copy_from_slice(q);
@@ -497,6 +491,12 @@ impl TreeKin {
             point: None,
         }
     }
+}
+
+/// Whether `a` and `b` hold the same values bit for bit (a zero's sign
+/// included: the values a function of them gives are then the same).
+pub(crate) fn same_bits(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())
 }
 
 /// A sparse Jacobian with three rows: a point's `∂p/∂q` or a body's

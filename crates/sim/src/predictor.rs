@@ -25,9 +25,8 @@
 //! solves every step after t = 0.515 s with the prediction alone (416
 //! Newton iterations in 5001 steps instead of 677), and from step 517 on
 //! it repeats, bit for bit, an exact equilibrium of the discrete
-//! equations. Ties keep the higher order, as
-//! at the first step, where the history before it is a fiction at rest.
-//! Once every difference of order 1 and more is `+0` (the robot exactly
+//! equations. Ties keep the higher order, as at the first step, where the
+//! history before it is a fiction at rest. Once every difference of order 1 and more is `+0` (the robot exactly
 //! at rest), recording the newest values again would change no bit:
 //! [`Predictor::record`] then compares them and leaves the histories as
 //! they are.
@@ -147,10 +146,12 @@ impl Predictor {
         let (zq, zf) = z.split_at(self.nq);
         if self.rest && self.newest_are(zq, zf) {
             // A history at rest recording its newest values again: every
-            // difference stays `+0` (`v − v`), every order predicted it
-            // exactly, the lowest wins the ties — what recording them
+            // difference stays `+0` (`v − v`) and every order predicted
+            // them exactly, so the ties give `q` order 1 (order 0 must win
+            // strictly) and the forces order 0 — what recording them
             // would give, bit for bit, without the pass over the histories
-            // (a robot at rest, module docs).
+            // (a robot at rest, module docs; `f_zero` may stay `false` for
+            // a force at rest at `+0`, which only skips less).
             self.orders = [1, 0];
         } else {
             let q_err = record_history(&mut self.q, zq);
@@ -174,9 +175,7 @@ impl Predictor {
         };
         self.steps += 1;
     }
-}
 
-impl Predictor {
     /// Whether `zq` and `zf` are the newest recorded values, bit for bit
     /// (and finite: `v − v` is `+0`).
     fn newest_are(&self, zq: &[f64], zf: &[f64]) -> bool {

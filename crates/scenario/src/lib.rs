@@ -598,6 +598,43 @@ impl ContactConfig {
     }
 }
 
+/// `[solver]`: Newton's settings, for every model (`config.toml` writes
+/// both, filled in). An extension of the paper's method, which solves
+/// each step by Newton's method without saying how.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SolverConfig {
+    /// How many chord steps in a row may reuse a kept factorisation of
+    /// the Jacobian (simplified Newton: a residual and a solve each, where
+    /// a full Newton step also factors the Jacobian); `0` is full Newton.
+    /// Default 6 (`fbd_sim::DEFAULT_CHORD_STEPS`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub chord_steps: Option<usize>,
+    /// The convergence tolerance: every row's residual at most this
+    /// fraction of its scale (a force row's: the robot's weight), from
+    /// 1e-12 to 1e-9. Default 1e-9 (`fbd_sim::DEFAULT_TOLERANCE`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+}
+
+impl SolverConfig {
+    /// The simulator's settings (the defaults where a key is not given).
+    pub fn settings(&self) -> fbd_sim::SolverSettings {
+        let d = fbd_sim::SolverSettings::default();
+        fbd_sim::SolverSettings {
+            chord_steps: self.chord_steps.unwrap_or(d.chord_steps),
+            tolerance: self.tolerance.unwrap_or(d.tolerance),
+        }
+    }
+
+    /// Every key filled in with its default.
+    pub fn resolve(&mut self) {
+        let s = self.settings();
+        self.chord_steps = Some(s.chord_steps);
+        self.tolerance = Some(s.tolerance);
+    }
+}
+
 /// `[output]`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -838,6 +875,9 @@ pub struct ConfigFile<I> {
     /// `[output]`.
     #[serde(default)]
     pub output: OutputConfig,
+    /// `[solver]`: Newton's settings.
+    #[serde(default)]
+    pub solver: SolverConfig,
     /// `[control]`: the joint controller (planar model, hexapod dynamics).
     #[serde(default)]
     pub control: ControlConfig,
@@ -867,6 +907,7 @@ impl Default for PlanarConfig {
             terrain: TerrainConfig::default(),
             contact: ContactConfig::default(),
             output: OutputConfig::default(),
+            solver: SolverConfig::default(),
             control: ControlConfig::default(),
             gait: None,
         };
@@ -892,6 +933,7 @@ impl<I> ConfigFile<I> {
         points.dedup();
         self.contact.points = points;
         self.terrain.resolve_kind();
+        self.solver.resolve();
     }
 
     /// The simulator's parameters of the tables every model shares
@@ -923,6 +965,7 @@ impl<I> ConfigFile<I> {
             patches: self.terrain.patches("").unwrap_or_default(),
             contact_points: self.contact.contact_points(),
             stride: self.output.stride,
+            solver: self.solver.settings(),
             ..PlanarParams::default()
         }
     }
@@ -1606,6 +1649,57 @@ mod tests {
         assert!(e.contains("mas"), "{e}");
         let e = parse("[time]\ndt = \"fast\"\n").unwrap_err().to_string();
         assert!(e.starts_with("c.toml:2:6: time.dt: invalid type"), "{e}");
+    }
+
+    #[test]
+    fn solver_table_is_filled_checked_and_set_by_overrides() {
+        // Filled in with the defaults (the effective configuration).
+        let full = parse("").unwrap();
+        assert!(
+            full.to_toml().contains("[solver]\nchord_steps = 6\n"),
+            "{}",
+            full.to_toml()
+        );
+        let Config::Planar(c) = full else {
+            unreachable!()
+        };
+        assert_eq!(
+            (c.solver.chord_steps, c.solver.tolerance),
+            (
+                Some(fbd_sim::DEFAULT_CHORD_STEPS),
+                Some(fbd_sim::DEFAULT_TOLERANCE)
+            )
+        );
+        // Given, and carried to the simulator's parameters of both models.
+        let Config::Planar(c) = parse("[solver]\nchord_steps = 0\ntolerance = 1e-11\n").unwrap()
+        else {
+            unreachable!()
+        };
+        assert_eq!(c.params().solver.chord_steps, 0);
+        assert_eq!(c.params().solver.tolerance, 1e-11);
+        let o = [Override::parse("solver.chord_steps=2").unwrap()];
+        let Config::Hexapod(h) = parse_str("model = \"hexapod\"\n", "h.toml", &o).unwrap() else {
+            unreachable!()
+        };
+        assert_eq!(h.spatial_params("h.toml").unwrap().solver.chord_steps, 2);
+        // Out of their domains, or misspelt: one line naming the key.
+        let e = parse("[solver]\nchord_steps = 101\n")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            e,
+            "c.toml: solver.chord_steps: is too large (got 101, expected an integer from 0 (full Newton) to 100)"
+        );
+        let e = parse("[solver]\ntolerance = 1e-6\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.toml: solver.tolerance: "), "{e}");
+        let e = parse("[solver]\nchord_steps = -1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.toml:2:15: solver.chord_steps: "), "{e}");
+        let e = parse("[solver]\nchord = 1\n").unwrap_err().to_string();
+        assert!(e.starts_with("c.toml:2:1: ") && e.contains("chord"), "{e}");
     }
 
     #[test]

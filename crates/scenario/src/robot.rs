@@ -308,6 +308,9 @@ pub struct RobotConfig {
     /// `[output]`.
     #[serde(default)]
     pub output: RobotOutput,
+    /// `[solver]`: Newton's settings (the hexapod's table).
+    #[serde(default)]
+    pub solver: crate::SolverConfig,
 }
 
 impl RobotConfig {
@@ -946,6 +949,7 @@ fn complete(config: &RobotConfig, description: &Path) -> RobotConfig {
         c.robot.mjcf = Some(path);
     }
     c.robot.up.get_or_insert_with(|| "z".to_owned());
+    c.solver.resolve();
     c
 }
 
@@ -1495,6 +1499,7 @@ impl LoadedRobot {
             contact: fbd_contact::ContactParams::default(),
             stride: c.output.stride,
             control: self.control.clone(),
+            solver: c.solver.settings(),
         }
     }
 

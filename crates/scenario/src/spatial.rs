@@ -645,6 +645,7 @@ impl HexapodConfig {
             contact: ContactParams::default(),
             control,
             stride: c.output.stride,
+            solver: c.solver.settings(),
         })
     }
 

@@ -43,6 +43,7 @@ pub mod robot;
 mod rules;
 mod run;
 pub mod simulator;
+mod solver_settings;
 pub mod spatial;
 pub mod step;
 mod system;
@@ -59,4 +60,8 @@ pub use record::{Event, LimitCode, LimitEvent, RetryEvent};
 pub use robot::RobotRecord;
 pub use run::{RunSummary, run, run_collect, run_until};
 pub use simulator::{Action, PdTargets, Plant, Readout, SimState, Simulator};
+pub use solver_settings::{
+    DEFAULT_CHORD_STEPS, DEFAULT_TOLERANCE, MAX_CHORD_STEPS, MAX_TOLERANCE, MIN_TOLERANCE,
+    SolverSettings,
+};
 pub use step::step;

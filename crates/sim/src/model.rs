@@ -169,6 +169,7 @@ impl PlanarParams {
             &format!("0 ≤ mu_dynamic ≤ {}", p.friction.mu_static),
         )?;
         crate::rules::stride(p.stride)?;
+        p.solver.validate()?;
         Ok(())
     }
 }
@@ -293,12 +294,13 @@ impl Model {
             mech,
             index,
             contact,
-            newton: NewtonParams {
+            newton: p.solver.applied(NewtonParams {
                 // At the small steps of a simulation the previous
                 // factorisation is an excellent approximate Jacobian; a chord
                 // step that does not contract falls back to full Newton, so
                 // the tolerances are unchanged.
-                chord_steps: 6,
+                chord_steps: crate::DEFAULT_CHORD_STEPS,
+                residual_tol: crate::DEFAULT_TOLERANCE,
                 // A refactorisation (the Jacobian, faer's numeric LU of the
                 // 15–31 unknowns) costs about eight chord steps here;
                 // renewing the kept one at that cost cut the instructions
@@ -307,7 +309,7 @@ impl Model {
                 // renew at 24 (`crate::engine::surface::newton_params`).
                 refactor_cost: 8.0,
                 ..NewtonParams::default()
-            },
+            }),
             steps: steps_f as usize + 1,
             contact_compliance: contact_bumper
                 .iter()

@@ -68,6 +68,8 @@ pub struct PlanarParams {
     pub stride: usize,
     /// Joint controller. Default [`Control::None`] (passive joints).
     pub control: Control,
+    /// Newton's settings (`[solver]`). Default: the model's.
+    pub solver: crate::SolverSettings,
 }
 
 impl Default for PlanarParams {
@@ -107,6 +109,7 @@ impl Default for PlanarParams {
             patches: Vec::new(),
             contact_points: ContactPoints::default(),
             stride: 1,
+            solver: crate::SolverSettings::default(),
             control: Control::None,
         }
     }

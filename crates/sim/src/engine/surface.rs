@@ -437,13 +437,13 @@ pub fn system<'a, M: SurfaceEngine>(
 /// hexapod and every imported robot).
 pub fn newton_params() -> fbd_solver::NewtonParams {
     fbd_solver::NewtonParams {
-        chord_steps: 6,
+        chord_steps: crate::DEFAULT_CHORD_STEPS,
         // The planar engine's tolerance. The angular momentum of a free
         // robot drifts by the residual's moments: 1.8e-9 relative over
         // 2000 steps at this tolerance, 1e-10 at a tolerance of 1e-10
         // (`tests/spatial_flight.rs`), which costs 30 % more iterations on
         // a walk.
-        residual_tol: 1e-9,
+        residual_tol: crate::DEFAULT_TOLERANCE,
         // The complementarity rows are semismooth: near a point that just
         // starts or stops sliding, or lands while it slides, Newton's
         // iterates cross branches and converge linearly for a while, and a

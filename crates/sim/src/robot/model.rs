@@ -80,6 +80,7 @@ impl RobotSim {
             "a finite value",
         )?;
         crate::rules::stride(p.stride)?;
+        p.solver.validate()?;
         assert_eq!(p.q0.len(), nq, "q0: 6 base coordinates + one per joint");
         assert_eq!(p.qdot0.len(), nq, "qdot0: the layout of q0");
         crate::rules::friction(&p.friction)?;
@@ -201,7 +202,7 @@ impl RobotSim {
             effort: robot.joints.iter().map(|j| j.effort).collect(),
             contact_bumper: vec![0.0; contact_specs.len()],
             contact_specs,
-            newton: crate::engine::surface::newton_params(),
+            newton: p.solver.applied(crate::engine::surface::newton_params()),
             steps: (p.duration / p.dt).round() as usize + 1,
             initial_states,
             max_substeps: 256,

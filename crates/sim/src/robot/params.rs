@@ -25,6 +25,8 @@ pub struct RobotParams {
     pub contact: ContactParams,
     /// Every `stride`-th step's record is handed out. Default 1.
     pub stride: usize,
+    /// Newton's settings (`[solver]`). Default: the model's.
+    pub solver: crate::SolverSettings,
     /// The joint controller. Default passive joints.
     pub control: RobotControl,
 }
@@ -46,6 +48,7 @@ impl RobotParams {
             },
             contact: ContactParams::default(),
             stride: 1,
+            solver: crate::SolverSettings::default(),
             control: RobotControl::None,
         }
     }

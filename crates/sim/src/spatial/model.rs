@@ -163,6 +163,7 @@ impl SpatialParams {
         crate::rules::friction(&p.friction)?;
         crate::rules::joint_ranges(p.joint_limits.is_valid(), "leg.theta1_deg", &p.joint_limits)?;
         crate::rules::stride(p.stride)?;
+        p.solver.validate()?;
         let Some((kp, kd, limit)) = p.control.gains() else {
             return Ok(());
         };
@@ -245,7 +246,7 @@ impl SpatialModel {
         let model = Self {
             params: p.clone(),
             steps: (p.duration / p.dt).round() as usize + 1,
-            newton: crate::engine::surface::newton_params(),
+            newton: p.solver.applied(crate::engine::surface::newton_params()),
             contact_bumper,
             initial_states,
             max_substeps: 256,

@@ -166,6 +166,8 @@ pub struct SpatialParams {
     pub control: SpatialControl,
     /// Write every `stride`-th step. Default 1.
     pub stride: usize,
+    /// Newton's settings (`[solver]`). Default: the model's.
+    pub solver: crate::SolverSettings,
 }
 
 /// `[Ixx, Iyy, Izz]` of a thin uniform hexagonal plate of side `side` and
@@ -207,6 +209,7 @@ impl Default for SpatialParams {
             contact: ContactParams::default(),
             control: SpatialControl::None,
             stride: 1,
+            solver: crate::SolverSettings::default(),
         }
     }
 }
@@ -351,6 +354,7 @@ impl SpatialParams {
             contact_points: p.contact_points,
             control,
             stride: p.stride,
+            solver: p.solver,
             ..Self::default()
         }
     }

@@ -8,24 +8,15 @@
 mod common;
 
 use common::physics::{run_ok, worst_body_imbalance};
-use common::spatial::assert_rows_within_laws;
+use common::spatial::{assert_rows_within_laws, landing_config};
 use fbd_sim::spatial::{SpatialModel, run_collect};
 use fbd_sim::{PlanarParams, SolverSettings};
-use std::path::Path;
 
 /// Landing `run` of `examples/sweep_hexapod_landing_1000.toml`, every row
 /// written, with `chord_steps` set in its configuration (`None`: the
 /// default).
 fn landing(run: usize, chord_steps: Option<usize>) -> SpatialModel {
-    let plan = fbd_cli::sweep::plan(Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/sweep_hexapod_landing_1000.toml"
-    )))
-    .expect("the sweep file loads");
-    let fbd_cli::sweep::RunConfig::Model(fbd_cli::Config::Hexapod(c)) = &plan.configs[run] else {
-        panic!("a hexapod run")
-    };
-    let mut c = c.clone();
+    let mut c = landing_config(run);
     c.solver.chord_steps = chord_steps;
     let mut params = c.spatial_params("landing").expect("a valid run");
     params.stride = 1;

@@ -17,10 +17,9 @@
 
 mod common;
 
-use common::spatial::{LawReport, assert_rows_within_laws};
+use common::spatial::{LawReport, assert_rows_within_laws, landing_config};
 use fbd_sim::RunSummary;
 use fbd_sim::spatial::{SpatialModel, run_collect};
-use std::path::Path;
 
 fn landing(run: usize) -> SpatialModel {
     with_watchdog(run, true)
@@ -28,15 +27,9 @@ fn landing(run: usize) -> SpatialModel {
 
 /// Landing `run`, with Newton's watchdog (the default) or without it.
 fn with_watchdog(run: usize, watchdog: bool) -> SpatialModel {
-    let plan = fbd_cli::sweep::plan(Path::new(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/examples/sweep_hexapod_landing_1000.toml"
-    )))
-    .expect("the sweep file loads");
-    let fbd_cli::sweep::RunConfig::Model(fbd_cli::Config::Hexapod(c)) = &plan.configs[run] else {
-        panic!("a hexapod run")
-    };
-    let mut params = c.spatial_params("landing").expect("a valid run");
+    let mut params = landing_config(run)
+        .spatial_params("landing")
+        .expect("a valid run");
     // Every row (the sweep file's `[set]` writes every 50th).
     params.stride = 1;
     let mut model = SpatialModel::new(&params).expect("a valid model");

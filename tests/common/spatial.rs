@@ -3,6 +3,23 @@
 use fbd_dynamics::tree::kin::TreeKin;
 use fbd_sim::spatial::{SpatialControl, SpatialModel, SpatialParams};
 
+/// The configuration of landing `run` of
+/// `examples/sweep_hexapod_landing_1000.toml` (the default hexapod dropped
+/// onto its feet, knees and hips; Δt = 2 ms, 1.5 s), as `fbd sweep` runs
+/// it.
+#[allow(dead_code)]
+pub fn landing_config(run: usize) -> fbd_scenario::HexapodConfig {
+    let plan = fbd_cli::sweep::plan(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/examples/sweep_hexapod_landing_1000.toml"
+    )))
+    .expect("the sweep file loads");
+    let fbd_cli::sweep::RunConfig::Model(fbd_cli::Config::Hexapod(c)) = &plan.configs[run] else {
+        panic!("a hexapod run")
+    };
+    (**c).clone()
+}
+
 /// A PD-held stance with the feet on the ground at t = 0.
 pub fn stance() -> SpatialParams {
     let theta = [0.0, (-20f64).to_radians(), 290f64.to_radians()];

@@ -68,7 +68,8 @@ pub struct PlanarParams {
     pub stride: usize,
     /// Joint controller. Default [`Control::None`] (passive joints).
     pub control: Control,
-    /// Newton's settings (`[solver]`). Default: the model's.
+    /// Newton's settings (`[solver]`). Default
+    /// [`crate::SolverSettings::default`]: 6 chord steps, tolerance 1e-9.
     pub solver: crate::SolverSettings,
 }
 

@@ -64,14 +64,14 @@ impl SolverSettings {
             "solver.chord_steps",
             "is too large",
             self.chord_steps,
-            "an integer from 0 (full Newton) to 100",
+            &format!("an integer from 0 (full Newton) to {MAX_CHORD_STEPS}"),
         )?;
         check(
             (MIN_TOLERANCE..=MAX_TOLERANCE).contains(&self.tolerance),
             "solver.tolerance",
-            "must lie from 1e-12 to 1e-9 (the default)",
+            &format!("must lie from {MIN_TOLERANCE:e} to {MAX_TOLERANCE:e} (the default)"),
             self.tolerance,
-            "a value in [1e-12, 1e-9]",
+            &format!("a value in [{MIN_TOLERANCE:e}, {MAX_TOLERANCE:e}]"),
         )
     }
 

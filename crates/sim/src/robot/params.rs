@@ -25,7 +25,8 @@ pub struct RobotParams {
     pub contact: ContactParams,
     /// Every `stride`-th step's record is handed out. Default 1.
     pub stride: usize,
-    /// Newton's settings (`[solver]`). Default: the model's.
+    /// Newton's settings (`[solver]`). Default
+    /// [`crate::SolverSettings::default`]: 6 chord steps, tolerance 1e-9.
     pub solver: crate::SolverSettings,
     /// The joint controller. Default passive joints.
     pub control: RobotControl,

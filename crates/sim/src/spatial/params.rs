@@ -166,7 +166,8 @@ pub struct SpatialParams {
     pub control: SpatialControl,
     /// Write every `stride`-th step. Default 1.
     pub stride: usize,
-    /// Newton's settings (`[solver]`). Default: the model's.
+    /// Newton's settings (`[solver]`). Default
+    /// [`crate::SolverSettings::default`]: 6 chord steps, tolerance 1e-9.
     pub solver: crate::SolverSettings,
 }
 

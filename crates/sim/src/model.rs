@@ -300,7 +300,6 @@ impl Model {
                 // step that does not contract falls back to full Newton, so
                 // the tolerances are unchanged.
                 chord_steps: crate::DEFAULT_CHORD_STEPS,
-                residual_tol: crate::DEFAULT_TOLERANCE,
                 // A refactorisation (the Jacobian, faer's numeric LU of the
                 // 15–31 unknowns) costs about eight chord steps here;
                 // renewing the kept one at that cost cut the instructions

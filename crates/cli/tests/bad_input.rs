@@ -320,6 +320,100 @@ fn negative_gravity_is_rejected_as_a_magnitude() {
     assert!(c.run().status.success());
 }
 
+/// The longest run of consecutive digits in `text`.
+fn longest_digit_run(text: &str) -> usize {
+    text.split(|c: char| !c.is_ascii_digit())
+        .map(str::len)
+        .max()
+        .unwrap_or(0)
+}
+
+#[test]
+fn huge_and_tiny_values_are_quoted_short() {
+    // Rust's `{}` writes 1e300 with all its 301 digits: every quoted
+    // number goes through `fbd_kinematics::num`.
+    let hexapod = "model = \"hexapod\"\n[time]\nduration = 0.01\n";
+    for (text, needles) in [
+        (
+            "[leg]\nlower_com = 1e300\n".to_owned(),
+            vec!["leg.lower_com", "got 1e300"],
+        ),
+        (
+            "[leg]\ntheta1_deg = 1e300\n".to_owned(),
+            vec!["leg.theta1_deg", "invalid type: floating point `1e300`"],
+        ),
+        (
+            format!("{hexapod}[initial.leg4]\ntheta_deg = [0.0, 0.0, 1e300]\n"),
+            vec![
+                "initial.leg4.theta_deg",
+                "theta3 = 1.000e300°",
+                "by 1.000e300°",
+            ],
+        ),
+        (
+            format!("{hexapod}[control]\nkind = \"pd\"\nkp = 1000.0\nkd = 1e300\n"),
+            vec!["control.kd", "got 1e300 N·m·s/rad"],
+        ),
+        (
+            "[terrain]\nmu_static = 0.5\nmu_dynamic = 1e300\n".to_owned(),
+            vec!["terrain.mu_dynamic", "got 1e300"],
+        ),
+        (
+            "[time]\ndt = 1e-300\nduration = 1e-301\n".to_owned(),
+            vec!["time.dt", "got 1e-300"],
+        ),
+    ] {
+        let e = Case::new(&text).rejected(&needles);
+        assert!(longest_digit_run(&e) < 20, "{text:?} → {e}");
+    }
+    // A run-time advice: the time scale of a robot under 1e300 m/s² of
+    // gravity and the step it asks for, as numbers, not as zeros.
+    let c = Case::new("[world]\ngravity = 1e300\n[time]\nduration = 0.01\n");
+    let o = c.run();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(e.contains("√(c/g) = 6.481e-151 s"), "{e}");
+    assert!(e.contains("try time.dt = 2e-152"), "{e}");
+    assert!(longest_digit_run(&e) < 20, "{e}");
+}
+
+#[test]
+fn a_swing_shorter_than_two_steps_is_rejected() {
+    // `period = 1e-9` asked the gait's plan for a foothold per period:
+    // 3e8 of them in a 0.3 s run, and the run was killed for memory.
+    // The tripod's swing is half the period: two steps of 1 ms need 4 ms.
+    let walk = |period: &str| {
+        format!(
+            "model = \"hexapod\"\n[time]\ndt = 0.001\nduration = 0.3\n\
+             [gait]\nkind = \"tripod\"\nperiod = {period}\n[control]\nkind = \"gait\"\n"
+        )
+    };
+    semantic(&walk("1e-9"), "gait.period", "1e-9");
+    let e = Case::new(&walk("0.0039")).rejected(&[
+        "gait.period",
+        "spans fewer than 2 steps of time.dt = 0.001 s",
+        "a period ≥ 0.004 s",
+    ]);
+    assert!(e.contains("(got 0.0039, "), "{e}");
+    assert!(parse_str(&walk("0.004"), "w.toml", &[]).is_ok());
+    // An imported robot's gait keeps the same rule.
+    let robots = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/robots");
+    let text = std::fs::read_to_string(robots.join("lab_hexapod_walk.toml"))
+        .unwrap()
+        .replace(
+            "urdf = \"lab_hexapod.urdf\"",
+            &format!("urdf = {:?}", s(&robots.join("lab_hexapod.urdf"))),
+        )
+        .replace(
+            "pattern = \"tripod\"",
+            "pattern = \"tripod\"\nperiod = 1e-9",
+        );
+    Case::new(&text).rejected(&[
+        "gait.period",
+        "spans fewer than 2 steps",
+        "at least 0.005 s",
+    ]);
+}
+
 #[test]
 fn a_typo_in_a_key_suggests_the_key() {
     let e = Case::new("[terrain]\nmu_statc = 0.5\n").rejected(&["cfg.toml:2:1"]);
@@ -513,6 +607,9 @@ fn load_checked(text: &str) -> Result<(), TestCaseError> {
             let msg = e.to_string();
             prop_assert!(!msg.contains('\n'), "multi-line error: {msg:?}");
             prop_assert!(msg.starts_with("fuzz.toml"), "{msg}");
+            // 1e308 quoted as itself, not as its 309 digits (the longest
+            // replacement is a 20-digit integer).
+            prop_assert!(longest_digit_run(&msg) <= 20, "{msg}");
         }
         Ok(c) => {
             let written = c.to_toml();
@@ -601,13 +698,12 @@ fn mutate(lines: &mut Vec<String>, (kind, a, b): (u8, usize, usize)) {
     }
 }
 
-#[test]
-fn loader_never_panics_on_mutations_of_the_paper_example() {
-    let paper = paper_toml();
-    load_checked(&paper).unwrap();
-    let base: Vec<String> = paper.lines().map(str::to_owned).collect();
+/// `cases` random mutations (1 to 7 each) of `text` through the loader.
+fn mutations_load(text: &str, cases: u32) {
+    load_checked(text).unwrap();
+    let base: Vec<String> = text.lines().map(str::to_owned).collect();
     let ops = prop::collection::vec((any::<u8>(), any::<usize>(), any::<usize>()), 1..8);
-    runner(500)
+    runner(cases)
         .run(&ops, |ops| {
             let mut lines = base.clone();
             for op in ops {
@@ -616,6 +712,18 @@ fn loader_never_panics_on_mutations_of_the_paper_example() {
             load_checked(&lines.join("\n"))
         })
         .unwrap();
+}
+
+#[test]
+fn loader_never_panics_on_mutations_of_the_paper_example() {
+    mutations_load(&paper_toml(), 500);
+}
+
+#[test]
+fn loader_never_panics_on_mutations_of_the_hexapod_walk() {
+    // The 3D keys: `[gait]`, `[control]`, the six legs' initial angles.
+    let walk = std::fs::read_to_string(common::examples().join("hexapod_walk.toml")).unwrap();
+    mutations_load(&walk, 300);
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! Rigid terrain `y = ϱ(x)` with its slope, tangent and normal.
 
+use fbd_kinematics::num::Num;
 use serde::{Deserialize, Serialize};
 
 /// A rigid planar terrain. `y = ϱ(x)` in the inertial frame (Y up).
@@ -138,7 +139,11 @@ impl Terrain {
                         return bad(
                             "points",
                             "x must be strictly increasing",
-                            format!("x = {} after {} (point {i})", p[0], points[i - 1][0]),
+                            format!(
+                                "x = {} after {} (point {i})",
+                                Num(p[0]),
+                                Num(points[i - 1][0])
+                            ),
                             "strictly increasing x",
                         );
                     }
@@ -156,7 +161,7 @@ impl Terrain {
                     return bad(
                         "wavelength",
                         "must be positive and finite",
-                        wavelength.to_string(),
+                        Num(*wavelength).to_string(),
                         "a finite value > 0",
                     );
                 }
@@ -173,7 +178,7 @@ impl Terrain {
                     return bad(
                         "step_width",
                         "must be positive and finite",
-                        step_width.to_string(),
+                        Num(*step_width).to_string(),
                         "a finite value > 0",
                     );
                 }

@@ -2,6 +2,8 @@
 
 use thiserror::Error;
 
+use crate::num::Fixed;
+
 /// Why an inverse-kinematics problem has no (unique) solution.
 #[derive(Clone, Debug, PartialEq, Error)]
 pub enum KinematicsError {
@@ -36,8 +38,9 @@ pub enum KinematicsError {
     NonFinite,
     /// A joint angle lies outside its [`crate::limits::JointLimits`] range.
     #[error(
-        "{joint} = {:.3}° is outside its limits [{:.3}°, {:.3}°] by {:.3}°",
-        value.to_degrees(), min.to_degrees(), max.to_degrees(), outside_by.to_degrees()
+        "{joint} = {}° is outside its limits [{}°, {}°] by {}°",
+        Fixed(value.to_degrees(), 3), Fixed(min.to_degrees(), 3),
+        Fixed(max.to_degrees(), 3), Fixed(outside_by.to_degrees(), 3)
     )]
     JointLimit {
         /// `"theta1"`, `"theta2"` or `"theta3"`.

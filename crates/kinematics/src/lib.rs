@@ -27,6 +27,8 @@
 //!   segment angles are linear in `q`; positions, Jacobians and
 //!   velocity-product terms of every auxiliary point.
 //! * [`limits`]: [`JointLimits`], the `[min, max]` range of θ1, θ2, θ3.
+//! * [`num`]: [`num::Num`] and [`num::Fixed`], numbers quoted in messages,
+//!   short at any magnitude.
 //! * [`fd`]: the shared central finite-difference checker used by every
 //!   Jacobian test in the workspace.
 
@@ -39,6 +41,7 @@ pub mod ik;
 pub mod leg;
 pub mod leg_jacobian;
 pub mod limits;
+pub mod num;
 pub mod planar;
 pub mod pose;
 pub mod stance;

@@ -80,6 +80,8 @@
 
 use nalgebra::{Isometry3, Matrix3, Point3, Unit, UnitQuaternion, Vector3};
 
+use fbd_kinematics::num::Num;
+
 use crate::forward::{RobotData, base_frame, forward};
 use crate::model::{JointLimits, RobotModel};
 
@@ -139,7 +141,7 @@ pub enum GaitError {
         feet: usize,
     },
     /// A phase offset outside `[0, 1)`.
-    #[error("phase offset {value} of leg {leg} is not in [0, 1)")]
+    #[error("phase offset {} of leg {leg} is not in [0, 1)", Num(*value))]
     Phase {
         /// The leg (index into the feet).
         leg: usize,
@@ -147,10 +149,10 @@ pub enum GaitError {
         value: f64,
     },
     /// A duty factor outside `(0, 1)`.
-    #[error("duty factor {0} is not in (0, 1)")]
+    #[error("duty factor {} is not in (0, 1)", Num(*.0))]
     Duty(f64),
     /// Another parameter out of its range.
-    #[error("gait parameter {name} = {value} must be {rule}")]
+    #[error("gait parameter {name} = {} must be {rule}", Num(*value))]
     Parameter {
         /// The field of [`GaitParams`].
         name: &'static str,
@@ -158,6 +160,19 @@ pub enum GaitError {
         value: f64,
         /// What it must be.
         rule: &'static str,
+    },
+    /// A swing shorter than [`MIN_SWING_STEPS`] steps ([`check_swing`]).
+    #[error(
+        "the swing (1 − duty factor)·period = {} s spans fewer than {MIN_SWING_STEPS} steps of Δt = {} s: the period must be at least {} s at this duty factor (or Δt smaller)",
+        Num(*swing), Num(*dt), Num(*min_period)
+    )]
+    ShortSwing {
+        /// `(1 − duty)·period` (s).
+        swing: f64,
+        /// The time step (s).
+        dt: f64,
+        /// The shortest period that passes (s).
+        min_period: f64,
     },
     /// A joint vector of the wrong length.
     #[error("{what} has {got} values, the model has {expected} joints")]
@@ -169,6 +184,29 @@ pub enum GaitError {
         /// The model's joint count.
         expected: usize,
     },
+}
+
+/// The fewest steps of Δt that a swing, `(1 − duty)·period`, may span:
+/// in fewer a foot would lift off and land with no step in the air, and a
+/// period of nanoseconds asked a plan for a foothold every period —
+/// hundreds of millions of them in a run of a second. The rule of every
+/// gait (the hexapod's and an imported robot's).
+pub const MIN_SWING_STEPS: f64 = 2.0;
+
+/// Checks that the swing `(1 − duty)·period` spans at least
+/// [`MIN_SWING_STEPS`] steps of `dt` ([`GaitError::ShortSwing`] names the
+/// shortest period that does). Values out of their own domains pass: each
+/// has its own check.
+pub fn check_swing(period: f64, duty: f64, dt: f64) -> Result<(), GaitError> {
+    let swing = (1.0 - duty) * period;
+    if swing < MIN_SWING_STEPS * dt {
+        return Err(GaitError::ShortSwing {
+            swing,
+            dt,
+            min_period: MIN_SWING_STEPS * dt / (1.0 - duty),
+        });
+    }
+    Ok(())
 }
 
 /// The gait's parameters: plain fields (a configuration table maps onto

@@ -8,7 +8,7 @@ use fbd_contact::Terrain;
 use fbd_sim::{Control, LegTrajectory};
 use serde::{Deserialize, Serialize};
 
-use super::{ConfigError, TerrainConfig, TerrainKind};
+use super::{ConfigError, Quote, TerrainConfig, TerrainKind};
 
 /// Controller kinds of `[control] kind`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -90,17 +90,8 @@ impl ControlLegConfig {
     }
 }
 
-fn semantic(
-    file: &str,
-    key: &str,
-    what: &str,
-    got: impl std::fmt::Display,
-    expected: &str,
-) -> ConfigError {
-    ConfigError::Semantic {
-        file: file.to_owned(),
-        message: format!("{key}: {what} (got {got}, expected {expected})"),
-    }
+fn semantic(file: &str, key: &str, what: &str, got: impl Quote, expected: &str) -> ConfigError {
+    ConfigError::semantic(file, key, what, got, expected)
 }
 
 fn pair(file: &str, key: &str, v: &[f64]) -> Result<[f64; 2], ConfigError> {

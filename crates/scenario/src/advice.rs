@@ -1,5 +1,6 @@
 //! Advice on a failed run: is the time step too large for the robot?
 
+use fbd_kinematics::num::{Fixed, Num};
 use fbd_sim::SimError;
 
 use crate::{ConfigFile, PlanarConfig};
@@ -46,8 +47,11 @@ impl<I> ConfigFile<I> {
         let suggested = self.suggested_dt()?;
         (dt > tau / WARN_STEPS_PER_TIME_SCALE).then(|| {
             format!(
-                "warning: time.dt = {dt} s is far too large for this robot: its lower links swing under gravity on a time scale √(c/g) = {tau:.3} s, which a step should resolve at least {STEPS_PER_TIME_SCALE} times (the run solves {} steps); try time.dt = {suggested}",
-                (self.time.duration / dt).round() as u64 + 1
+                "warning: time.dt = {} s is far too large for this robot: its lower links swing under gravity on a time scale √(c/g) = {} s, which a step should resolve at least {STEPS_PER_TIME_SCALE} times (the run solves {} steps); try time.dt = {}",
+                Num(dt),
+                Fixed(tau, 3),
+                (self.time.duration / dt).round() as u64 + 1,
+                Num(suggested)
             )
         })
     }
@@ -64,7 +68,10 @@ impl PlanarConfig {
         let suggested = self.suggested_dt()?;
         (dt > tau / STEPS_PER_TIME_SCALE).then(|| {
             format!(
-                "time.dt = {dt} s is likely too large: the lower links swing under gravity on a time scale √(c/g) = {tau:.3} s, which a step should resolve at least {STEPS_PER_TIME_SCALE} times; try time.dt = {suggested}"
+                "time.dt = {} s is likely too large: the lower links swing under gravity on a time scale √(c/g) = {} s, which a step should resolve at least {STEPS_PER_TIME_SCALE} times; try time.dt = {}",
+                Num(dt),
+                Fixed(tau, 3),
+                Num(suggested)
             )
         })
     }

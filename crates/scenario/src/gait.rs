@@ -7,12 +7,13 @@ use fbd_kinematics::hexapod::{HexapodData, HexapodModel, forward};
 use fbd_kinematics::ik::KneeBranch;
 use fbd_kinematics::leg::LegGeometry;
 use fbd_kinematics::nalgebra::Vector3;
+use fbd_kinematics::num::Num;
 use fbd_kinematics::pose::BodyPose;
 use fbd_kinematics::stance::stance_ik;
 use fbd_sim::gait::{Command, GaitKind, GaitModel, GaitParams, InitialPose, Masses};
 use serde::{Deserialize, Serialize};
 
-use crate::{Config, ConfigError, HexapodConfig, HexapodInitial, HexapodLegInitial};
+use crate::{Config, ConfigError, HexapodConfig, HexapodInitial, HexapodLegInitial, Quote};
 
 /// The joint angles `(θ1, θ2, θ3)` (deg) of the default stance, every leg
 /// alike: the upper link horizontal and the lower link 25° outward from
@@ -263,7 +264,7 @@ impl GaitConfig {
 
     /// Checks every key; errors name `gait.key`.
     pub fn validate(&self, file: &str) -> Result<(), ConfigError> {
-        let err = |key: &str, what: &str, got: &dyn std::fmt::Display, expected: &str| {
+        let err = |key: &str, what: &str, got: &dyn Quote, expected: &str| {
             Err(ConfigError::semantic(file, key, what, got, expected))
         };
         if let Some(l) = self.step_length {
@@ -385,6 +386,36 @@ impl GaitConfig {
         self.lateral_speed.check(file, "gait.lateral_speed")?;
         self.yaw_rate_deg.check(file, "gait.yaw_rate_deg")?;
         Ok(())
+    }
+
+    /// The swing `(1 − duty_factor)·period` against `time.dt`
+    /// ([`fbd_robot::gait::check_swing`]); call after
+    /// [`GaitConfig::validate`]. The error names `gait.period`.
+    pub fn validate_swing(&self, file: &str, dt: f64) -> Result<(), ConfigError> {
+        let Some(duty) = self
+            .duty_factor
+            .or_else(|| self.kind.kind().preset().map(|(d, _)| d))
+        else {
+            return Ok(());
+        };
+        let period = self.period_used();
+        match fbd_robot::gait::check_swing(period, duty, dt) {
+            Err(fbd_robot::gait::GaitError::ShortSwing {
+                swing, min_period, ..
+            }) => Err(ConfigError::semantic(
+                file,
+                "gait.period",
+                &format!(
+                    "the swing (1 − duty_factor)·period = {} s spans fewer than {} steps of time.dt = {} s",
+                    Num(swing),
+                    fbd_robot::gait::MIN_SWING_STEPS,
+                    Num(dt)
+                ),
+                period,
+                &format!("a period ≥ {} s, or a smaller time.dt", Num(min_period)),
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// The library's parameters (SI units, radians); call after

@@ -53,11 +53,11 @@
 //! parsed [`toml::Table`] one at a time and the result deserialized again
 //! (errors name the override).
 
-use std::fmt;
 use std::path::Path;
 
 use fbd_contact::{Friction, Terrain};
 use fbd_dynamics::ContactPoints;
+pub(crate) use fbd_kinematics::num::{Num, Quote};
 use fbd_sim::{Model, PlanarParams, SimError};
 use serde::{Deserialize, Serialize};
 
@@ -169,10 +169,18 @@ impl ConfigError {
         matches!(self, ConfigError::Io { .. })
     }
 
-    fn semantic(file: &str, key: &str, what: &str, got: impl fmt::Display, expected: &str) -> Self {
+    /// `file: key: what (got …, expected …)`, the value quoted through
+    /// [`Quote`] (numbers short at any magnitude).
+    pub(crate) fn semantic(
+        file: &str,
+        key: &str,
+        what: &str,
+        got: impl Quote,
+        expected: &str,
+    ) -> Self {
         ConfigError::Semantic {
             file: file.to_owned(),
-            message: format!("{key}: {what} (got {got}, expected {expected})"),
+            message: format!("{key}: {what} (got {}, expected {expected})", got.quote()),
         }
     }
 }
@@ -972,7 +980,7 @@ impl<I> ConfigFile<I> {
 
     /// Checks the keys every model shares; errors name `table.key`.
     pub fn validate_common(&self, file: &str) -> Result<(), ConfigError> {
-        let err = |key: &str, what: &str, got: &dyn fmt::Display, expected: &str| {
+        let err = |key: &str, what: &str, got: &dyn Quote, expected: &str| {
             Err(ConfigError::semantic(file, key, what, got, expected))
         };
         for (key, [lo, hi]) in self.leg.limits_deg() {
@@ -980,7 +988,7 @@ impl<I> ConfigFile<I> {
                 return err(
                     key,
                     "must be a finite range [min, max] with min < max",
-                    &format!("[{lo}, {hi}]"),
+                    &format!("[{}, {}]", Num(lo), Num(hi)),
                     "finite degrees, min < max",
                 );
             }
@@ -1179,6 +1187,7 @@ impl HexapodConfig {
         }
         if let Some(g) = &self.gait {
             g.validate(file)?;
+            g.validate_swing(file, self.time.dt)?;
         }
         Ok(())
     }
@@ -1362,7 +1371,7 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 /// (when toml knows it and the message does not already say it).
 fn describe(err: &toml::de::Error) -> String {
     // serde names Rust types (`expected f64`): say what the file needs.
-    let message = describe_key(err)
+    let message = short_float(&describe_key(err))
         .replace("expected f64", "expected a number")
         .replace("expected usize", "expected a whole number")
         .replace("expected u64", "expected a whole number")
@@ -1371,6 +1380,28 @@ fn describe(err: &toml::de::Error) -> String {
         // `table: unknown field `x`, did you mean `y`? expected one of …`
         Some(hint) => message.replacen(", expected", &format!(", {hint}expected"), 1),
         None => message,
+    }
+}
+
+/// serde quotes a number of the wrong type with every digit (`invalid
+/// type: floating point `1000…000.0``, 310 characters for `1e308`):
+/// short, as every message quotes numbers ([`fbd_kinematics::num::Num`]).
+fn short_float(message: &str) -> String {
+    const TAG: &str = "floating point `";
+    let Some(start) = message.find(TAG).map(|i| i + TAG.len()) else {
+        return message.to_owned();
+    };
+    let Some(len) = message[start..].find('`') else {
+        return message.to_owned();
+    };
+    match message[start..start + len].parse::<f64>() {
+        Ok(x) if len > 20 => format!(
+            "{}{}{}",
+            &message[..start],
+            fbd_kinematics::num::Num(x),
+            &message[start + len..]
+        ),
+        _ => message.to_owned(),
     }
 }
 

@@ -31,7 +31,7 @@ use fbd_robot::nalgebra::Isometry3;
 use fbd_robot::{ContactChoice, RobotModel, Up};
 use serde::{Deserialize, Serialize};
 
-use crate::ConfigError;
+use crate::{ConfigError, Num};
 
 /// The `model` value of an imported robot.
 pub const MODEL: &str = "robot";
@@ -449,8 +449,12 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
                     &file,
                     &format!("{table}.{name}"),
                     "outside the joint's limits",
-                    format!("{deg}°"),
-                    &format!("[{}°, {}°]", l.lower.to_degrees(), l.upper.to_degrees()),
+                    format!("{}°", Num(deg)),
+                    &format!(
+                        "[{}°, {}°]",
+                        Num(l.lower.to_degrees()),
+                        Num(l.upper.to_degrees())
+                    ),
                 ));
             }
             out[j] = rad;
@@ -574,7 +578,7 @@ pub fn load_str(text: &str, path: &Path) -> Result<LoadedRobot, ConfigError> {
         }
         let time = config.time.clone();
         let gait = config.gait.get_or_insert_with(Default::default);
-        let mut plan = resolve_gait(gait, &model, &base, init.phi_deg, &q, &file)?;
+        let mut plan = resolve_gait(gait, &model, &base, init.phi_deg, &q, time.dt, &file)?;
         check_reach(&mut plan, &time, &file)?;
         Some(plan)
     } else if config.gait.is_some() {
@@ -693,6 +697,7 @@ fn resolve_gait(
     base: &Isometry3<f64>,
     phi_deg: [f64; 3],
     q: &[f64],
+    dt: f64,
     file: &str,
 ) -> Result<fbd_robot::gait::GaitPlan, ConfigError> {
     use fbd_robot::gait::{GaitParams, GaitPlan};
@@ -773,6 +778,8 @@ fn resolve_gait(
     if let Some(v) = gait.ramp {
         p.ramp = finite("ramp", v)?;
     }
+    fbd_robot::gait::check_swing(p.period, p.duty, dt)
+        .map_err(|e| semantic(file, format!("gait.period: {e}")))?;
     let position = base.translation.vector;
     let plan = GaitPlan::new(
         model,

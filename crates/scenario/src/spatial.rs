@@ -32,7 +32,8 @@ use fbd_sim::spatial::{
 use serde::{Deserialize, Serialize};
 
 use crate::{
-    Config, ConfigError, ControlKind, ControlLegConfig, HexapodConfig, PlanarConfig, TargetDeg,
+    Config, ConfigError, ControlKind, ControlLegConfig, HexapodConfig, PlanarConfig, Quote,
+    TargetDeg,
 };
 
 /// `dynamics = "fbd" | "kinematic"`: how a hexapod configuration runs.
@@ -334,7 +335,7 @@ impl HexapodConfig {
     /// `[control]`, `[gait]`, `[body] inertia`, `[leg]` radii); called by
     /// [`HexapodConfig::validate`].
     pub(crate) fn validate_dispatch(&self, file: &str) -> Result<(), ConfigError> {
-        let err = |key: &str, what: &str, got: &dyn std::fmt::Display, expected: &str| {
+        let err = |key: &str, what: &str, got: &dyn Quote, expected: &str| {
             Err(ConfigError::semantic(file, key, what, got, expected))
         };
         if let Some(i) = &self.body.inertia {
@@ -672,7 +673,7 @@ fn kind_name(k: ControlKind) -> &'static str {
 /// Rejects the hexapod-only keys in a planar configuration; errors name
 /// the key.
 pub(crate) fn reject_hexapod_keys(c: &PlanarConfig, file: &str) -> Result<(), ConfigError> {
-    let err = |key: &str, got: &dyn std::fmt::Display, expected: &str| {
+    let err = |key: &str, got: &dyn Quote, expected: &str| {
         Err(ConfigError::semantic(
             file,
             key,

@@ -21,7 +21,7 @@ use fbd_contact::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{ConfigError, TerrainConfig, TerrainKind};
+use super::{ConfigError, Quote, TerrainConfig, TerrainKind};
 
 /// Default extent `[x, z]` (m) of a generated terrain.
 pub const DEFAULT_SIZE: [f64; 2] = [3.0, 3.0];
@@ -44,17 +44,8 @@ pub struct PatchConfig {
     pub mu_dynamic: f64,
 }
 
-fn semantic(
-    file: &str,
-    key: &str,
-    what: &str,
-    got: impl std::fmt::Display,
-    expected: &str,
-) -> ConfigError {
-    ConfigError::Semantic {
-        file: file.to_owned(),
-        message: format!("{key}: {what} (got {got}, expected {expected})"),
-    }
+fn semantic(file: &str, key: &str, what: &str, got: impl Quote, expected: &str) -> ConfigError {
+    ConfigError::semantic(file, key, what, got, expected)
 }
 
 /// A `[min, max]` pair with `min ≤ max` (`strict`: `min < max`).

@@ -1,5 +1,6 @@
 //! Errors of a simulation.
 
+use fbd_kinematics::num::Fixed;
 use fbd_solver::SolverError;
 
 /// Why a model could not be built or a run stopped.
@@ -20,7 +21,8 @@ pub enum SimError {
     },
     /// A contact point starts below the terrain.
     #[error(
-        "initial.{leg}: {point} starts {depth:.6} m below the terrain (got depth {depth:.6} m, expected ≤ 1e-9 m)"
+        "initial.{leg}: {point} starts {} m below the terrain (got depth {} m, expected ≤ 1e-9 m)",
+        Fixed(*depth, 6), Fixed(*depth, 6)
     )]
     InitialPenetration {
         /// The leg table, e.g. `leg3`.
@@ -31,7 +33,7 @@ pub enum SimError {
         depth: f64,
     },
     /// Newton's method failed.
-    #[error("step {step} (t = {t:.6} s): {source}")]
+    #[error("step {step} (t = {} s): {source}", Fixed(*t, 6))]
     Newton {
         /// Step index k.
         step: usize,
@@ -41,9 +43,7 @@ pub enum SimError {
         source: SolverError,
     },
     /// The contact-state search revisited a state combination.
-    #[error(
-        "step {step} (t = {t:.6} s): the contact-state search cycles at [{states}] (residual {residual:.3e})"
-    )]
+    #[error("step {step} (t = {} s): the contact-state search cycles at [{states}] (residual {residual:.3e})", Fixed(*t, 6))]
     Cycling {
         /// Step index k.
         step: usize,
@@ -56,7 +56,7 @@ pub enum SimError {
     },
     /// The controller could not compute its torques (e.g. the gait
     /// generator cannot place a foot).
-    #[error("step {step} (t = {t:.6} s): control: {message}")]
+    #[error("step {step} (t = {} s): control: {message}", Fixed(*t, 6))]
     Control {
         /// Step index k.
         step: usize,
@@ -68,9 +68,7 @@ pub enum SimError {
     /// No state combination of the step, down to its finest substeps,
     /// obeys every contact and joint-limit law: the step is not written
     /// rather than written inexactly.
-    #[error(
-        "step {step} (t = {t:.6} s): no exact solution down to Δt/{substeps}: {point} breaks {law} by {amount:.3e} N (states [{states}])"
-    )]
+    #[error("step {step} (t = {} s): no exact solution down to Δt/{substeps}: {point} breaks {law} by {amount:.3e} N (states [{states}])", Fixed(*t, 6))]
     Inexact {
         /// Step index k.
         step: usize,
@@ -88,7 +86,7 @@ pub enum SimError {
         states: String,
     },
     /// The state became NaN or infinite.
-    #[error("step {step} (t = {t:.6} s): the state is not finite (residual {residual:.3e})")]
+    #[error("step {step} (t = {} s): the state is not finite (residual {residual:.3e})", Fixed(*t, 6))]
     NonFinite {
         /// Step index k.
         step: usize,

@@ -254,7 +254,7 @@ impl Model {
                     false,
                     &format!("initial.leg{leg}.theta_deg"),
                     "outside the joint limits",
-                    e,
+                    e.to_string(),
                     &format!("angles inside [leg] {}_deg", joint.name()),
                 )?;
             }

@@ -6,6 +6,7 @@
 use crate::SimError;
 use fbd_dynamics::{JacobianSink, LimitState};
 use fbd_kinematics::LimitSide;
+use fbd_kinematics::num::{Fixed, Num, Quote};
 
 /// Most solves of one (sub)step's state search: a search that has not
 /// settled by then is treated as a cycle (the step is retried in
@@ -81,7 +82,7 @@ pub(crate) fn check(
     ok: bool,
     key: &str,
     what: &str,
-    got: impl std::fmt::Display,
+    got: impl Quote,
     expected: &str,
 ) -> Result<(), SimError> {
     if ok {
@@ -90,7 +91,7 @@ pub(crate) fn check(
         Err(SimError::InvalidParameter {
             key: key.into(),
             what: what.into(),
-            got: got.to_string(),
+            got: got.quote(),
             expected: expected.into(),
         })
     }
@@ -153,7 +154,7 @@ pub(crate) fn friction(f: &fbd_contact::Friction) -> Result<(), SimError> {
     f.validate().map_err(|e| SimError::InvalidParameter {
         key: "terrain.mu_dynamic".into(),
         what: e.to_string(),
-        got: format!("μS = {}, μD = {}", f.mu_static, f.mu_dynamic),
+        got: format!("μS = {}, μD = {}", Num(f.mu_static), Num(f.mu_dynamic)),
         expected: "0 ≤ μD ≤ μS".into(),
     })
 }
@@ -220,17 +221,19 @@ pub(crate) fn pd_stability(
     let kd_max = pd_kd_limit(kp, inertia, dt);
     let dt_max = pd_dt_limit(kp, kd, inertia);
     let why = format!(
-        "makes the explicit joint torques unstable at time.dt = {dt} s: the fastest joint mode \
-         ({joint}, effective inertia {inertia:.3e} kg·m²) needs kp·Δt²/I + 2·kd·Δt/I < 4"
+        "makes the explicit joint torques unstable at time.dt = {} s: the fastest joint mode \
+         ({joint}, effective inertia {inertia:.3e} kg·m²) needs kp·Δt²/I + 2·kd·Δt/I < 4",
+        Num(dt)
     );
     if kd_max > 0.0 {
         check(
             false,
             "control.kd",
             &why,
-            format!("{kd} N·m·s/rad"),
+            format!("{} N·m·s/rad", Num(kd)),
             &format!(
-                "control.kd < {kd_max:.4} N·m·s/rad: set control.kd below that, or time.dt below {dt_max:.3e} s"
+                "control.kd < {} N·m·s/rad: set control.kd below that, or time.dt below {dt_max:.3e} s",
+                Fixed(kd_max, 4)
             ),
         )
     } else {
@@ -238,10 +241,10 @@ pub(crate) fn pd_stability(
             false,
             "control.kp",
             &why,
-            format!("{kp} N·m/rad"),
+            format!("{} N·m/rad", Num(kp)),
             &format!(
-                "control.kp < {:.4} N·m/rad (even with control.kd = 0): set control.kp below that, or time.dt below {dt_max:.3e} s",
-                4.0 * inertia / (dt * dt)
+                "control.kp < {} N·m/rad (even with control.kd = 0): set control.kp below that, or time.dt below {dt_max:.3e} s",
+                Fixed(4.0 * inertia / (dt * dt), 4)
             ),
         )
     }

@@ -1,10 +1,14 @@
 //! Why a gait could not be built or a kinematic run stopped.
 
+use fbd_kinematics::num::Fixed;
 use thiserror::Error;
 
 /// `t` as a short decimal: up to 6 decimals, trailing zeros removed.
 pub fn fmt_time(t: f64) -> String {
-    let s = format!("{t:.6}");
+    let s = Fixed(t, 6).to_string();
+    if s.contains('e') {
+        return s;
+    }
     let s = s.trim_end_matches('0');
     if s.ends_with('.') {
         format!("{s}0")
@@ -23,8 +27,8 @@ pub enum GaitError {
     /// A foot target is farther from (or closer to) the hip than the leg
     /// reaches.
     #[error(
-        "leg {leg} at t = {} s: foot target out of reach by {by:.6} m (hip–foot distance {distance:.6} m, the leg reaches [{min:.6}, {max:.6}] m)",
-        fmt_time(*t)
+        "leg {leg} at t = {} s: foot target out of reach by {} m (hip–foot distance {} m, the leg reaches [{}, {}] m)",
+        fmt_time(*t), Fixed(*by, 6), Fixed(*distance, 6), Fixed(*min, 6), Fixed(*max, 6)
     )]
     Unreachable {
         /// Leg number 1–6.
@@ -53,8 +57,8 @@ pub enum GaitError {
     },
     /// A joint angle past its limit.
     #[error(
-        "leg {leg} at t = {} s: {joint} = {angle_deg:.3}° is past its limit by {by_deg:.3}° (range [{min_deg:.3}°, {max_deg:.3}°])",
-        fmt_time(*t)
+        "leg {leg} at t = {} s: {joint} = {}° is past its limit by {}° (range [{}°, {}°])",
+        fmt_time(*t), Fixed(*angle_deg, 3), Fixed(*by_deg, 3), Fixed(*min_deg, 3), Fixed(*max_deg, 3)
     )]
     JointLimit {
         /// Leg number 1–6.
@@ -75,8 +79,8 @@ pub enum GaitError {
     /// The stability margin fell below the threshold with
     /// `require_stable = true`.
     #[error(
-        "t = {} s: statically unstable: stability margin {margin:.6} m below the required {threshold:.6} m",
-        fmt_time(*t)
+        "t = {} s: statically unstable: stability margin {} m below the required {} m",
+        fmt_time(*t), Fixed(*margin, 6), Fixed(*threshold, 6)
     )]
     Unstable {
         /// Time (s).

@@ -5,6 +5,7 @@ use fbd_contact::Surface;
 use fbd_kinematics::hexapod::{HexapodConfig, HexapodData, HexapodModel, forward};
 use fbd_kinematics::ik::KneeBranch;
 use fbd_kinematics::nalgebra::Vector3;
+use fbd_kinematics::num::Num;
 use fbd_kinematics::pose::BodyPose;
 
 use super::body::{BodyPlan, BodyState};
@@ -95,8 +96,14 @@ impl GaitModel {
         params.check().map_err(GaitError::Invalid)?;
         if !(dt.is_finite() && dt > 0.0 && duration.is_finite() && duration >= 0.0) {
             return Err(GaitError::Invalid(format!(
-                "time: dt and duration must be positive (got dt = {dt}, duration = {duration})"
+                "time: dt and duration must be positive (got dt = {}, duration = {})",
+                Num(dt),
+                Num(duration)
             )));
+        }
+        if params.walking {
+            fbd_robot::gait::check_swing(params.period, params.duty, dt)
+                .map_err(|e| GaitError::Invalid(format!("period: {e}")))?;
         }
         if params.walking && !surface.exists() {
             return Err(GaitError::Invalid(

@@ -2,6 +2,7 @@
 //! presets ([`GaitKind`]) and commanded speed profiles ([`Command`]).
 
 use fbd_kinematics::JointLimits;
+use fbd_kinematics::num::Num;
 
 /// Number of legs.
 pub const LEGS: usize = 6;
@@ -220,18 +221,21 @@ impl GaitParams {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(format!("{name} must be positive and finite (got {v})"))
+                Err(format!(
+                    "{name} must be positive and finite (got {})",
+                    Num(v)
+                ))
             }
         };
         pos("period", self.period)?;
         if !(self.duty > 0.0 && self.duty < 1.0) {
             return Err(format!(
                 "duty_factor must lie in (0, 1) (got {})",
-                self.duty
+                Num(self.duty)
             ));
         }
         if let Some(p) = self.phases.iter().find(|p| !(0.0..1.0).contains(*p)) {
-            return Err(format!("phases must lie in [0, 1) (got {p})"));
+            return Err(format!("phases must lie in [0, 1) (got {})", Num(*p)));
         }
         for (name, v) in [
             ("swing_height", self.swing_height),
@@ -239,7 +243,7 @@ impl GaitParams {
             ("sway", self.sway),
         ] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(format!("{name} must be finite and ≥ 0 (got {v})"));
+                return Err(format!("{name} must be finite and ≥ 0 (got {})", Num(v)));
             }
         }
         for (name, v) in [

@@ -215,7 +215,7 @@ impl SpatialModel {
                     false,
                     &format!("initial.leg{}.theta_deg", legs[lim.slot]),
                     "outside the joint limits",
-                    e,
+                    e.to_string(),
                     &format!("angles inside [leg] {}_deg", lim.joint.name()),
                 )?;
             }

@@ -150,6 +150,32 @@ def test_observe_many_and_set_pd_targets_many_equal_one_by_one(name):
         _fbd.set_pd_targets_many(sims, targets, -1.0, 2.0)
 
 
+def test_bad_actions_are_named_and_infinite_ones_clipped():
+    env = gymnasium.make("fbd/PlanarStand-v0", episode_seconds=0.2).unwrapped
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"action of shape \(3,\), expected \(4,\)"):
+        env.step(np.zeros(3))
+    bad = np.zeros(4)
+    bad[2] = np.nan
+    with pytest.raises(ValueError, match=r"action is NaN at index \(2,\)"):
+        env.step(bad)
+    # ±inf is at the bounds of the Box: the same step as ±1.
+    x = env.reset(seed=0)[0]
+    a = env.step(np.array([np.inf, -np.inf, 1e300, 0.0]))[0]
+    env.reset(seed=0)
+    b = env.step(np.array([1.0, -1.0, 1.0, 0.0]))[0]
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, x)
+    venv = gymnasium.make_vec("fbd/PlanarStand-v0", num_envs=2, vectorization_mode="vector_entry_point")
+    venv.reset(seed=0)
+    with pytest.raises(ValueError, match=r"action of shape \(4,\), expected \(2, 4\)"):
+        venv.step(np.zeros(4))
+    rows = np.zeros((2, 4))
+    rows[1, 3] = np.nan
+    with pytest.raises(ValueError, match=r"action is NaN at index \(1, 3\)"):
+        venv.step(rows)
+
+
 def test_vector_env_pickles():
     venv = gymnasium.make_vec("fbd/PlanarStand-v0", num_envs=2, vectorization_mode="vector_entry_point")
     venv.reset(seed=0)

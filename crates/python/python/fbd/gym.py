@@ -129,6 +129,21 @@ __all__ = [
 ]
 
 
+def _checked_action(action: Any, shape: Tuple[int, ...], nan: bool = True) -> np.ndarray:
+    """``action`` as a float64 array of the action space's ``shape``,
+    clipped to [-1, 1] (±inf to the bounds); a wrong shape or (``nan``) a
+    NaN is a ``ValueError`` that says which."""
+    a = np.asarray(action, dtype=np.float64)
+    if a.shape != shape:
+        raise ValueError(f"action of shape {a.shape}, expected {shape} (the action space's)")
+    if not nan:
+        return a
+    where = np.argwhere(np.isnan(a))
+    if where.size:
+        raise ValueError(f"action is NaN at index {tuple(int(i) for i in where[0])} ({len(where)} NaN in all)")
+    return np.clip(a, -1.0, 1.0)
+
+
 class _FbdEnv(gymnasium.Env):
     """What the environments share: a simulator stepped ``frame_skip``
     physics steps per action with PD targets; subclasses define the task
@@ -203,7 +218,7 @@ class _FbdEnv(gymnasium.Env):
 
     def _apply(self, action: Any) -> np.ndarray:
         """Sets the PD targets of ``action``; the state before the step."""
-        a = np.clip(np.asarray(action, dtype=np.float64), -1.0, 1.0)
+        a = _checked_action(action, self.action_space.shape)
         kp, kd, limit = self._gains()
         self.sim.set_pd_targets(self._targets(a[None])[0], kp, kd, torque_limit=limit)
         return self.sim.q
@@ -682,7 +697,8 @@ class _FbdVectorEnv(VectorEnv):
         return infos
 
     def step(self, actions: Any):
-        actions = np.asarray(actions, dtype=np.float64)
+        # NaN checked in the rows that step (a resetting row's is unused).
+        actions = _checked_action(actions, self.action_space.shape, nan=False)
         n = self.num_envs
         if not self._autoreset.any():
             # Every sub-environment steps (the common case).
@@ -720,7 +736,7 @@ class _FbdVectorEnv(VectorEnv):
         envs = [self.envs[i] for i in stepping]
         sims = [e.sim for e in envs]
         kp, kd, limit = task._gains()
-        a = np.clip(actions, -1.0, 1.0)
+        a = _checked_action(actions, actions.shape)
         _fbd.set_pd_targets_many(sims, np.ascontiguousarray(task._targets(a)), kp, kd, torque_limit=limit)
         before = _fbd.observe_many(sims, ["q"])["q"]
         errors = _fbd.step_many(sims, None, task.frame_skip)

@@ -444,6 +444,9 @@ impl Simulator {
                 v.len()
             )));
         }
+        if what == "torques" {
+            finite_torques(&v)?;
+        }
         Ok(v)
     }
 
@@ -1354,6 +1357,19 @@ pub fn set_pd_targets_many<'py>(
     Ok(())
 }
 
+/// Torques given to a step must be numbers: a NaN or an infinity is a
+/// `ValueError` naming the joint's index (it would fail the step as "a
+/// non-finite value in the residual").
+fn finite_torques(v: &[f64]) -> PyResult<()> {
+    match v.iter().position(|x| !x.is_finite()) {
+        Some(j) => Err(PyValueError::new_err(format!(
+            "torques: must be finite (got {} at index {j})",
+            v[j]
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// `step_many(sims, torques=None, steps=1)`: steps every simulator of the
 /// list `steps` steps on Rust threads (rayon; the GIL released): with row
 /// i of `torques` (shape `(len(sims), joints)`) for simulator i when given,
@@ -1398,6 +1414,8 @@ pub fn step_many<'py>(
                         s.sim.joints()
                     )));
                 }
+                finite_torques(&row)
+                    .map_err(|e| PyValueError::new_err(format!("row {i}: {}", e.value(py))))?;
                 Some(row)
             }
             None => None,

@@ -174,6 +174,18 @@ def test_bad_torques():
         sim.step([1.0, 2.0])
     with pytest.raises(ValueError):
         sim.step("abc")
+    # A NaN or an infinity is named before the step (it used to fail the
+    # step as a non-finite residual, with advice about feedback gains).
+    with pytest.raises(ValueError, match=r"torques: must be finite \(got NaN at index 2\)"):
+        sim.step([0.0, 0.0, np.nan, 0.0])
+    with pytest.raises(ValueError, match=r"torques: must be finite \(got -inf at index 0\)"):
+        sim.step([-np.inf, 0.0, 0.0, 0.0])
+    twins = [fbd.Simulator(), fbd.Simulator()]
+    rows = np.zeros((2, 4))
+    rows[1, 3] = np.nan
+    with pytest.raises(ValueError, match=r"row 1: torques: must be finite \(got NaN at index 3\)"):
+        fbd.step_many(twins, rows)
+    assert [t.k for t in twins] == [0, 0]
     assert sim.k == 0
     sim.step(np.zeros(4))
     sim.step((0, 0, 0, 0))

@@ -155,6 +155,80 @@ fn unknown_key_or_wrong_type_fails_up_front_naming_run_and_key() {
 }
 
 #[test]
+fn a_sweep_too_large_to_plan_is_a_one_line_error() {
+    // A grid of five 200-value lists (3.2e11 runs) and samples = 1e9 asked
+    // for more memory than the machine has and aborted; samples = 0 ran
+    // nothing and exited 0.
+    let t = tempfile::tempdir().unwrap();
+    let list = |x0: f64| {
+        let v: Vec<String> = (0..200)
+            .map(|i| format!("{}", x0 + 0.001 * f64::from(i)))
+            .collect();
+        format!("[{}]", v.join(", "))
+    };
+    let grid = format!(
+        "mode = \"grid\"\n[vary]\n\"terrain.mu_static\" = {}\n\"time.duration\" = {}\n\"initial.position\" = [[0.0, 0.5]]\n\"world.gravity\" = {}\n\"body.mass\" = {}\n\"leg.upper_mass\" = {}\n",
+        list(0.3),
+        list(0.2),
+        list(9.0),
+        list(5.0),
+        list(0.5)
+    );
+    for (body, needles) in [
+        (
+            grid.as_str(),
+            vec![
+                "mode = \"grid\" of 200 × 200 × 1 × 200 × 200 × 200 values",
+                "(1000000)",
+            ],
+        ),
+        (
+            "mode = \"random\"\nsamples = 1000000000\n[vary]\n\"terrain.mu_static\" = { min = 0.3, max = 0.8 }\n",
+            vec!["samples = 1000000000: more runs than one sweep file may plan"],
+        ),
+        (
+            "mode = \"random\"\nsamples = 0\n[vary]\n\"terrain.mu_static\" = { min = 0.3, max = 0.8 }\n",
+            vec!["samples = 0: mode = \"random\" needs at least 1"],
+        ),
+    ] {
+        let f = sweep_file(t.path(), "big.toml", body);
+        let out = t.path().join("big");
+        let o = fbd(&["sweep", s(&f), "--out", s(&out)]);
+        assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(e.lines().count(), 1, "{e}");
+        for n in needles {
+            assert!(e.contains(n), "{n:?} not in {e}");
+        }
+        assert!(!out.exists(), "nothing may run");
+    }
+    // One run past the cap (a grid of 1000 × 1001, whose size is known
+    // before anything is planned) is refused.
+    let values = |n: usize| {
+        let v: Vec<String> = (0..n)
+            .map(|i| format!("{}", 0.2 + 1e-6 * i as f64))
+            .collect();
+        format!("[{}]", v.join(", "))
+    };
+    let f = sweep_file(
+        t.path(),
+        "cap.toml",
+        &format!(
+            "mode = \"grid\"\n[vary]\n\"terrain.mu_static\" = {}\n\"time.duration\" = {}\n",
+            values(1000),
+            values(1001)
+        ),
+    );
+    let o = fbd(&["sweep", s(&f), "--out", s(&t.path().join("cap"))]);
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("1000 × 1001 values"),
+        "{}",
+        text(&o)
+    );
+}
+
+#[test]
 fn random_is_reproducible_by_seed() {
     let t = tempfile::tempdir().unwrap();
     let body = |seed: u64| {

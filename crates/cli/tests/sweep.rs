@@ -229,6 +229,31 @@ fn a_sweep_too_large_to_plan_is_a_one_line_error() {
 }
 
 #[test]
+fn a_sweep_file_error_is_said_as_a_configuration_error() {
+    // The loader's wording (the key, a whole number, a close key), not
+    // serde's Rust types.
+    let t = tempfile::tempdir().unwrap();
+    for (body, needles) in [
+        (
+            "mode = \"random\"\nsamples = -3\n[vary]\n\"terrain.mu_static\" = { min = 0.3, max = 0.8 }\n",
+            vec![":3:11: samples: invalid value: integer `-3`, expected a whole number"],
+        ),
+        (
+            "mod = \"grid\"\n[vary]\n\"terrain.mu_static\" = [0.3]\n",
+            vec![":2:1: unknown field `mod`, did you mean `mode`?"],
+        ),
+    ] {
+        let f = sweep_file(t.path(), "e.toml", body);
+        let o = fbd(&["sweep", s(&f), "--out", s(&t.path().join("e"))]);
+        assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+        let e = String::from_utf8_lossy(&o.stderr);
+        for n in needles {
+            assert!(e.contains(n) && !e.contains("usize"), "{n:?} not in {e}");
+        }
+    }
+}
+
+#[test]
 fn random_is_reproducible_by_seed() {
     let t = tempfile::tempdir().unwrap();
     let body = |seed: u64| {

@@ -909,18 +909,8 @@ pub struct Plan {
 pub fn plan(path: &Path) -> Result<Plan, OutputError> {
     let name = path.display().to_string();
     let text = config::read_text(path)?;
-    let mut file: SweepFile = toml::from_str(&text).map_err(|e| {
-        let at = e.span().map_or(String::new(), |sp| {
-            let before = &text[..sp.start.min(text.len())];
-            let line = before.matches('\n').count() + 1;
-            let col = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-            format!(":{line}:{col}")
-        });
-        OutputError::Usage(format!(
-            "{name}{at}: {}",
-            e.message().trim().replace('\n', "; ")
-        ))
-    })?;
+    let mut file: SweepFile = toml::from_str(&text)
+        .map_err(|e| OutputError::Usage(config::syntax_error(&name, &text, &e).to_string()))?;
     let values = expand(&file, &name).map_err(OutputError::Usage)?;
     for (k, _) in &file.set.0 {
         for (table, list) in [("vary", &file.vary), ("derive", &file.derive)] {

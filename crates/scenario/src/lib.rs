@@ -1436,7 +1436,11 @@ fn suggestion(message: &str) -> Option<String> {
         .map(|(_, k)| format!("did you mean `{k}`? "))
 }
 
-fn syntax_error(file: &str, text: &str, err: &toml::de::Error) -> ConfigError {
+/// A TOML error of `file` (its `text`) as the loader reports it:
+/// `file:line:col: key: message`, serde's Rust types said in the file's
+/// terms (`expected a whole number`), a close key suggested, numbers
+/// short. The sweep files' errors too.
+pub fn syntax_error(file: &str, text: &str, err: &toml::de::Error) -> ConfigError {
     let (line, col) = err.span().map_or((1, 1), |s| line_col(text, s.start));
     let mut message = describe(err);
     // toml names no key for some errors (e.g. "duplicate key"): quote the

@@ -56,8 +56,7 @@ impl fmt::Display for Fixed {
 }
 
 /// A value quoted in an error message: numbers short at any magnitude
-/// ([`Num`]: `1e300`, not its 301 digits), text as
-/// it is.
+/// ([`Num`]: `1e300`, not its 301 digits), text as it is.
 pub trait Quote {
     /// The value as the message shows it.
     fn quote(&self) -> String;

@@ -8,7 +8,7 @@ use fbd_contact::Terrain;
 use fbd_sim::{Control, LegTrajectory};
 use serde::{Deserialize, Serialize};
 
-use super::{ConfigError, Quote, TerrainConfig, TerrainKind};
+use super::{ConfigError, TerrainConfig, TerrainKind};
 
 /// Controller kinds of `[control] kind`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -90,21 +90,17 @@ impl ControlLegConfig {
     }
 }
 
-fn semantic(file: &str, key: &str, what: &str, got: impl Quote, expected: &str) -> ConfigError {
-    ConfigError::semantic(file, key, what, got, expected)
-}
-
 fn pair(file: &str, key: &str, v: &[f64]) -> Result<[f64; 2], ConfigError> {
     match v {
         [a, b] if a.is_finite() && b.is_finite() => Ok([*a, *b]),
-        [_, _] => Err(semantic(
+        [_, _] => Err(ConfigError::semantic(
             file,
             key,
             "must be finite",
             format!("{v:?}"),
             "finite values",
         )),
-        _ => Err(semantic(
+        _ => Err(ConfigError::semantic(
             file,
             key,
             "must be a pair [θ2, θ3]",
@@ -139,11 +135,11 @@ impl ControlConfig {
     pub fn control(&self, file: &str) -> Result<Control, ConfigError> {
         let (kp, kd, torque_limit) = (self.kp, self.kd, self.torque_limit);
         let invalid = |(key, what, got): (String, &'static str, String)| {
-            semantic(file, &key, what, got, "see [control] in docs/reference.md")
+            ConfigError::semantic(file, &key, what, got, "see [control] in docs/reference.md")
         };
         let control = match self.kind {
             ControlKind::Gait => {
-                return Err(semantic(
+                return Err(ConfigError::semantic(
                     file,
                     "control.kind",
                     "\"gait\" is for model = \"hexapod\"",
@@ -169,7 +165,7 @@ impl ControlConfig {
                 for (i, (name, l)) in self.legs().into_iter().enumerate() {
                     let key = format!("control.{name}.target_deg");
                     if l.times.is_some() {
-                        return Err(semantic(
+                        return Err(ConfigError::semantic(
                             file,
                             &format!("control.{name}.times"),
                             "is only used by kind = \"trajectory\"",
@@ -180,7 +176,7 @@ impl ControlConfig {
                     target[i] = match &l.target_deg {
                         Some(TargetDeg::Point(v)) => pair(file, &key, v)?.map(f64::to_radians),
                         Some(TargetDeg::Points(v)) => {
-                            return Err(semantic(
+                            return Err(ConfigError::semantic(
                                 file,
                                 &key,
                                 "must be one pair [θ2, θ3] for kind = \"pd\"",
@@ -189,7 +185,7 @@ impl ControlConfig {
                             ));
                         }
                         None => {
-                            return Err(semantic(
+                            return Err(ConfigError::semantic(
                                 file,
                                 &key,
                                 "is required for kind = \"pd\"",
@@ -211,7 +207,7 @@ impl ControlConfig {
                 for (i, (name, l)) in self.legs().into_iter().enumerate() {
                     let key = format!("control.{name}.target_deg");
                     let Some(times) = &l.times else {
-                        return Err(semantic(
+                        return Err(ConfigError::semantic(
                             file,
                             &format!("control.{name}.times"),
                             "is required for kind = \"trajectory\"",
@@ -227,7 +223,7 @@ impl ControlConfig {
                         // An empty list parses as a single (empty) point.
                         Some(TargetDeg::Point(v)) if v.is_empty() => Vec::new(),
                         Some(TargetDeg::Point(v)) => {
-                            return Err(semantic(
+                            return Err(ConfigError::semantic(
                                 file,
                                 &key,
                                 "must be a list of pairs for kind = \"trajectory\"",
@@ -236,7 +232,7 @@ impl ControlConfig {
                             ));
                         }
                         None => {
-                            return Err(semantic(
+                            return Err(ConfigError::semantic(
                                 file,
                                 &key,
                                 "is required for kind = \"trajectory\"",
@@ -246,7 +242,7 @@ impl ControlConfig {
                         }
                     };
                     if targets.len() != times.len() {
-                        return Err(semantic(
+                        return Err(ConfigError::semantic(
                             file,
                             &key,
                             "must have one pair per time",
@@ -373,7 +369,7 @@ impl TerrainConfig {
             return Ok(());
         };
         if self.points.is_some() {
-            return Err(semantic(
+            return Err(ConfigError::semantic(
                 config_file,
                 "terrain.file",
                 "cannot be given together with terrain.points",
@@ -386,7 +382,7 @@ impl TerrainConfig {
             .unwrap_or(Path::new(""))
             .join(&name);
         let text = crate::read_text(&path).map_err(|e| {
-            semantic(
+            ConfigError::semantic(
                 config_file,
                 "terrain.file",
                 &format!("cannot read it: {e}"),
@@ -406,7 +402,7 @@ impl TerrainConfig {
                 Ok(v) if v.len() == 2 => points.push(v),
                 Err(_) if points.is_empty() && n == 0 => continue, // header
                 _ => {
-                    return Err(semantic(
+                    return Err(ConfigError::semantic(
                         config_file,
                         "terrain.file",
                         &format!("{}:{}: expected `x,y`", path.display(), n + 1),
@@ -450,7 +446,7 @@ impl TerrainConfig {
         let kind = kind_name(self.kind);
         for (key, is_given) in given {
             if is_given && !used.contains(&key) {
-                return Err(semantic(
+                return Err(ConfigError::semantic(
                     file,
                     &format!("terrain.{key}"),
                     &format!("is not used by kind = \"{kind}\""),
@@ -490,7 +486,7 @@ impl TerrainConfig {
         };
         for (key, ok) in required {
             if !ok {
-                return Err(semantic(
+                return Err(ConfigError::semantic(
                     file,
                     &format!("terrain.{key}"),
                     &format!("is required for kind = \"{kind}\""),
@@ -502,7 +498,7 @@ impl TerrainConfig {
         if let Some(a) = self.angle_deg
             && !(a.is_finite() && a.abs() < 90.0)
         {
-            return Err(semantic(
+            return Err(ConfigError::semantic(
                 file,
                 "terrain.angle_deg",
                 "must be finite and steeper than neither vertical",
@@ -513,7 +509,7 @@ impl TerrainConfig {
         if let Some(points) = &self.points {
             for p in points {
                 if p.len() != 2 {
-                    return Err(semantic(
+                    return Err(ConfigError::semantic(
                         file,
                         "terrain.points",
                         "must be [x, y] pairs",
@@ -524,7 +520,7 @@ impl TerrainConfig {
             }
         }
         if let Err(e) = self.terrain().validate() {
-            return Err(semantic(
+            return Err(ConfigError::semantic(
                 file,
                 &format!("terrain.{}", e.key),
                 e.what,

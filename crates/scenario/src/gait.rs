@@ -389,32 +389,14 @@ impl GaitConfig {
     }
 
     /// The swing `(1 − duty_factor)·period` against `time.dt`
-    /// ([`fbd_robot::gait::check_swing`]); call after
-    /// [`GaitConfig::validate`]. The error names `gait.period`.
+    /// ([`swing_fits`]); call after [`GaitConfig::validate`].
     pub fn validate_swing(&self, file: &str, dt: f64) -> Result<(), ConfigError> {
-        let Some(duty) = self
+        match self
             .duty_factor
             .or_else(|| self.kind.kind().preset().map(|(d, _)| d))
-        else {
-            return Ok(());
-        };
-        let period = self.period_used();
-        match fbd_robot::gait::check_swing(period, duty, dt) {
-            Err(fbd_robot::gait::GaitError::ShortSwing {
-                swing, min_period, ..
-            }) => Err(ConfigError::semantic(
-                file,
-                "gait.period",
-                &format!(
-                    "the swing (1 − duty_factor)·period = {} s spans fewer than {} steps of time.dt = {} s",
-                    Num(swing),
-                    fbd_robot::gait::MIN_SWING_STEPS,
-                    Num(dt)
-                ),
-                period,
-                &format!("a period ≥ {} s, or a smaller time.dt", Num(min_period)),
-            )),
-            _ => Ok(()),
+        {
+            Some(duty) => swing_fits(file, self.period_used(), duty, dt),
+            None => Ok(()),
         }
     }
 
@@ -442,6 +424,29 @@ impl GaitConfig {
             limits: d.limits,
             walking: true,
         }
+    }
+}
+
+/// [`fbd_robot::gait::check_swing`] as a configuration error naming
+/// `gait.period`: the rule of the hexapod's `[gait]` and of an imported
+/// robot's.
+pub(crate) fn swing_fits(file: &str, period: f64, duty: f64, dt: f64) -> Result<(), ConfigError> {
+    match fbd_robot::gait::check_swing(period, duty, dt) {
+        Err(fbd_robot::gait::GaitError::ShortSwing {
+            swing, min_period, ..
+        }) => Err(ConfigError::semantic(
+            file,
+            "gait.period",
+            &format!(
+                "the swing (1 − duty_factor)·period = {} s spans fewer than {} steps of time.dt = {} s",
+                Num(swing),
+                fbd_robot::gait::MIN_SWING_STEPS,
+                Num(dt)
+            ),
+            period,
+            &format!("a period ≥ {} s, or a smaller time.dt", Num(min_period)),
+        )),
+        _ => Ok(()),
     }
 }
 

@@ -778,8 +778,7 @@ fn resolve_gait(
     if let Some(v) = gait.ramp {
         p.ramp = finite("ramp", v)?;
     }
-    fbd_robot::gait::check_swing(p.period, p.duty, dt)
-        .map_err(|e| semantic(file, format!("gait.period: {e}")))?;
+    crate::gait::swing_fits(file, p.period, p.duty, dt)?;
     let position = base.translation.vector;
     let plan = GaitPlan::new(
         model,

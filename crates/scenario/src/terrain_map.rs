@@ -21,7 +21,7 @@ use fbd_contact::{
 };
 use serde::{Deserialize, Serialize};
 
-use super::{ConfigError, Quote, TerrainConfig, TerrainKind};
+use super::{ConfigError, TerrainConfig, TerrainKind};
 
 /// Default extent `[x, z]` (m) of a generated terrain.
 pub const DEFAULT_SIZE: [f64; 2] = [3.0, 3.0];
@@ -44,15 +44,11 @@ pub struct PatchConfig {
     pub mu_dynamic: f64,
 }
 
-fn semantic(file: &str, key: &str, what: &str, got: impl Quote, expected: &str) -> ConfigError {
-    ConfigError::semantic(file, key, what, got, expected)
-}
-
 /// A `[min, max]` pair with `min ≤ max` (`strict`: `min < max`).
 fn range(file: &str, key: &str, v: &[f64], strict: bool) -> Result<[f64; 2], ConfigError> {
     match v {
         [a, b] if a.is_finite() && b.is_finite() && (a < b || (!strict && a == b)) => Ok([*a, *b]),
-        _ => Err(semantic(
+        _ => Err(ConfigError::semantic(
             file,
             key,
             "must be a finite range [min, max]",
@@ -70,7 +66,7 @@ fn range(file: &str, key: &str, v: &[f64], strict: bool) -> Result<[f64; 2], Con
 fn pair(file: &str, key: &str, v: &[f64]) -> Result<[f64; 2], ConfigError> {
     match v {
         [a, b] if a.is_finite() && b.is_finite() => Ok([*a, *b]),
-        _ => Err(semantic(
+        _ => Err(ConfigError::semantic(
             file,
             key,
             "must be 2 finite numbers",
@@ -85,7 +81,7 @@ fn positive(file: &str, key: &str, v: f64) -> Result<f64, ConfigError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(semantic(
+        Err(ConfigError::semantic(
             file,
             key,
             "must be positive and finite",
@@ -100,7 +96,13 @@ fn finite(file: &str, key: &str, v: f64) -> Result<f64, ConfigError> {
     if v.is_finite() {
         Ok(v)
     } else {
-        Err(semantic(file, key, "must be finite", v, "a finite value"))
+        Err(ConfigError::semantic(
+            file,
+            key,
+            "must be finite",
+            v,
+            "a finite value",
+        ))
     }
 }
 
@@ -353,7 +355,7 @@ impl TerrainConfig {
                     mu_dynamic: p.mu_dynamic,
                 };
                 if !(p.mu_static.is_finite() && p.mu_static >= 0.0) {
-                    return Err(semantic(
+                    return Err(ConfigError::semantic(
                         file,
                         &key("mu_static"),
                         "must be finite and ≥ 0",
@@ -362,7 +364,7 @@ impl TerrainConfig {
                     ));
                 }
                 if friction.validate().is_err() {
-                    return Err(semantic(
+                    return Err(ConfigError::semantic(
                         file,
                         &key("mu_dynamic"),
                         "must satisfy 0 ≤ mu_dynamic ≤ mu_static",
@@ -419,7 +421,7 @@ impl TerrainConfig {
         let size = match &self.size {
             Some(v) => pair(f, "terrain.size", v)?,
             None if self.kind == TerrainKind::Heightfield => {
-                return Err(semantic(
+                return Err(ConfigError::semantic(
                     f,
                     "terrain.size",
                     "is required for kind = \"heightfield\"",
@@ -431,7 +433,7 @@ impl TerrainConfig {
         };
         for (axis, e) in size.iter().enumerate() {
             if *e <= 0.0 {
-                return Err(semantic(
+                return Err(ConfigError::semantic(
                     f,
                     "terrain.size",
                     &format!("the {} extent must be positive", ["x", "z"][axis]),
@@ -460,7 +462,7 @@ impl TerrainConfig {
         center: [f64; 2],
     ) -> Result<HeightGrid, ConfigError> {
         let Some(name) = self.file.clone() else {
-            return Err(semantic(
+            return Err(ConfigError::semantic(
                 f,
                 "terrain.file",
                 "is required for kind = \"heightfield\"",
@@ -471,7 +473,7 @@ impl TerrainConfig {
         let path = Path::new(f).parent().unwrap_or(Path::new("")).join(&name);
         let shown = path.display().to_string();
         let fail = |what: String| {
-            semantic(
+            ConfigError::semantic(
                 f,
                 "terrain.file",
                 &format!("{shown}: {what}"),
@@ -483,7 +485,7 @@ impl TerrainConfig {
         let values = match h.scale {
             Some([lo, hi]) => {
                 let Some(e) = &self.elevation else {
-                    return Err(semantic(
+                    return Err(ConfigError::semantic(
                         f,
                         "terrain.elevation",
                         &format!("is required for the image or MuJoCo heightfield {shown}"),
@@ -497,7 +499,7 @@ impl TerrainConfig {
             }
             None => {
                 if self.elevation.is_some() {
-                    return Err(semantic(
+                    return Err(ConfigError::semantic(
                         f,
                         "terrain.elevation",
                         &format!("is not used by {shown}, whose heights are metres"),
@@ -509,7 +511,7 @@ impl TerrainConfig {
             }
         };
         let grid = HeightGrid::new(h.nrow, h.ncol, values, size, center).map_err(|e| match e {
-            GridIssue::Extent { .. } => semantic(
+            GridIssue::Extent { .. } => ConfigError::semantic(
                 f,
                 "terrain.size",
                 &e.to_string(),
@@ -533,7 +535,7 @@ impl TerrainConfig {
     ) -> Result<HeightGrid, ConfigError> {
         let need = |key: &str, v: Option<f64>| -> Result<f64, ConfigError> {
             let v = v.ok_or_else(|| {
-                semantic(
+                ConfigError::semantic(
                     f,
                     &format!("terrain.{key}"),
                     "is required for this kind",
@@ -550,7 +552,7 @@ impl TerrainConfig {
         )?;
         let cells = (size[0] / resolution + 1.0) * (size[1] / resolution + 1.0);
         if cells > 4e6 {
-            return Err(semantic(
+            return Err(ConfigError::semantic(
                 f,
                 "terrain.resolution",
                 "gives a grid of more than 4 million points",
@@ -560,7 +562,7 @@ impl TerrainConfig {
         }
         let edge_radius = self.edge_radius.unwrap_or(DEFAULT_EDGE_RADIUS);
         if !(edge_radius.is_finite() && edge_radius >= 0.0) {
-            return Err(semantic(
+            return Err(ConfigError::semantic(
                 f,
                 "terrain.edge_radius",
                 "must be finite and ≥ 0",
@@ -614,7 +616,7 @@ impl TerrainConfig {
                 )?,
             },
             k => {
-                return Err(semantic(
+                return Err(ConfigError::semantic(
                     f,
                     "terrain.kind",
                     "is not a generated kind",
@@ -632,7 +634,7 @@ impl TerrainConfig {
                 height: self.height,
             })
             .map_err(|e| {
-                semantic(
+                ConfigError::semantic(
                     f,
                     "terrain.size",
                     &e.to_string(),

@@ -444,8 +444,10 @@ impl Simulator {
                 v.len()
             )));
         }
-        if what == "torques" {
-            finite_torques(&v)?;
+        if what == "torques"
+            && let Some(e) = nonfinite_torque(&v)
+        {
+            return Err(PyValueError::new_err(e));
         }
         Ok(v)
     }
@@ -1357,17 +1359,15 @@ pub fn set_pd_targets_many<'py>(
     Ok(())
 }
 
-/// Torques given to a step must be numbers: a NaN or an infinity is a
-/// `ValueError` naming the joint's index (it would fail the step as "a
+/// Torques given to a step must be numbers: the message of a NaN or an
+/// infinity, naming the joint's index (it would fail the step as "a
 /// non-finite value in the residual").
-fn finite_torques(v: &[f64]) -> PyResult<()> {
-    match v.iter().position(|x| !x.is_finite()) {
-        Some(j) => Err(PyValueError::new_err(format!(
-            "torques: must be finite (got {} at index {j})",
-            v[j]
-        ))),
-        None => Ok(()),
-    }
+fn nonfinite_torque(v: &[f64]) -> Option<String> {
+    let j = v.iter().position(|x| !x.is_finite())?;
+    Some(format!(
+        "torques: must be finite (got {} at index {j})",
+        v[j]
+    ))
 }
 
 /// `step_many(sims, torques=None, steps=1)`: steps every simulator of the
@@ -1414,8 +1414,9 @@ pub fn step_many<'py>(
                         s.sim.joints()
                     )));
                 }
-                finite_torques(&row)
-                    .map_err(|e| PyValueError::new_err(format!("row {i}: {}", e.value(py))))?;
+                if let Some(e) = nonfinite_torque(&row) {
+                    return Err(PyValueError::new_err(format!("row {i}: {e}")));
+                }
                 Some(row)
             }
             None => None,
